@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Installs what strata needs to build on Debian 12, idempotently:
+#   - libclang (bindgen in embree4-sys needs the full -dev package for stddef.h), pkg-config
+#   - Embree 4.4 + TBB into ./.embree/lib, from the PyPI wheel embreex==4.4.0.post1
+#     (skipped when EMBREE_DIR is set or pkg-config finds embree4)
+#   - a Rust toolchain is assumed (cargo on PATH); rustup is used to install it if missing.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+
+need_apt=()
+dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
+command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
+command -v python3 >/dev/null 2>&1 || need_apt+=(python3)
+python3 -m pip --version >/dev/null 2>&1 || need_apt+=(python3-pip)
+if [ ${#need_apt[@]} -gt 0 ]; then
+  echo "setup: installing ${need_apt[*]}" >&2
+  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  [ -x "$HOME/.cargo/bin/cargo" ] && export PATH="$HOME/.cargo/bin:$PATH"
+fi
+command -v cargo >/dev/null 2>&1 || { echo "setup: cargo not found; install Rust with rustup first" >&2; exit 1; }
+
+if [ -n "${EMBREE_DIR:-}" ] || pkg-config --exists embree4 2>/dev/null; then
+  exit 0
+fi
+lib="$root/.embree/lib"
+if [ -e "$lib/libembree4.so" ] && ls "$lib"/libtbb*.so* >/dev/null 2>&1; then
+  exit 0
+fi
+echo "setup: fetching Embree 4.4 from the PyPI wheel embreex==4.4.0.post1 into .embree/" >&2
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+python3 -m pip download -q --no-deps --only-binary=:all: --python-version 3.11 \
+  --platform manylinux_2_28_x86_64 embreex==4.4.0.post1 -d "$tmp"
+mkdir -p "$lib"
+python3 - "$tmp"/embreex-*.whl "$lib" <<'PY'
+import sys, zipfile, os
+whl, out = sys.argv[1], sys.argv[2]
+with zipfile.ZipFile(whl) as z:
+    for n in z.namelist():
+        if n.startswith("embreex.libs/") and ".so" in n:
+            dst = os.path.join(out, os.path.basename(n))
+            with z.open(n) as src, open(dst, "wb") as f:
+                f.write(src.read())
+PY
+emb="$(ls "$lib"/libembree4-*.so.4 | head -n1)"
+ln -sf "$(basename "$emb")" "$lib/libembree4.so"
+ln -sf "$(basename "$emb")" "$lib/libembree4.so.4"
+echo "setup: Embree ready in $lib" >&2

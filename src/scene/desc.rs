@@ -1,0 +1,226 @@
+//! The parsed scene: plain data, world space, no Embree. Produced by `scene::parse`, consumed by
+//! `scene::build` (which makes the Embree scene and the SoA shading tables).
+//!
+//! Conventions: right-handed world space; all geometry already transformed to world space except
+//! spheres, which keep their object-to-world matrix (a unit sphere at the origin maps to the
+//! ellipsoid). Radiance in linear RGB.
+
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+
+/// Which integrator a scene asks for (`integrator` command).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum IntegratorKind {
+    /// hw1 Whitted ray tracer (default of the format).
+    #[default]
+    RayTracer,
+    /// Exact polygonal irradiance from quad lights, no visibility.
+    AnalyticDirect,
+    /// Area-light sampling with shadow rays.
+    Direct,
+    /// Unidirectional path tracer.
+    PathTracer,
+}
+
+/// `nexteventestimation off|on|mis`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Nee {
+    /// Count emission at every hit.
+    #[default]
+    Off,
+    /// Sample one light point per vertex; emission only on camera rays.
+    On,
+    /// Light and BRDF sampling combined with the power heuristic.
+    Mis,
+}
+
+/// `importancesampling hemisphere|cosine|brdf`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ImportanceSampling {
+    /// Uniform hemisphere.
+    #[default]
+    Hemisphere,
+    /// Cosine-weighted hemisphere.
+    Cosine,
+    /// Mixture of the BRDF's lobes.
+    Brdf,
+}
+
+/// `brdf phong|ggx`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BrdfKind {
+    /// Modified Phong.
+    #[default]
+    Phong,
+    /// GGX microfacet with Schlick Fresnel.
+    Ggx,
+}
+
+/// Material state in force when a primitive was declared.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// kd (default 0)
+    pub diffuse: Vec3,
+    /// ks (default 0)
+    pub specular: Vec3,
+    /// Phong exponent s (default 1)
+    pub shininess: f32,
+    /// Emitted radiance added at every hit (default 0)
+    pub emission: Vec3,
+    /// Ambient term, raytracer only (default 0.2)
+    pub ambient: Vec3,
+    /// BRDF model (default Phong)
+    pub brdf: BrdfKind,
+    /// GGX alpha, used as is (default 1)
+    pub roughness: f32,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            diffuse: Vec3::ZERO,
+            specular: Vec3::ZERO,
+            shininess: 1.0,
+            emission: Vec3::ZERO,
+            ambient: Vec3::splat(0.2),
+            brdf: BrdfKind::Phong,
+            roughness: 1.0,
+        }
+    }
+}
+
+/// Look-at pinhole camera; `fovy_deg` is the full vertical field of view in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    /// eye position
+    pub eye: Vec3,
+    /// look-at point
+    pub center: Vec3,
+    /// up hint
+    pub up: Vec3,
+    /// full vertical field of view, degrees
+    pub fovy_deg: f32,
+}
+
+/// A triangle in world space; geometric normal (v1-v0)x(v2-v0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleDesc {
+    /// vertices, world space
+    pub v: [Vec3; 3],
+    /// index into `SceneDesc::materials`
+    pub material: u32,
+}
+
+/// A unit sphere at the origin mapped by `object_to_world` (= M * T(c) * S(r)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereDesc {
+    /// object-to-world affine matrix
+    pub object_to_world: Mat4,
+    /// index into `SceneDesc::materials`
+    pub material: u32,
+}
+
+/// Parallelogram light a + u ab + v ac; one-sided radiance towards normalize(ac x ab).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuadLightDesc {
+    /// corner
+    pub a: Vec3,
+    /// first edge
+    pub ab: Vec3,
+    /// second edge
+    pub ac: Vec3,
+    /// emitted radiance
+    pub radiance: Vec3,
+}
+
+/// Point light (raytracer only).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLightDesc {
+    /// world position (transformed by the current matrix when declared)
+    pub position: Vec3,
+    /// intensity
+    pub color: Vec3,
+    /// attenuation (c0, c1, c2) in force when declared
+    pub attenuation: Vec3,
+}
+
+/// Directional light (raytracer only); `direction` points towards the light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DirectionalLightDesc {
+    /// unit direction towards the light, world space
+    pub direction: Vec3,
+    /// radiance scale
+    pub color: Vec3,
+}
+
+/// Everything a `.test` file says.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneDesc {
+    /// file it came from (for messages)
+    pub source: PathBuf,
+    /// image width in pixels
+    pub width: u32,
+    /// image height in pixels
+    pub height: u32,
+    /// `output` name, if given
+    pub output: Option<String>,
+    /// camera, if given
+    pub camera: Option<CameraDesc>,
+    /// samples per pixel (default 1)
+    pub spp: u32,
+    /// display gamma for 8-bit output (default 1)
+    pub gamma: f32,
+    /// integrator (default raytracer)
+    pub integrator: IntegratorKind,
+    /// max depth (default 5; -1 = unbounded)
+    pub max_depth: i32,
+    /// light samples per light for `direct` (default 1)
+    pub light_samples: u32,
+    /// `lightstratify on`
+    pub light_stratify: bool,
+    /// next event estimation
+    pub nee: Nee,
+    /// Russian roulette
+    pub russian_roulette: bool,
+    /// direction sampling of the path tracer
+    pub importance_sampling: ImportanceSampling,
+    /// distinct materials, referenced by index
+    pub materials: Vec<Material>,
+    /// triangles, world space
+    pub triangles: Vec<TriangleDesc>,
+    /// spheres / ellipsoids
+    pub spheres: Vec<SphereDesc>,
+    /// quad area lights (not transformed by the stack)
+    pub quad_lights: Vec<QuadLightDesc>,
+    /// point lights
+    pub point_lights: Vec<PointLightDesc>,
+    /// directional lights
+    pub directional_lights: Vec<DirectionalLightDesc>,
+}
+
+impl Default for SceneDesc {
+    fn default() -> Self {
+        Self {
+            source: PathBuf::new(),
+            width: 640,
+            height: 480,
+            output: None,
+            camera: None,
+            spp: 1,
+            gamma: 1.0,
+            integrator: IntegratorKind::RayTracer,
+            max_depth: 5,
+            light_samples: 1,
+            light_stratify: false,
+            nee: Nee::Off,
+            russian_roulette: false,
+            importance_sampling: ImportanceSampling::Hemisphere,
+            materials: Vec::new(),
+            triangles: Vec::new(),
+            spheres: Vec::new(),
+            quad_lights: Vec::new(),
+            point_lights: Vec::new(),
+            directional_lights: Vec::new(),
+        }
+    }
+}
