@@ -1,0 +1,3 @@
+//! Scene description, parsing and building.
+pub mod desc;
+pub mod parse;
