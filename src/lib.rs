@@ -1,4 +1,10 @@
-//! strata: a SIMD packet ray tracer on Embree 4.
+//! strata: a SIMD packet ray tracer on Embree 4, built to compare sampling techniques.
 pub mod accel;
+pub mod app;
+pub mod film;
+pub mod integrator;
+pub mod light;
+pub mod render;
+pub mod sampler;
 pub mod scene;
 pub mod simd;

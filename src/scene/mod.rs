@@ -1,3 +1,4 @@
 //! Scene description, parsing and building.
 pub mod desc;
 pub mod parse;
+pub mod build;

@@ -1,0 +1,227 @@
+//! The `strata render` command as a library function (the binary, tests and benches share it).
+
+use crate::film::{self, Film, Metadata};
+use crate::integrator::Integrator;
+use crate::render::{self, RenderStats};
+use crate::sampler::SamplerKind;
+use crate::scene::build::Scene;
+use crate::scene::desc::{IntegratorKind, SceneDesc};
+use crate::scene::parse::{self, Limits};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// The built-in default scene (a Cornell box written for strata).
+pub const DEFAULT_SCENE: &str = include_str!("../scenes/cornell.test");
+
+/// Options of `strata render`.
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions {
+    /// scene file; None renders the built-in Cornell box
+    pub scene: Option<PathBuf>,
+    /// samples per pixel (default: the scene's `spp`)
+    pub spp: Option<u32>,
+    /// image size override, keeping the camera
+    pub size: Option<(u32, u32)>,
+    /// base seed
+    pub seed: u64,
+    /// worker threads (0 = all cores)
+    pub threads: usize,
+    /// light sample layout (default: the scene's `lightstratify`)
+    pub light_sampler: Option<SamplerKind>,
+    /// light samples per light (default: the scene's `lightsamples`)
+    pub light_samples: Option<u32>,
+    /// output stem: writes OUT.exr and OUT.png (default: the scene's `output` name)
+    pub out: Option<PathBuf>,
+    /// JSON statistics file
+    pub stats: Option<PathBuf>,
+    /// integrator override
+    pub integrator: Option<IntegratorKind>,
+}
+
+/// Everything a render produced.
+pub struct RenderOutput {
+    /// the scene as built
+    pub scene: Scene,
+    /// the integrator settings used
+    pub integrator: Integrator,
+    /// accumulated samples
+    pub film: Film,
+    /// timing and counters
+    pub stats: RenderStats,
+    /// the output stem written to, if any
+    pub out: Option<PathBuf>,
+}
+
+/// Parses the scene named in `opts` (or the built-in one) and applies the size override.
+pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
+    let limits = Limits::default();
+    let mut desc = match &opts.scene {
+        Some(p) => parse::parse_file(p, &limits).map_err(|e| e.to_string())?,
+        None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits).map_err(|e| e.to_string())?,
+    };
+    if let Some((w, h)) = opts.size {
+        if w == 0 || h == 0 || u64::from(w) * u64::from(h) > limits.max_pixels || w > limits.max_side || h > limits.max_side {
+            return Err(format!("--size {w}x{h} is outside 1..={} per side and {} pixels", limits.max_side, limits.max_pixels));
+        }
+        desc.width = w;
+        desc.height = h;
+    }
+    if let Some(k) = opts.integrator {
+        desc.integrator = k;
+    }
+    Ok(desc)
+}
+
+/// Integrator name as the format spells it.
+pub fn integrator_name(k: IntegratorKind) -> &'static str {
+    match k {
+        IntegratorKind::RayTracer => "raytracer",
+        IntegratorKind::AnalyticDirect => "analyticdirect",
+        IntegratorKind::Direct => "direct",
+        IntegratorKind::PathTracer => "pathtracer",
+    }
+}
+
+/// Parses an integrator name.
+pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
+    Some(match s {
+        "raytracer" => IntegratorKind::RayTracer,
+        "analyticdirect" => IntegratorKind::AnalyticDirect,
+        "direct" => IntegratorKind::Direct,
+        "pathtracer" => IntegratorKind::PathTracer,
+        _ => return None,
+    })
+}
+
+/// Renders without writing anything: scene build, integrator set-up, all samples.
+pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
+    let desc = load_scene(opts)?;
+    match desc.integrator {
+        IntegratorKind::AnalyticDirect | IntegratorKind::Direct => {}
+        k => {
+            return Err(format!(
+                "{}: integrator `{}` is not implemented yet (this build renders analyticdirect and direct)",
+                desc.source.display(),
+                integrator_name(k)
+            ))
+        }
+    }
+    let spp = opts.spp.unwrap_or(desc.spp).max(1);
+    let scene = Scene::build(desc).map_err(|e| e.to_string())?;
+    let integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples);
+    let pool = render::thread_pool(opts.threads).map_err(|e| e.to_string())?;
+    let mut film = Film::new(scene.desc.width, scene.desc.height);
+    let stats = render::render(&scene, &integrator, &mut film, 0..spp, &pool);
+    Ok(RenderOutput { scene, integrator, film, stats, out: None })
+}
+
+/// Output stem: `-o OUT`, else the scene's `output` file name without extension (directories
+/// stripped: a scene file never chooses where we write), else "strata".
+pub fn output_stem(opts: &RenderOptions, desc: &SceneDesc) -> PathBuf {
+    if let Some(o) = &opts.out {
+        let s = o.to_string_lossy();
+        for ext in [".exr", ".png"] {
+            if let Some(stripped) = s.strip_suffix(ext) {
+                return PathBuf::from(stripped);
+            }
+        }
+        return o.clone();
+    }
+    desc.output
+        .as_deref()
+        .and_then(|n| Path::new(n).file_stem())
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("strata"))
+}
+
+fn with_ext(stem: &Path, ext: &str) -> PathBuf {
+    let mut s = stem.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+/// Metadata written into the EXR header.
+pub fn metadata(out: &RenderOutput) -> Metadata {
+    let d = &out.scene.desc;
+    vec![
+        ("strata.version".into(), env!("CARGO_PKG_VERSION").into()),
+        ("strata.scene".into(), d.source.display().to_string()),
+        ("strata.integrator".into(), integrator_name(d.integrator).into()),
+        ("strata.spp".into(), out.integrator.spp.to_string()),
+        ("strata.seed".into(), out.integrator.seed.to_string()),
+        ("strata.pixel_sampler".into(), out.integrator.pixel_set.kind().name().into()),
+        ("strata.light_sampler".into(), out.integrator.light_set.kind().name().into()),
+        ("strata.light_samples".into(), out.integrator.light_set.n().to_string()),
+        ("strata.render_seconds".into(), format!("{:.6}", out.stats.seconds)),
+        ("strata.threads".into(), out.stats.threads.to_string()),
+    ]
+}
+
+/// The `--stats` JSON.
+pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
+    let d = &out.scene.desc;
+    let c = &out.stats.counters;
+    json!({
+        "scene": d.source.display().to_string(),
+        "integrator": integrator_name(d.integrator),
+        "seconds": out.stats.seconds,
+        "spp": out.integrator.spp,
+        "width": d.width,
+        "height": d.height,
+        "seed": out.integrator.seed,
+        "threads": out.stats.threads,
+        "pixel_sampler": out.integrator.pixel_set.kind().name(),
+        "light_sampler": out.integrator.light_set.kind().name(),
+        "light_samples": out.integrator.light_set.n(),
+        "rays": { "camera": c.camera, "shadow": c.shadow, "bounce": c.bounce, "total": c.total_rays() },
+        "mrays_per_sec": out.stats.mrays_per_sec(),
+        "packets": c.packets,
+        "occupancy": c.occupancy(),
+        "nonfinite_samples": c.nonfinite,
+        "version": env!("CARGO_PKG_VERSION"),
+    })
+}
+
+/// One-line summary printed after a render.
+pub fn summary(out: &RenderOutput) -> String {
+    let d = &out.scene.desc;
+    let c = &out.stats.counters;
+    format!(
+        "{} {}x{} {} spp {} (light {} x{}): {:.3} s, {:.2} Mrays/s (camera {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
+        d.source.display(),
+        d.width,
+        d.height,
+        out.integrator.spp,
+        integrator_name(d.integrator),
+        out.integrator.light_set.kind().name(),
+        out.integrator.light_set.n(),
+        out.stats.seconds,
+        out.stats.mrays_per_sec(),
+        c.camera,
+        c.shadow,
+        100.0 * c.occupancy(),
+        out.stats.threads,
+        c.nonfinite,
+        out.out.as_ref().map(|p| format!(" -> {}.exr/.png", p.display())).unwrap_or_default()
+    )
+}
+
+/// `strata render`: render, write OUT.exr (with a variance layer) and OUT.png, and the stats JSON.
+pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, String> {
+    let mut out = render_to_film(opts)?;
+    let stem = output_stem(opts, &out.scene.desc);
+    let (w, h) = (out.film.width, out.film.height);
+    let mean = out.film.mean();
+    let var = out.film.variance_of_mean();
+    let exr = with_ext(&stem, "exr");
+    film::write_exr(&exr, w, h, &mean, Some(&var), &metadata(&out)).map_err(|e| format!("{}: {e}", exr.display()))?;
+    let png = with_ext(&stem, "png");
+    film::write_png(&png, w, h, &mean, out.scene.desc.gamma).map_err(|e| format!("{}: {e}", png.display()))?;
+    out.out = Some(stem);
+    if let Some(p) = &opts.stats {
+        let text = serde_json::to_string_pretty(&stats_json(&out)).map_err(|e| e.to_string())?;
+        film::write_atomic(p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,2 @@
+//! Lights: quad (parallelogram) area lights and exact polygonal irradiance.
+pub mod polygonal;

@@ -1,0 +1,199 @@
+//! Tiles, threads and accumulation: the only place with threads.
+//!
+//! The image is cut into 16x16-pixel tiles; a tile is cut into 4x2-pixel packets. Tiles run in
+//! parallel under rayon; each pixel's samples are accumulated in f64 in increasing sample order,
+//! and every sample value is a pure function of (pixel, sample, dimension, seed), so the image is
+//! bit-identical whatever the thread count or tile schedule.
+
+use crate::film::Film;
+use crate::integrator::{Counters, Integrator};
+use crate::scene::build::Scene;
+use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Tile side in pixels.
+pub const TILE: u32 = 16;
+/// Packet footprint: 4 pixels wide, 2 tall.
+pub const PACKET_W: u32 = 4;
+/// Packet footprint height.
+pub const PACKET_H: u32 = 2;
+
+/// The pixels of one 4x2 packet: linear pixel ids, pixel coordinates and the in-image mask.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelPacket {
+    /// linear pixel index y * width + x (0 for lanes outside the image)
+    pub pixel: U8,
+    /// pixel x
+    pub x: F8,
+    /// pixel y
+    pub y: F8,
+    /// lanes inside the image
+    pub active: Mask8,
+}
+
+impl PixelPacket {
+    /// Packet whose top-left pixel is (x0, y0), clipped to a `width` x `height` image.
+    pub fn new(x0: u32, y0: u32, width: u32, height: u32) -> Self {
+        let mut pix = [0u32; 8];
+        let mut inside = [false; 8];
+        let mut xs = [0u32; 8];
+        let mut ys = [0u32; 8];
+        for i in 0..8u32 {
+            let (x, y) = (x0 + i % PACKET_W, y0 + i / PACKET_W);
+            xs[i as usize] = x;
+            ys[i as usize] = y;
+            if x < width && y < height {
+                inside[i as usize] = true;
+                pix[i as usize] = y * width + x;
+            }
+        }
+        Self { pixel: U8::new(pix), x: u8_to_f8(U8::new(xs)), y: u8_to_f8(U8::new(ys)), active: mask_from_bools(inside) }
+    }
+}
+
+/// What a render produced besides the film.
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    /// wall-clock seconds of the sampling loop (scene build excluded)
+    pub seconds: f64,
+    /// ray and packet counters summed over threads
+    pub counters: Counters,
+    /// worker threads used
+    pub threads: usize,
+}
+
+impl RenderStats {
+    /// Rays traced per second over all kinds, in millions.
+    pub fn mrays_per_sec(&self) -> f64 {
+        self.counters.total_rays() as f64 / self.seconds.max(1e-12) / 1e6
+    }
+}
+
+/// Builds a rayon pool of `threads` workers (0 = all cores), each with FTZ/DAZ set.
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, rayon::ThreadPoolBuildError> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()
+}
+
+/// Renders samples `samples.start..samples.end` of every pixel into `film` (which accumulates).
+pub fn render(
+    scene: &Scene,
+    integrator: &Integrator,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+    pool: &rayon::ThreadPool,
+) -> RenderStats {
+    let (w, h) = (film.width, film.height);
+    let tiles_x = w.div_ceil(TILE);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let start = Instant::now();
+    let results: Vec<(TileResult, Counters)> = pool.install(|| {
+        tiles
+            .par_iter()
+            .map(|&(tx, ty)| {
+                let mut counters = Counters::default();
+                let r = render_tile(scene, integrator, tx * TILE, ty * TILE, w, h, samples.clone(), &mut counters);
+                (r, counters)
+            })
+            .collect()
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    let mut counters = Counters::default();
+    for (tile, c) in &results {
+        counters.merge(c);
+        tile.add_to(film);
+    }
+    RenderStats { seconds, counters, threads: pool.current_num_threads() }
+}
+
+/// Accumulated samples of one tile (f64 sums, row-major inside the tile).
+struct TileResult {
+    x0: u32,
+    y0: u32,
+    tw: u32,
+    th: u32,
+    sum: Vec<[f64; 3]>,
+    sum_sq: Vec<[f64; 3]>,
+    count: u32,
+}
+
+impl TileResult {
+    fn add_to(&self, film: &mut Film) {
+        for ty in 0..self.th {
+            for tx in 0..self.tw {
+                let i = (ty * self.tw + tx) as usize;
+                let j = ((self.y0 + ty) * film.width + self.x0 + tx) as usize;
+                for c in 0..3 {
+                    film.sum[j][c] += self.sum[i][c];
+                    film.sum_sq[j][c] += self.sum_sq[i][c];
+                }
+                film.count[j] += self.count;
+            }
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render_tile(
+    scene: &Scene,
+    integrator: &Integrator,
+    x0: u32,
+    y0: u32,
+    w: u32,
+    h: u32,
+    samples: std::ops::Range<u32>,
+    counters: &mut Counters,
+) -> TileResult {
+    let tw = TILE.min(w - x0);
+    let th = TILE.min(h - y0);
+    let n = (tw * th) as usize;
+    let mut sum = vec![[0f64; 3]; n];
+    let mut sum_sq = vec![[0f64; 3]; n];
+    let packets: Vec<PixelPacket> = (0..th.div_ceil(PACKET_H))
+        .flat_map(|py| (0..tw.div_ceil(PACKET_W)).map(move |px| (px, py)))
+        .map(|(px, py)| PixelPacket::new(x0 + px * PACKET_W, y0 + py * PACKET_H, w, h))
+        .collect();
+    for s in samples.clone() {
+        for pk in &packets {
+            let l = integrator.radiance(scene, pk, s, counters);
+            accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, &l, counters);
+        }
+    }
+    TileResult { x0, y0, tw, th, sum, sum_sq, count: samples.len() as u32 }
+}
+
+/// Adds one sample per active lane; a non-finite lane value is counted and replaced by zero so
+/// no NaN or Inf ever reaches the image.
+#[allow(clippy::too_many_arguments)]
+fn accumulate(
+    sum: &mut [[f64; 3]],
+    sum_sq: &mut [[f64; 3]],
+    pk: &PixelPacket,
+    x0: u32,
+    y0: u32,
+    tw: u32,
+    l: &Vec3x8,
+    counters: &mut Counters,
+) {
+    let active = crate::simd::mask_to_bools(pk.active);
+    let finite = crate::simd::mask_to_bools(l.is_finite());
+    let (xs, ys) = (pk.x.to_array(), pk.y.to_array());
+    let lanes = l.to_lanes();
+    for i in 0..8 {
+        if !active[i] {
+            continue;
+        }
+        let v = if finite[i] {
+            lanes[i]
+        } else {
+            counters.nonfinite += 1;
+            glam::Vec3::ZERO
+        };
+        let j = ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize;
+        for c in 0..3 {
+            let x = v[c] as f64;
+            sum[j][c] += x;
+            sum_sq[j][c] += x * x;
+        }
+    }
+}

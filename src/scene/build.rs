@@ -1,0 +1,332 @@
+//! Builds a renderable [`Scene`] from a [`SceneDesc`]: the Embree scene (through `accel`), the
+//! shading tables, the lights and the camera; and the one AoS -> SoA gather of hit records.
+//!
+//! Conventions: world space; `ng` is the unit geometric normal as declared ((v1-v0)x(v2-v0) for
+//! triangles, outward for ellipsoids); shading uses the normal flipped to face the incoming ray
+//! (surfaces are shaded two-sided, so meshes of either winding render; lights stay one-sided).
+
+use crate::accel::{self, Hits8, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
+use crate::scene::desc::{BrdfKind, CameraDesc, Material, SceneDesc};
+use crate::simd::{Mask8, Vec3x8, F8, U8};
+use glam::{Mat3, Mat4, Vec3};
+
+/// A parallelogram area light a + u ab + v ac, one-sided, emitting towards `normal`.
+#[derive(Clone, Copy, Debug)]
+pub struct QuadLight {
+    /// corner
+    pub a: Vec3,
+    /// first edge
+    pub ab: Vec3,
+    /// second edge
+    pub ac: Vec3,
+    /// emitted radiance
+    pub radiance: Vec3,
+    /// unit emitting normal, normalize(ac x ab)
+    pub normal: Vec3,
+    /// area |ab x ac|
+    pub area: f32,
+}
+
+impl QuadLight {
+    /// The four corners in the order a, a+ab, a+ab+ac, a+ac.
+    pub fn corners(&self) -> [Vec3; 4] {
+        [self.a, self.a + self.ab, self.a + self.ab + self.ac, self.a + self.ac]
+    }
+    /// Power (radiant flux) per unit radiance scale: pi * area * luminance-free max channel.
+    pub fn power(&self) -> f32 {
+        std::f32::consts::PI * self.area * self.radiance.max_element()
+    }
+}
+
+/// Pinhole camera, look-at, full vertical field of view.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    /// eye position
+    pub eye: Vec3,
+    /// unit view direction
+    pub look: Vec3,
+    /// unit right vector (look x up)
+    pub right: Vec3,
+    /// unit up vector (right x look)
+    pub up: Vec3,
+    /// image plane distance 1/tan(fovy/2) (half-height 1)
+    pub plane_dist: f32,
+    /// image width in pixels
+    pub width: u32,
+    /// image height in pixels
+    pub height: u32,
+}
+
+impl Camera {
+    /// Camera of `desc` for a `width` x `height` image.
+    pub fn new(desc: &CameraDesc, width: u32, height: u32) -> Self {
+        let look = (desc.center - desc.eye).normalize_or(Vec3::NEG_Z);
+        let mut right = look.cross(desc.up).normalize_or_zero();
+        if right == Vec3::ZERO {
+            // Up parallel to the view: pick any perpendicular (the parser refuses this; be safe).
+            right = look.any_orthonormal_vector();
+        }
+        let up = right.cross(look);
+        let half = (desc.fovy_deg.to_radians() * 0.5).tan().max(1e-6);
+        Self { eye: desc.eye, look, right, up, plane_dist: 1.0 / half, width, height }
+    }
+
+    /// Unnormalized-then-normalized directions through image positions (x, y) in pixels, y down.
+    #[inline]
+    pub fn dirs8(&self, x: F8, y: F8) -> Vec3x8 {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let aspect = w / h;
+        let sx = (x * F8::splat(2.0 / w) - F8::ONE) * F8::splat(aspect);
+        let sy = F8::ONE - y * F8::splat(2.0 / h);
+        let d = Vec3x8::splat(self.look * self.plane_dist) + Vec3x8::splat(self.right).scale(sx) + Vec3x8::splat(self.up).scale(sy);
+        d.normalize_or_zero()
+    }
+
+    /// Scalar twin of [`Camera::dirs8`].
+    pub fn dir(&self, x: f32, y: f32) -> Vec3 {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let sx = (x * (2.0 / w) - 1.0) * (w / h);
+        let sy = 1.0 - y * (2.0 / h);
+        (self.look * self.plane_dist + self.right * sx + self.up * sy).normalize_or_zero()
+    }
+}
+
+/// Shading record of 8 hits, structure of arrays (the one AoS -> SoA gather).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit8 {
+    /// lanes that hit a surface
+    pub valid: Mask8,
+    /// hit position, world space
+    pub p: Vec3x8,
+    /// unit geometric normal flipped to face the incoming ray (n . wo >= 0)
+    pub n: Vec3x8,
+    /// unit direction towards the viewer (-ray direction)
+    pub wo: Vec3x8,
+    /// diffuse reflectance kd
+    pub kd: Vec3x8,
+    /// specular reflectance ks
+    pub ks: Vec3x8,
+    /// Phong exponent
+    pub shininess: F8,
+    /// GGX alpha
+    pub roughness: F8,
+    /// lanes whose material is GGX
+    pub ggx: Mask8,
+    /// radiance emitted towards wo: material emission plus a light's radiance on its emitting side
+    pub emitted: Vec3x8,
+    /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
+    pub light: U8,
+}
+
+/// A renderable scene.
+pub struct Scene {
+    /// settings and geometry as parsed
+    pub desc: SceneDesc,
+    /// camera for the image size in `desc`
+    pub camera: Camera,
+    /// area lights (quad lights)
+    pub lights: Vec<QuadLight>,
+    /// materials (desc materials, then one black material per light)
+    pub materials: Vec<Material>,
+    /// per triangle: material index
+    pub tri_material: Vec<u32>,
+    /// per triangle: unit geometric normal (zero for degenerate triangles)
+    pub tri_normal: Vec<Vec3>,
+    /// per triangle: light index or u32::MAX
+    pub tri_light: Vec<u32>,
+    /// per ellipsoid: material index
+    pub ell_material: Vec<u32>,
+    /// per ellipsoid: world-to-object matrix
+    pub ell_world_to_object: Vec<Mat4>,
+    /// per ellipsoid: normal matrix (inverse transpose of the linear part)
+    pub ell_normal: Vec<Mat3>,
+    /// radius of the scene's bounding sphere (for offsets)
+    pub extent: f32,
+    /// the Embree scene
+    pub accel: accel::Scene,
+    _device: accel::Device,
+}
+
+/// Errors building a scene.
+#[derive(Debug)]
+pub enum BuildError {
+    /// Embree refused something.
+    Accel(accel::AccelError),
+    /// The scene lacks something the renderer needs.
+    Invalid(String),
+}
+
+impl std::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BuildError::Accel(e) => write!(f, "{e}"),
+            BuildError::Invalid(s) => write!(f, "{s}"),
+        }
+    }
+}
+impl std::error::Error for BuildError {}
+impl From<accel::AccelError> for BuildError {
+    fn from(e: accel::AccelError) -> Self {
+        BuildError::Accel(e)
+    }
+}
+
+impl Scene {
+    /// Builds the scene. Quad lights become two triangles each, after the scene's triangles.
+    pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
+        let cam_desc = desc
+            .camera
+            .ok_or_else(|| BuildError::Invalid(format!("{}: no camera command", desc.source.display())))?;
+        let camera = Camera::new(&cam_desc, desc.width, desc.height);
+        let mut materials = desc.materials.clone();
+        let mut vertices = Vec::with_capacity(desc.triangles.len() * 3 + desc.quad_lights.len() * 4);
+        let mut indices = Vec::with_capacity(desc.triangles.len() + desc.quad_lights.len() * 2);
+        let mut tri_material = Vec::with_capacity(indices.capacity());
+        let mut tri_light = Vec::with_capacity(indices.capacity());
+        for t in &desc.triangles {
+            let base = vertices.len() as u32;
+            vertices.extend_from_slice(&t.v);
+            indices.push([base, base + 1, base + 2]);
+            tri_material.push(t.material);
+            tri_light.push(INVALID_ID);
+        }
+        let mut lights = Vec::with_capacity(desc.quad_lights.len());
+        let black = materials.len() as u32;
+        materials.push(Material { ambient: Vec3::ZERO, ..Material::default() });
+        for (i, q) in desc.quad_lights.iter().enumerate() {
+            let cross = q.ab.cross(q.ac);
+            let light = QuadLight {
+                a: q.a,
+                ab: q.ab,
+                ac: q.ac,
+                radiance: q.radiance,
+                normal: (-cross).normalize_or_zero(),
+                area: cross.length(),
+            };
+            let base = vertices.len() as u32;
+            vertices.extend_from_slice(&light.corners());
+            indices.push([base, base + 1, base + 2]);
+            indices.push([base, base + 2, base + 3]);
+            tri_material.extend([black, black]);
+            tri_light.extend([i as u32, i as u32]);
+            lights.push(light);
+        }
+        let tri_normal: Vec<Vec3> = indices
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| vertices[i as usize]);
+                (b - a).cross(c - a).normalize_or_zero()
+            })
+            .collect();
+        let ell_o2w: Vec<Mat4> = desc.spheres.iter().map(|s| s.object_to_world).collect();
+        let ell_world_to_object: Vec<Mat4> = ell_o2w.iter().map(|m| m.inverse()).collect();
+        let ell_normal = ell_world_to_object.iter().map(|m| Mat3::from_mat4(*m).transpose()).collect();
+        let ell_material = desc.spheres.iter().map(|s| s.material).collect();
+
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for v in &vertices {
+            lo = lo.min(*v);
+            hi = hi.max(*v);
+        }
+        for m in &ell_o2w {
+            let c = m.w_axis.truncate();
+            let r = m.x_axis.truncate().length() + m.y_axis.truncate().length() + m.z_axis.truncate().length();
+            lo = lo.min(c - Vec3::splat(r));
+            hi = hi.max(c + Vec3::splat(r));
+        }
+        let extent = if lo.x.is_finite() { ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE) } else { 1.0 };
+
+        let device = accel::Device::new()?;
+        let mut b = accel::SceneBuilder::new(&device)?;
+        b.add_triangles(&vertices, &indices)?;
+        b.add_ellipsoids(&ell_o2w)?;
+        let accel = b.commit()?;
+        Ok(Self {
+            desc,
+            camera,
+            lights,
+            materials,
+            tri_material,
+            tri_normal,
+            tri_light,
+            ell_material,
+            ell_world_to_object,
+            ell_normal,
+            extent,
+            accel,
+            _device: device,
+        })
+    }
+
+    /// Gathers the shading records of a packet's hits (rays `org + t dir`, `dir` unit).
+    pub fn gather(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8) -> SurfaceHit8 {
+        let p = dir.mul_add(hits.t, org);
+        let (geom, prim) = (hits.geom.to_array(), hits.prim.to_array());
+        let valid = crate::simd::mask_to_bools(hits.hit);
+        let ps = p.to_lanes();
+        let dirs = dir.to_lanes();
+        let mut ng = [Vec3::Z; 8];
+        let mut kd = [Vec3::ZERO; 8];
+        let mut ks = [Vec3::ZERO; 8];
+        let mut emitted = [Vec3::ZERO; 8];
+        let mut shin = [0f32; 8];
+        let mut rough = [1f32; 8];
+        let mut ggx = [false; 8];
+        let mut light = [INVALID_ID; 8];
+        for i in 0..8 {
+            if !valid[i] {
+                continue;
+            }
+            let prim = prim[i] as usize;
+            let (n, mat) = match geom[i] {
+                GEOM_TRIANGLES => {
+                    let l = self.tri_light[prim];
+                    if l != INVALID_ID {
+                        light[i] = l;
+                        let q = &self.lights[l as usize];
+                        if q.normal.dot(dirs[i]) < 0.0 {
+                            emitted[i] += q.radiance;
+                        }
+                    }
+                    (self.tri_normal[prim], self.tri_material[prim])
+                }
+                GEOM_SPHERES => {
+                    let obj = self.ell_world_to_object[prim].transform_point3(ps[i]);
+                    ((self.ell_normal[prim] * obj).normalize_or_zero(), self.ell_material[prim])
+                }
+                _ => (Vec3::Z, 0),
+            };
+            let m = &self.materials[mat as usize];
+            // Shade two-sided: flip the normal to face the incoming ray.
+            ng[i] = if n.dot(dirs[i]) > 0.0 { -n } else { n };
+            kd[i] = m.diffuse;
+            ks[i] = m.specular;
+            shin[i] = m.shininess;
+            rough[i] = m.roughness;
+            ggx[i] = m.brdf == BrdfKind::Ggx;
+            emitted[i] += m.emission;
+        }
+        SurfaceHit8 {
+            valid: hits.hit,
+            p,
+            n: Vec3x8::from_lanes(ng),
+            wo: -dir,
+            kd: Vec3x8::from_lanes(kd),
+            ks: Vec3x8::from_lanes(ks),
+            shininess: F8::new(shin),
+            roughness: F8::new(rough),
+            ggx: crate::simd::mask_from_bools(ggx),
+            emitted: Vec3x8::from_lanes(emitted),
+            light: U8::new(light),
+        }
+    }
+
+    /// Offset distance for secondary-ray origins at points `p`: scales with the magnitude of the
+    /// coordinates (float spacing) and with the scene extent.
+    #[inline]
+    pub fn offset_eps(&self, p: Vec3x8) -> F8 {
+        let mag = p.x.abs().max(p.y.abs()).max(p.z.abs());
+        mag.mul_add(F8::splat(3e-5), F8::splat(self.extent * 1e-5))
+    }
+}
