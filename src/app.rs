@@ -30,6 +30,8 @@ pub struct RenderOptions {
     pub light_sampler: Option<SamplerKind>,
     /// light samples per light (default: the scene's `lightsamples`)
     pub light_samples: Option<u32>,
+    /// pixel sample layout (default stratified)
+    pub pixel_sampler: Option<SamplerKind>,
     /// output stem: writes OUT.exr and OUT.png (default: the scene's `output` name)
     pub out: Option<PathBuf>,
     /// JSON statistics file
@@ -93,8 +95,8 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
     })
 }
 
-/// Renders without writing anything: scene build, integrator set-up, all samples.
-pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
+/// Parses, checks and builds the scene and the integrator of `opts`.
+pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     let desc = load_scene(opts)?;
     match desc.integrator {
         IntegratorKind::AnalyticDirect | IntegratorKind::Direct => {}
@@ -108,7 +110,14 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
     }
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
-    let integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples);
+    let integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    Ok((scene, integrator))
+}
+
+/// Renders without writing anything: scene build, integrator set-up, all samples.
+pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
+    let (scene, integrator) = prepare(opts)?;
+    let spp = integrator.spp;
     let pool = render::thread_pool(opts.threads).map_err(|e| e.to_string())?;
     let mut film = Film::new(scene.desc.width, scene.desc.height);
     let stats = render::render(&scene, &integrator, &mut film, 0..spp, &pool);
@@ -224,4 +233,25 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, String> {
         film::write_atomic(p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
     }
     Ok(out)
+}
+
+/// `strata rays`: renderer rays/s next to Embree's raw rate on the same packets.
+pub fn run_rays(opts: &RenderOptions) -> Result<(crate::measure::RayRates, String), String> {
+    let (scene, integrator) = prepare(opts)?;
+    let rates = crate::measure::ray_rates(&scene, &integrator, integrator.spp);
+    Ok((rates, scene.desc.source.display().to_string()))
+}
+
+/// A small table of [`crate::measure::RayRates`].
+pub fn rates_table(name: &str, r: &crate::measure::RayRates) -> String {
+    format!(
+        "{name}: {} camera + {} shadow rays, 1 thread\n  renderer          {:8.2} Mrays/s\n  Embree raw mixed  {:8.2} Mrays/s  (camera {:.2}, shadow {:.2})\n  renderer / raw    {:8.1} %",
+        r.camera_rays,
+        r.shadow_rays,
+        r.renderer_mrays,
+        r.raw_mixed_mrays,
+        r.raw_camera_mrays,
+        r.raw_shadow_mrays,
+        100.0 * r.ratio
+    )
 }

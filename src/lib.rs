@@ -4,6 +4,7 @@ pub mod app;
 pub mod film;
 pub mod integrator;
 pub mod light;
+pub mod measure;
 pub mod render;
 pub mod sampler;
 pub mod scene;

@@ -6,7 +6,7 @@
 //! bit-identical whatever the thread count or tile schedule.
 
 use crate::film::Film;
-use crate::integrator::{Counters, Integrator};
+use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
 use rayon::prelude::*;
@@ -149,14 +149,13 @@ fn render_tile(
     let n = (tw * th) as usize;
     let mut sum = vec![[0f64; 3]; n];
     let mut sum_sq = vec![[0f64; 3]; n];
-    let packets: Vec<PixelPacket> = (0..th.div_ceil(PACKET_H))
-        .flat_map(|py| (0..tw.div_ceil(PACKET_W)).map(move |px| (px, py)))
-        .map(|(px, py)| PixelPacket::new(x0 + px * PACKET_W, y0 + py * PACKET_H, w, h))
-        .collect();
+    let packets = tile_packets(x0, y0, tw, th, w, h);
+    let mut scratch = Scratch::default();
+    let mut radiance = Vec::with_capacity(packets.len());
     for s in samples.clone() {
-        for pk in &packets {
-            let l = integrator.radiance(scene, pk, s, counters);
-            accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, &l, counters);
+        integrator.radiance_tile(scene, &packets, s, &mut radiance, &mut scratch, counters, None);
+        for (pk, l) in packets.iter().zip(&radiance) {
+            accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, l, counters);
         }
     }
     TileResult { x0, y0, tw, th, sum, sum_sq, count: samples.len() as u32 }
@@ -196,4 +195,12 @@ fn accumulate(
             sum_sq[j][c] += x * x;
         }
     }
+}
+
+/// The 4x2 packets covering the `tw` x `th` tile at (x0, y0) of a `w` x `h` image, row by row.
+pub fn tile_packets(x0: u32, y0: u32, tw: u32, th: u32, w: u32, h: u32) -> Vec<PixelPacket> {
+    (0..th.div_ceil(PACKET_H))
+        .flat_map(|py| (0..tw.div_ceil(PACKET_W)).map(move |px| (px, py)))
+        .map(|(px, py)| PixelPacket::new(x0 + px * PACKET_W, y0 + py * PACKET_H, w, h))
+        .collect()
 }

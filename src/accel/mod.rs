@@ -7,14 +7,17 @@
 //!
 //! Geometry layout of a built scene (the ids `scene::build` relies on):
 //! - geometry [`GEOM_TRIANGLES`]: one triangle mesh holding every triangle (quad lights included);
-//! - geometry [`GEOM_SPHERES`]: every sphere and ellipsoid, as one Embree user geometry whose
-//!   primitive i is the unit sphere under an affine map (ellipsoids without instancing, and an f64
-//!   object-space intersection that stays accurate at extreme scene scales);
+//! - geometry [`GEOM_SPHERES`]: spheres placed by similarity transforms, as Embree sphere points
+//!   (centre, radius) in world space: Embree's own vectorized intersector;
+//! - geometry [`GEOM_ELLIPSOIDS`]: spheres under any other affine map, as one Embree user geometry
+//!   whose primitive i is the unit sphere under that map (no instancing; f64 object-space
+//!   intersection, accurate at extreme scales; slower than sphere points);
 //! - geometries from [`GEOM_FIRST_INSTANCE`] on: instances (hits report `inst_id`).
+//! Geometry kinds must be added in this order; a kind may be skipped.
 
 use crate::simd::{mask_to_valid, Mask8, Vec3x8, F8, U8};
 use embree4_sys as sys;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 use std::ffi::{c_char, c_void, CStr};
 use std::sync::Mutex;
 
@@ -22,10 +25,12 @@ use std::sync::Mutex;
 pub const INVALID_ID: u32 = u32::MAX;
 /// Geometry id of the triangle mesh.
 pub const GEOM_TRIANGLES: u32 = 0;
-/// Geometry id of the sphere/ellipsoid user geometry.
+/// Geometry id of the world-space sphere points.
 pub const GEOM_SPHERES: u32 = 1;
+/// Geometry id of the ellipsoid user geometry.
+pub const GEOM_ELLIPSOIDS: u32 = 2;
 /// First geometry id of instances.
-pub const GEOM_FIRST_INSTANCE: u32 = 2;
+pub const GEOM_FIRST_INSTANCE: u32 = 3;
 
 /// A packet of 8 rays, Embree 4.4 `RTCRay8` layout (384 bytes, 32-byte aligned).
 #[repr(C, align(32))]
@@ -234,10 +239,13 @@ unsafe impl Send for Device {}
 unsafe impl Sync for Device {}
 
 impl Device {
-    /// Creates a device (default configuration) with the error callback installed.
+    /// Creates a device with the error callback installed. The Embree configuration string is
+    /// `verbose=0`, or `$STRATA_EMBREE_CONFIG` when set (e.g. `isa=avx2`).
     pub fn new() -> Result<Self, AccelError> {
+        let config = std::env::var("STRATA_EMBREE_CONFIG").unwrap_or_else(|_| "verbose=0".into());
+        let config = std::ffi::CString::new(config).map_err(|_| AccelError("STRATA_EMBREE_CONFIG contains a NUL byte".into()))?;
         // SAFETY: a NUL-terminated config string; a null return is checked.
-        let raw = unsafe { sys::rtcNewDevice(c"verbose=0".as_ptr()) };
+        let raw = unsafe { sys::rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
             return Err(AccelError("rtcNewDevice failed (is libembree4 usable on this CPU?)".into()));
         }
@@ -332,6 +340,15 @@ impl<'d> SceneBuilder<'d> {
         Ok(Self { device, scene, children: Vec::new(), user_data: Vec::new(), next_id: 0 })
     }
 
+    /// Claims geometry id `id` for the next kind; kinds come in the documented order.
+    fn reserve(&mut self, id: u32, what: &str) -> Result<(), AccelError> {
+        if self.next_id > id {
+            return Err(AccelError(format!("{what} added out of order (geometry id {id} already passed)")));
+        }
+        self.next_id = id + 1;
+        Ok(())
+    }
+
     fn attach(&mut self, geom: sys::RTCGeometry, want: u32) -> Result<u32, AccelError> {
         // SAFETY: `geom` is a committed geometry of this device; attach then drop our reference
         // (the scene keeps its own).
@@ -348,11 +365,8 @@ impl<'d> SceneBuilder<'d> {
     /// index triples. An empty mesh is allowed (nothing is attached but the id is reserved).
     pub fn add_triangles(&mut self, vertices: &[Vec3], indices: &[[u32; 3]]) -> Result<u32, AccelError> {
         let id = GEOM_TRIANGLES;
-        if self.next_id != id {
-            return Err(AccelError("triangles must be added first".into()));
-        }
+        self.reserve(id, "triangles")?;
         if indices.is_empty() {
-            self.next_id = id + 1;
             return Ok(id);
         }
         if let Some(bad) = indices.iter().flatten().find(|&&i| i as usize >= vertices.len()) {
@@ -385,18 +399,42 @@ impl<'d> SceneBuilder<'d> {
         }
     }
 
-    /// Adds every sphere/ellipsoid as geometry [`GEOM_SPHERES`]: an Embree user geometry whose
+    /// Adds world-space spheres (centre xyz, radius w) as geometry [`GEOM_SPHERES`] (Embree
+    /// sphere points).
+    pub fn add_spheres(&mut self, spheres: &[Vec4]) -> Result<u32, AccelError> {
+        let id = GEOM_SPHERES;
+        self.reserve(id, "spheres")?;
+        if spheres.is_empty() {
+            return Ok(id);
+        }
+        // SAFETY: an Embree-owned buffer of exactly `spheres.len()` FLOAT4s, written fully before
+        // the geometry is committed.
+        unsafe {
+            let g = sys::rtcNewGeometry(self.device.raw, sys::RTCGeometryType::SPHERE_POINT);
+            let vb = sys::rtcSetNewGeometryBuffer(g, sys::RTCBufferType::VERTEX, 0, sys::RTCFormat::FLOAT4, 16, spheres.len())
+                as *mut f32;
+            self.device.take_errors()?;
+            if vb.is_null() {
+                sys::rtcReleaseGeometry(g);
+                return Err(AccelError("could not allocate sphere buffer".into()));
+            }
+            let dst = std::slice::from_raw_parts_mut(vb, spheres.len() * 4);
+            for (d, s) in dst.chunks_exact_mut(4).zip(spheres) {
+                d.copy_from_slice(&s.to_array());
+            }
+            sys::rtcCommitGeometry(g);
+            self.attach(g, id)
+        }
+    }
+
+    /// Adds every ellipsoid as geometry [`GEOM_ELLIPSOIDS`]: an Embree user geometry whose
     /// primitive `i` is the unit sphere mapped by `object_to_world[i]` (any invertible affine map).
     /// Intersection runs in object space in f64 (robust at huge and tiny scales); `t` is preserved
     /// by affine maps, so hits are reported in world units of the ray.
     pub fn add_ellipsoids(&mut self, object_to_world: &[Mat4]) -> Result<u32, AccelError> {
-        let id = GEOM_SPHERES;
-        if self.next_id > id {
-            return Err(AccelError("ellipsoids must be added right after triangles".into()));
-        }
-        self.next_id = id;
+        let id = GEOM_ELLIPSOIDS;
+        self.reserve(id, "ellipsoids")?;
         if object_to_world.is_empty() {
-            self.next_id = id + 1;
             return Ok(id);
         }
         let mut prims = Vec::with_capacity(object_to_world.len());
@@ -426,6 +464,7 @@ impl<'d> SceneBuilder<'d> {
     /// id, `geom_id` = 0 and `prim_id` the child's triangle.
     pub fn add_mesh_instance(&mut self, vertices: &[Vec3], indices: &[[u32; 3]], object_to_world: &Mat4) -> Result<u32, AccelError> {
         let id = self.next_id.max(GEOM_FIRST_INSTANCE);
+        self.reserve(id, "instance")?;
         let mut child = SceneBuilder::new(self.device)?;
         child.add_triangles(vertices, indices)?;
         let child = child.commit()?;
@@ -714,8 +753,10 @@ mod tests {
         // A quad at z = 5 spanning [-1,1]^2, two triangles.
         let v = [Vec3::new(-1.0, -1.0, 5.0), Vec3::new(1.0, -1.0, 5.0), Vec3::new(1.0, 1.0, 5.0), Vec3::new(-1.0, 1.0, 5.0)];
         b.add_triangles(&v, &[[0, 1, 2], [0, 2, 3]]).unwrap();
-        // A sphere of radius 0.5 at (3, 0, 5) and an ellipsoid (0.5, 0.25, 0.5) at (0, 3, 5).
-        let sphere = Mat4::from_translation(Vec3::new(3.0, 0.0, 5.0)) * Mat4::from_scale(Vec3::splat(0.5));
+        // A sphere point of radius 0.5 at (3, 0, 5); a user-geometry sphere of radius 0.5 at
+        // (3, 3, 5) and an ellipsoid (0.5, 0.25, 0.5) at (0, 3, 5).
+        b.add_spheres(&[Vec4::new(3.0, 0.0, 5.0, 0.5)]).unwrap();
+        let sphere = Mat4::from_translation(Vec3::new(3.0, 3.0, 5.0)) * Mat4::from_scale(Vec3::splat(0.5));
         let ellipsoid = Mat4::from_translation(Vec3::new(0.0, 3.0, 5.0)) * Mat4::from_scale(Vec3::new(0.5, 0.25, 0.5));
         b.add_ellipsoids(&[sphere, ellipsoid]).unwrap();
         if with_instance {
@@ -739,8 +780,8 @@ mod tests {
     fn abi_canaries_survive_plain_and_instanced_hits() {
         let dev = Device::new().unwrap();
         let scene = build(&dev, true);
-        let xs = [0.0, 0.5, 3.0, 0.0, -3.0, -3.1, 10.0, 0.0];
-        let ys = [0.0, 0.5, 0.0, 3.1, 0.0, 0.05, 0.0, -0.9];
+        let xs = [0.0, 3.0, 3.0, 0.0, -3.0, -3.1, 10.0, 0.0];
+        let ys = [0.0, 3.0, 0.0, 3.1, 0.0, 0.05, 0.0, -0.9];
         let (org, dir) = packet(xs, ys);
         let mut c = Canaried { value: RayHit8::default(), canary: [CANARY; 64] };
         set_rayhit(&mut c.value, org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
@@ -750,15 +791,17 @@ mod tests {
         assert_eq!(mask_to_bools(h.hit), [true, true, true, true, true, true, false, true]);
         let geom = h.geom.to_array();
         let inst = h.inst.to_array();
-        assert_eq!(&geom[0..2], &[GEOM_TRIANGLES; 2]);
-        assert_eq!(&geom[2..4], &[GEOM_SPHERES; 2]);
-        assert_eq!(h.prim.to_array()[2..4], [0, 1]);
+        assert_eq!([geom[0], geom[7]], [GEOM_TRIANGLES; 2]);
+        assert_eq!(geom[2], GEOM_SPHERES);
+        assert_eq!([geom[1], geom[3]], [GEOM_ELLIPSOIDS; 2]);
+        assert_eq!([h.prim.to_array()[1], h.prim.to_array()[3]], [0, 1]);
         assert_eq!(&inst[4..6], &[GEOM_FIRST_INSTANCE; 2]);
         assert_eq!(&geom[4..6], &[0, 0]);
         assert_eq!(inst[0], INVALID_ID);
         let t = h.t.to_array();
         assert!((t[0] - 5.0).abs() < 1e-5);
-        assert!((t[2] - 4.5).abs() < 1e-5, "sphere front at z = 4.5: {}", t[2]);
+        assert!((t[2] - 4.5).abs() < 1e-5, "sphere point front at z = 4.5: {}", t[2]);
+        assert!((t[1] - 4.5).abs() < 1e-5, "user sphere front at z = 4.5: {}", t[1]);
         // ellipsoid at (0, 3): z half-axis 0.5; at y offset 0.1 of a 0.25 half-axis, z = 5 - 0.5 sqrt(1 - 0.16).
         assert!((t[3] - (5.0 - 0.5 * 0.84f32.sqrt())).abs() < 1e-5, "ellipsoid: {}", t[3]);
         assert!((t[4] - 2.5).abs() < 1e-5, "instanced quad at z = 2.5: {}", t[4]);

@@ -8,7 +8,7 @@
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::light::polygonal::polygon_phi_x8;
 use crate::render::PixelPacket;
-use crate::sampler::{PointSet, SamplerKind};
+use crate::sampler::{PointSet, SamplerKind, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::IntegratorKind;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
@@ -90,7 +90,14 @@ pub struct Integrator {
 
 impl Integrator {
     /// Settings from the scene, overridden by explicit choices.
-    pub fn new(scene: &Scene, spp: u32, seed: u64, light_sampler: Option<SamplerKind>, light_samples: Option<u32>) -> Self {
+    pub fn new(
+        scene: &Scene,
+        spp: u32,
+        seed: u64,
+        light_sampler: Option<SamplerKind>,
+        light_samples: Option<u32>,
+        pixel_sampler: Option<SamplerKind>,
+    ) -> Self {
         let d = &scene.desc;
         let n_light = light_samples.unwrap_or(d.light_samples).max(1);
         let light_kind = light_sampler.unwrap_or(if d.light_stratify { SamplerKind::Stratified } else { SamplerKind::Independent });
@@ -98,7 +105,7 @@ impl Integrator {
             kind: d.integrator,
             spp: spp.max(1),
             seed,
-            pixel_set: PointSet::new(SamplerKind::Stratified, spp.max(1)),
+            pixel_set: PointSet::new(pixel_sampler.unwrap_or(SamplerKind::Stratified), spp.max(1)),
             light_set: PointSet::new(light_kind, n_light),
         }
     }
@@ -111,89 +118,150 @@ impl Integrator {
         (Vec3x8::splat(scene.camera.eye), dir)
     }
 
-    /// Radiance of pixel sample `s` for the 8 pixels of `pk` (inactive lanes return zero).
-    pub fn radiance(&self, scene: &Scene, pk: &PixelPacket, s: u32, c: &mut Counters) -> Vec3x8 {
-        self.radiance_logged(scene, pk, s, c, None)
-    }
-
-    /// [`Integrator::radiance`], optionally recording every packet traced into `log`.
-    pub fn radiance_logged(&self, scene: &Scene, pk: &PixelPacket, s: u32, c: &mut Counters, mut log: Option<&mut RayLog>) -> Vec3x8 {
-        // Camera packet: coherent primary rays from a 4x2 tile.
-        let (org, dir) = self.camera_rays(scene, pk, s);
-        let mut rh = RayHit8::default();
-        let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
-        if let Some(l) = log.as_deref_mut() {
-            l.camera.push((rh, active));
+    /// Radiance of pixel sample `s` for each packet of `pks` (a tile), into `out` (one `Vec3x8`
+    /// per packet; inactive lanes zero). The tile is processed as a wavefront: all camera packets
+    /// are traced, then gathered, then for each (light, light sample) all shadow packets are built
+    /// and traced back to back, so Embree runs in tight loops. `log` records every packet traced.
+    pub fn radiance_tile(
+        &self,
+        scene: &Scene,
+        pks: &[PixelPacket],
+        s: u32,
+        out: &mut Vec<Vec3x8>,
+        sc: &mut Scratch,
+        c: &mut Counters,
+        mut log: Option<&mut RayLog>,
+    ) {
+        let n = pks.len();
+        out.clear();
+        sc.rh.clear();
+        sc.hits.clear();
+        // Camera packets: coherent primary rays from 4x2 pixel blocks.
+        for pk in pks {
+            let (org, dir) = self.camera_rays(scene, pk, s);
+            let mut rh = RayHit8::default();
+            let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
+            if let Some(l) = log.as_deref_mut() {
+                l.camera.push((rh, active));
+            }
+            sc.rh.push((rh, active));
         }
-        let traced = scene.accel.intersect8(&mut rh, true, active);
-        c.camera += c.packet(traced);
-        let hits = Hits8::from_rayhit(&rh, traced);
-        if hits.hit.none() {
-            return Vec3x8::ZERO;
+        for (rh, active) in sc.rh.iter_mut() {
+            let traced = scene.accel.intersect8(rh, true, *active);
+            c.camera += c.packet(traced);
+            *active = traced;
         }
-        let sh = scene.gather(org, dir, &hits);
+        // Gather: hit records to SoA shading records; emission.
+        for (rh, traced) in &sc.rh {
+            let org = Vec3x8::new(F8::new(rh.ray.org_x), F8::new(rh.ray.org_y), F8::new(rh.ray.org_z));
+            let dir = Vec3x8::new(F8::new(rh.ray.dir_x), F8::new(rh.ray.dir_y), F8::new(rh.ray.dir_z));
+            let sh = scene.gather(org, dir, &Hits8::from_rayhit(rh, *traced));
+            out.push(masked(sh.emitted, sh.valid));
+            sc.hits.push(sh);
+        }
         match self.kind {
-            IntegratorKind::AnalyticDirect => analytic_direct(scene, &sh),
-            _ => self.direct(scene, &sh, pk, s, c, log),
+            IntegratorKind::AnalyticDirect => {
+                for (o, sh) in out.iter_mut().zip(&sc.hits) {
+                    *o += analytic_direct(scene, sh);
+                }
+            }
+            _ => self.direct_tile(scene, pks, s, out, sc, c, log),
         }
+        debug_assert_eq!(out.len(), n);
     }
 
-    /// `direct`: emission plus, for each light, the mean over the light samples of
-    /// L f cos(th_i) cos(th_l) / (d^2 pdf_area) with visibility from shadow packets.
-    fn direct(&self, scene: &Scene, sh: &SurfaceHit8, pk: &PixelPacket, s: u32, c: &mut Counters, mut log: Option<&mut RayLog>) -> Vec3x8 {
-        let mut l_out = masked(sh.emitted, sh.valid);
-        // Lights shade nothing themselves (black, one-sided emitters).
-        let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into());
-        if shade.none() {
-            return l_out;
-        }
+    /// `direct`: for each light, the mean over the light samples of
+    /// L f cos(th_i) cos(th_l) / (d^2 pdf_area) with visibility from shadow packets, added to `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn direct_tile(
+        &self,
+        scene: &Scene,
+        pks: &[PixelPacket],
+        s: u32,
+        out: &mut [Vec3x8],
+        sc: &mut Scratch,
+        c: &mut Counters,
+        mut log: Option<&mut RayLog>,
+    ) {
         let n_light = self.light_set.n();
         let inv_n = F8::splat(1.0 / n_light as f32);
-        let eps = scene.offset_eps(sh.p);
         let sample_idx = U8::splat(s);
+        // Lights shade nothing themselves (black, one-sided emitters).
+        sc.shade.clear();
+        sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into())));
+        sc.eps.clear();
+        sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
+        let any_spec = sc.hits.iter().any(|sh| sh.ks.max_elem().simd_gt(F8::ZERO).any());
         for (li, light) in scene.lights.iter().enumerate() {
             let dim = DIM_LIGHT_BASE + li as u32;
-            let mut acc = Vec3x8::ZERO;
+            let (la, lab, lac, ln) = (Vec3x8::splat(light.a), Vec3x8::splat(light.ab), Vec3x8::splat(light.ac), Vec3x8::splat(light.normal));
+            sc.acc.clear();
+            sc.acc.resize(pks.len(), Vec3x8::ZERO);
+            sc.streams.clear();
+            sc.streams.extend(pks.iter().map(|pk| self.light_set.stream_x8(pk.pixel, sample_idx, dim, self.seed)));
             for k in 0..n_light {
-                // Sample a point on the light (uniform in area, pdf_area = 1/A).
-                let (u, v) = self.light_set.point_x8(pk.pixel, sample_idx, dim, U8::splat(k), self.seed);
-                let y = Vec3x8::splat(light.a) + Vec3x8::splat(light.ab).scale(u) + Vec3x8::splat(light.ac).scale(v);
-                let to = y - sh.p;
-                let d2 = to.length_squared();
-                let d = d2.sqrt();
-                let wi = to.scale(F8::ONE / d);
-                let cos_i = sh.n.dot(wi);
-                let cos_l = -(Vec3x8::splat(light.normal).dot(wi));
-                let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
-                if lit.none() {
-                    continue;
+                sc.shadow.clear();
+                for i in 0..pks.len() {
+                    let (sh, shade) = (&sc.hits[i], sc.shade[i]);
+                    if shade.none() {
+                        continue;
+                    }
+                    // Sample a point on the light (uniform in area, pdf_area = 1/A).
+                    let (u, v) = sc.streams[i].point(k);
+                    let y = lac.mul_add(v, lab.mul_add(u, la));
+                    let to = y - sh.p;
+                    let d2 = to.length_squared();
+                    let inv_d = F8::ONE / d2.sqrt();
+                    let wi = to.scale(inv_d);
+                    let cos_i = sh.n.dot(wi);
+                    let cos_l = -ln.dot(wi);
+                    let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO);
+                    if lit.none() {
+                        continue;
+                    }
+                    // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
+                    let f = brdf_eval(sh, wi, lit, any_spec);
+                    let contrib = f.scale(cos_i * cos_l / d2);
+                    // Shadow packet from the offset point towards the light sample, stopping short.
+                    let o = sh.n.mul_add(sc.eps[i], sh.p);
+                    let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
+                    let mut ray = Ray8::default();
+                    let lit = ray.set(o, y - o, F8::ZERO, tfar, lit);
+                    sc.shadow.push((ray, lit, contrib, i as u32));
                 }
-                // Shadow packet from the offset point towards the light sample, stopping short of it.
-                let o = sh.n.mul_add(eps, sh.p);
-                let dir = y - o;
-                let tfar = F8::ONE - scene.offset_eps(y) / d;
-                let mut ray = Ray8::default();
-                let lit = ray.set(o, dir, F8::ZERO, tfar, lit);
                 if let Some(l) = log.as_deref_mut() {
-                    l.shadow.push((ray, lit));
+                    l.shadow.extend(sc.shadow.iter().map(|(r, m, _, _)| (*r, *m)));
                 }
-                let occluded = scene.accel.occluded8(&mut ray, lit);
-                c.shadow += c.packet(lit);
-                let visible = lit & !occluded;
-                let f = brdf_eval(sh, wi, visible);
-                let g = cos_i * cos_l / d2;
-                acc += f.scale(masked_f(g, visible));
+                for (ray, lit, contrib, i) in sc.shadow.iter_mut() {
+                    let occluded = scene.accel.occluded8(ray, *lit);
+                    c.shadow += c.packet(*lit);
+                    let visible = *lit & !occluded;
+                    sc.acc[*i as usize] += masked(*contrib, visible);
+                }
             }
-            let scale = inv_n * F8::splat(light.area);
-            l_out += acc.mul_elem(Vec3x8::splat(light.radiance)).scale(scale);
+            let scale = Vec3x8::splat(light.radiance).scale(inv_n * F8::splat(light.area));
+            for (o, acc) in out.iter_mut().zip(&sc.acc) {
+                *o += acc.mul_elem(scale);
+            }
         }
-        l_out
     }
 }
 
-/// `analyticdirect`: emission plus kd/pi * sum over lights of L * max(0, Phi . n) (no visibility).
+/// Per-thread buffers of the tile wavefront, reused across samples and tiles.
+#[derive(Default)]
+pub struct Scratch {
+    rh: Vec<(RayHit8, Mask8)>,
+    hits: Vec<SurfaceHit8>,
+    shade: Vec<Mask8>,
+    eps: Vec<F8>,
+    acc: Vec<Vec3x8>,
+    shadow: Vec<(Ray8, Mask8, Vec3x8, u32)>,
+    streams: Vec<Stream<U8>>,
+}
+
+/// `analyticdirect` without emission: kd/pi * sum over lights of L * max(0, Phi . n) (no visibility).
 fn analytic_direct(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
-    let mut l_out = masked(sh.emitted, sh.valid);
+    let mut l_out = Vec3x8::ZERO;
     let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into());
     for light in &scene.lights {
         let phi = polygon_phi_x8(sh.p, &light.corners(), shade);
@@ -205,25 +273,25 @@ fn analytic_direct(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
 
 /// Modified Phong (the format's definition) in world space:
 /// kd/pi + ks (s+2)/(2 pi) max(0, r . wi)^s with r the mirror of wo about n; zero on inactive lanes.
+/// `any_spec = false` promises ks = 0 on every lane and skips the lobe.
 #[inline]
-fn brdf_eval(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
-    let diffuse = sh.kd.scale(F8::splat(1.0 / PI));
-    let r = sh.n.scale(F8::splat(2.0) * sh.n.dot(sh.wo)) - sh.wo;
-    let c = r.dot(wi).max(F8::ZERO);
-    let spec = c.powf_simd(sh.shininess) * (sh.shininess + F8::splat(2.0)) * F8::splat(0.5 / PI);
-    let has_spec = c.simd_gt(F8::ZERO);
-    let f = diffuse + sh.ks.scale(has_spec.select(spec, F8::ZERO));
+fn brdf_eval(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8, any_spec: bool) -> Vec3x8 {
+    let mut f = sh.kd.scale(F8::splat(1.0 / PI));
+    if any_spec {
+        let r = sh.n.scale(F8::splat(2.0) * sh.n.dot(sh.wo)) - sh.wo;
+        let c = r.dot(wi);
+        let has_spec = c.simd_gt(F8::ZERO);
+        // c^s = exp(s ln c), only where c > 0 (ln of a non-positive number never reaches exp).
+        let pow = (sh.shininess * has_spec.select(c, F8::ONE).ln()).exp();
+        let spec = pow * (sh.shininess + F8::splat(2.0)) * F8::splat(0.5 / PI);
+        f += sh.ks.scale(has_spec.select(spec, F8::ZERO));
+    }
     masked(f, active)
 }
 
 #[inline]
 fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
     Vec3x8::new(m.select(v.x, F8::ZERO), m.select(v.y, F8::ZERO), m.select(v.z, F8::ZERO))
-}
-
-#[inline]
-fn masked_f(v: F8, m: Mask8) -> F8 {
-    m.select(v, F8::ZERO)
 }
 
 /// Scalar radiance of a diffuse point lit by one quad light, exact (for tests and the report).

@@ -178,6 +178,27 @@ impl PointSet {
         self.eval(pixel, sample, dim, k, seed)
     }
 
+    /// The set of (pixel, sample, dim) for 8 lanes, with the hash work its points share done once:
+    /// `stream_x8(..).point(k)` equals `point_x8(pixel, sample, dim, U8::splat(k), seed)` bit for
+    /// bit and is much cheaper (the cell of a lane-uniform k is found in scalar code).
+    pub fn stream_x8(&self, pixel: U8, sample: U8, dim: u32, seed: u64) -> Stream<U8> {
+        self.stream(pixel, sample, dim, seed)
+    }
+
+    /// Scalar twin of [`PointSet::stream_x8`].
+    pub fn stream_1(&self, pixel: u32, sample: u32, dim: u32, seed: u64) -> Stream<u32> {
+        self.stream(pixel, sample, dim, seed)
+    }
+
+    fn stream<L: Lanes>(&self, pixel: L, sample: L, dim: u32, seed: u64) -> Stream<L> {
+        let prefix = match self.layout {
+            Layout::Independent => mix(mix(L::splat(stream_key(TAG_INDEPENDENT, seed, dim)), pixel), sample),
+            Layout::Grid { .. } => mix(mix(L::splat(stream_key(TAG_STRATIFIED, seed, dim)), pixel), sample),
+            Layout::Halton => mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel),
+        };
+        Stream { set: *self, prefix, base: sample.mul(L::splat(self.n)) }
+    }
+
     fn eval<L: Lanes>(&self, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
         match self.layout {
             Layout::Independent => {
@@ -187,19 +208,64 @@ impl PointSet {
             Layout::Grid { grid, jitter } => {
                 let k = grid.n.rem(k);
                 let (cy, cx) = grid.nx.div_rem(k);
-                let (vx, vy) = if jitter {
+                if jitter {
                     let h = hash(TAG_STRATIFIED, seed, dim, [pixel, sample, k]);
-                    (jitter_offset(h, grid.nx.d), jitter_offset(mix(h, L::splat(1)), grid.ny.d))
+                    let (x, y) = (cell_span(cx, grid.nx), cell_span(cy, grid.ny));
+                    (jittered(x, h), jittered(y, mix(h, L::splat(1))))
                 } else {
-                    (L::splat(centre_offset(grid.nx.d)), L::splat(centre_offset(grid.ny.d)))
-                };
-                (cell_coord(cx, grid.nx, vx).unit24(), cell_coord(cy, grid.ny, vy).unit24())
+                    let (x, y) = (cell_centre(cx, grid.nx), cell_centre(cy, grid.ny));
+                    (x.unit24(), y.unit24())
+                }
             }
             Layout::Halton => {
                 let index = sample.mul(L::splat(self.n)).add(k);
                 let key = mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel);
                 let x = RADIX2.inverse(index, Some(mix(key, L::splat(2))));
                 let y = RADIX3.inverse(index, Some(mix(key, L::splat(3))));
+                (x.unit24(), y.unit24())
+            }
+        }
+    }
+}
+
+/// The n-point set of one (pixel, sample, dim) per lane, prepared by [`PointSet::stream_x8`].
+#[derive(Clone, Copy, Debug)]
+pub struct Stream<L> {
+    set: PointSet,
+    /// hash state after (tag, seed, dim, pixel[, sample]); Halton: its scramble key
+    prefix: L,
+    /// Halton: sample * n
+    base: L,
+}
+
+impl<L: Lanes> Stream<L> {
+    /// Point k of the set, coordinates in [0, 1); equal to `PointSet::point*` for the same k.
+    #[inline]
+    pub fn point(&self, k: u32) -> (L::F, L::F) {
+        match self.set.layout {
+            Layout::Independent => {
+                let h = mix(self.prefix, L::splat(k));
+                (unit(h), unit(mix(h, L::splat(1))))
+            }
+            Layout::Grid { grid, jitter } => {
+                // k is lane-uniform: its cell is found once, in scalar code.
+                let k = grid.n.rem(k);
+                let (cy, cx) = grid.nx.div_rem(k);
+                if jitter {
+                    let h = mix(self.prefix, L::splat(k));
+                    let span = |c: u32, m: Divisor| {
+                        let (lo, hi) = cell_span(c, m);
+                        (L::splat(lo), L::splat(hi))
+                    };
+                    (jittered(span(cx, grid.nx), h), jittered(span(cy, grid.ny), mix(h, L::splat(1))))
+                } else {
+                    (L::splat(cell_centre(cx, grid.nx)).unit24(), L::splat(cell_centre(cy, grid.ny)).unit24())
+                }
+            }
+            Layout::Halton => {
+                let index = self.base.add(L::splat(k));
+                let x = RADIX2.inverse(index, Some(mix(self.prefix, L::splat(2))));
+                let y = RADIX3.inverse(index, Some(mix(self.prefix, L::splat(3))));
                 (x.unit24(), y.unit24())
             }
         }
@@ -218,8 +284,9 @@ enum Layout {
 // ------------------------------------------------------------------------------------------------
 
 /// Unsigned 32-bit lanes: `u32` (one lane) or `U8` (eight). Every generator is written once against
-/// this trait, so the scalar and the x8 instantiation run the same integer operations.
-trait Lanes: Copy {
+/// this trait, so the scalar and the x8 instantiation run the same integer operations. (Public only
+/// so that [`Stream`] can name it; its methods are internal.)
+pub trait Lanes: Copy {
     /// Matching float lanes (`f32` or `F8`).
     type F;
     fn splat(x: u32) -> Self;
@@ -470,11 +537,29 @@ fn cell_coord<L: Lanes>(c: L, m: Divisor, v: L) -> L {
     y
 }
 
-/// Uniform jitter offset in [m - 1, 2^24) for `cell_coord`, from a 32-bit hash.
+/// The 24-bit fixed-point points of cell `c` of an m-cell axis: `[lo, hi)` with
+/// lo = ceil(c 2^24 / m) and hi = ceil((c+1) 2^24 / m), so every y in it has c/m <= y 2^-24 < (c+1)/m.
+/// (Cells narrower than 2^-24 collapse onto their lower edge.)
 #[inline]
-fn jitter_offset<L: Lanes>(h: L, m: u32) -> L {
-    let m = m.min(FIXED_ONE);
-    L::splat(m - 1).add(h.mulhi(L::splat(FIXED_ONE - m + 1)))
+fn cell_span<L: Lanes>(c: L, m: Divisor) -> (L, L) {
+    let v = L::splat(m.d.min(FIXED_ONE) - 1);
+    let next = c.add(L::splat(1));
+    // cell_coord needs its cell below m: the top edge of the last cell is 2^24 itself.
+    let hi = next.lt_select(L::splat(m.d), cell_coord(next, m, v), L::splat(FIXED_ONE));
+    (cell_coord(c, m, v), hi)
+}
+
+/// A point of `span` picked by the 32-bit hash `h` (uniform up to 2^-32 relative), as f32 in [0, 1).
+#[inline]
+fn jittered<L: Lanes>((lo, hi): (L, L), h: L) -> L::F {
+    let w = hi.sub(lo);
+    lo.add(h.mulhi(w)).unit24()
+}
+
+/// Centre of cell `c` of an m-cell axis in 24-bit fixed point (rounded down).
+#[inline]
+fn cell_centre<L: Lanes>(c: L, m: Divisor) -> L {
+    cell_coord(c, m, L::splat(centre_offset(m.d)))
 }
 
 /// Offset that puts `cell_coord` at the cell centre (rounded down to the 2^-24 grid).
@@ -729,6 +814,33 @@ mod tests {
     }
 
     #[test]
+    fn streams_equal_points_bit_for_bit() {
+        let mut st = 5u64;
+        for kind in SamplerKind::ALL {
+            for n in interesting_n() {
+                let set = PointSet::new(kind, n);
+                for _ in 0..10 {
+                    let seed = u64::from(lcg(&mut st)) << 32 | u64::from(lcg(&mut st));
+                    let dim = lcg(&mut st) % 64;
+                    let pixel = u8_from(|i| if i == 7 { u32::MAX } else { lcg(&mut st) % 100_000 });
+                    let sample = u8_from(|_| lcg(&mut st) % 256);
+                    let st8 = set.stream_x8(pixel, sample, dim, seed);
+                    let (p, s) = (pixel.to_array(), sample.to_array());
+                    let st1 = set.stream_1(p[3], s[3], dim, seed);
+                    for k in [0, 1, n / 2, n.saturating_sub(1), n.wrapping_add(3), u32::MAX] {
+                        let (x8, y8) = st8.point(k);
+                        let (xr, yr) = set.point_x8(pixel, sample, dim, U8::splat(k), seed);
+                        assert_eq!(x8.to_array().map(f32::to_bits), xr.to_array().map(f32::to_bits), "{kind:?} n={n} k={k}");
+                        assert_eq!(y8.to_array().map(f32::to_bits), yr.to_array().map(f32::to_bits), "{kind:?} n={n} k={k}");
+                        let (x1, y1) = st1.point(k);
+                        assert_eq!((x1.to_bits(), y1.to_bits()), (x8.to_array()[3].to_bits(), y8.to_array()[3].to_bits()));
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn deterministic_and_sensitive_to_seed_and_dim() {
         for kind in SamplerKind::ALL {
             let set = PointSet::new(kind, 16);
@@ -823,7 +935,7 @@ mod tests {
             for c in [0, 1, m / 2, m - 1] {
                 for h in [0, 1, u32::MAX / 2, u32::MAX] {
                     let c = c.min(m - 1);
-                    let y = cell_coord(c, dv, jitter_offset(h, m));
+                    let y = (jittered(cell_span(c, dv), h) * FIXED_ONE as f32) as u32;
                     assert!(u64::from(y) * u64::from(m) >= u64::from(c) << 24, "m={m} c={c}");
                     assert!(u64::from(y) * u64::from(m) < u64::from(c + 1) << 24, "m={m} c={c}");
                     let yc = cell_coord(c, dv, centre_offset(m));

@@ -117,38 +117,40 @@ pub fn cosine_hemisphere_pdf_x8(w: Vec3x8, active: Mask8) -> F8 {
 /// Phong lobe around +z with exponent s >= 0 (negative s is treated as 0): cos theta = u0^(1/(s+1)),
 /// pdf (s+1)/(2 pi) cos^s theta per unit solid angle, on the hemisphere z >= 0.
 ///
-/// f32 precision for large s: ln cos = ln(u0)/(s+1) is exact to a few ulp, 1 - cos = -expm1(ln cos)
-/// keeps the lobe's width (~1/s) to full relative precision where `1 - u0^(1/(s+1))` would cancel,
-/// sin^2 = (1 - cos)(1 + cos), and cos^s = exp(s ln cos) = u0^(s/(s+1)). ln cos is clamped to
-/// -f32::MAX so that u0 = 0 gives cos = 0 and pdf 1/(2 pi) at s = 0 (0^0 = 1), 0 for s > 0.
+/// f32 precision: ln cos = ln(u0)/(s+1) is exact to a few ulp; from it cos = exp(ln cos) and
+/// 1 - cos = -expm1(ln cos) are both exact to a few ulp relative (no `1 - u0^(1/(s+1))` cancellation,
+/// which would quantize a lobe of width ~1/s at large s, nor `1 - (1 - cos)`, which would flush
+/// cos < 2^-24 near the horizon at small s); sin^2 = (1 - cos)(1 + cos); cos^s = exp(s ln cos). ln cos
+/// is clamped to -f32::MAX so that u0 = 0 gives cos = 0 and pdf 1/(2 pi) at s = 0 (0^0 = 1), 0 for
+/// s > 0.
 #[inline]
 pub fn sample_phong_lobe(u: [f32; 2], s: f32) -> (Vec3, f32) {
     let s = s.max(0.0);
     let lc = (u[0].ln() / (s + 1.0)).max(-f32::MAX);
-    let omc = -lc.exp_m1();
-    let sin = (omc * (2.0 - omc)).sqrt();
+    let (c, omc) = (lc.exp(), -lc.exp_m1());
+    let sin = (omc * (1.0 + c)).sqrt();
     let (sp, cp) = azimuth(u[1]);
-    (Vec3::new(sin * cp, sin * sp, 1.0 - omc), (s + 1.0) * INV_2PI * (lc * s).exp())
+    (Vec3::new(sin * cp, sin * sp, c), (s + 1.0) * INV_2PI * (lc * s).exp())
 }
 /// Eight-lane [`sample_phong_lobe`] with a per-lane exponent.
 #[inline]
 pub fn sample_phong_lobe_x8(u: [F8; 2], s: F8, active: Mask8) -> (Vec3x8, F8) {
     let s = s.max(F8::ZERO);
     let lc = (u[0].ln() / (s + F8::ONE)).max(-F8::MAX);
-    let omc = -lc.exp_m1();
-    let sin = (omc * (F8::splat(2.0) - omc)).sqrt();
+    let (c, omc) = (lc.exp(), -lc.exp_m1());
+    let sin = (omc * (F8::ONE + c)).sqrt();
     let (sp, cp) = azimuth_x8(u[1]);
     let pdf = (s + F8::ONE) * F8::splat(INV_2PI) * (lc * s).exp();
-    finish(Vec3x8::new(sin * cp, sin * sp, F8::ONE - omc), pdf, active)
+    finish(Vec3x8::new(sin * cp, sin * sp, c), pdf, active)
 }
 
-/// cos^s theta of a lobe from c = cos theta and sin2 = sin^2 theta (given separately because near the
-/// axis sin^2 carries the precision that c has lost): 1 - c is taken as sin2/(1 + c) for c > 1/2, and
-/// cos^s = exp(s ln1p(-(1 - c))). The lobe's support is c >= 0 (0 below; 0^0 = 1 at c = 0, s = 0).
+/// cos^s theta of a lobe from c = cos theta and sin2 = sin^2 theta, given separately because near the
+/// axis sin^2 carries the precision that c has lost: cos^s = exp(s ln cos) with ln cos = ln1p(-sin2 /
+/// (1 + c)) for c > 1/2 and ln c below. The lobe's support is c >= 0 (0 below; 0^0 = 1 at c = 0,
+/// s = 0, through the clamp of ln 0 to -f32::MAX).
 #[inline]
 pub(crate) fn cos_pow(c: f32, sin2: f32, s: f32) -> f32 {
-    let omc = (if c > 0.5 { sin2 / (1.0 + c) } else { 1.0 - c }).min(1.0);
-    let l = (-omc).ln_1p().max(-f32::MAX);
+    let l = if c > 0.5 { (-sin2 / (1.0 + c)).ln_1p() } else { c.ln() }.max(-f32::MAX);
     if c >= 0.0 {
         (s * l).exp()
     } else {
@@ -158,8 +160,7 @@ pub(crate) fn cos_pow(c: f32, sin2: f32, s: f32) -> f32 {
 /// Eight-lane [`cos_pow`].
 #[inline]
 pub(crate) fn cos_pow_x8(c: F8, sin2: F8, s: F8) -> F8 {
-    let omc = c.simd_gt(F8::HALF).select(sin2 / (F8::ONE + c), F8::ONE - c).min(F8::ONE);
-    let l = (-omc).ln_1p().max(-F8::MAX);
+    let l = c.simd_gt(F8::HALF).select((-sin2 / (F8::ONE + c)).ln_1p(), c.ln()).max(-F8::MAX);
     c.simd_ge(F8::ZERO).select((s * l).exp(), F8::ZERO)
 }
 

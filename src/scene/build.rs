@@ -5,10 +5,10 @@
 //! triangles, outward for ellipsoids); shading uses the normal flipped to face the incoming ray
 //! (surfaces are shaded two-sided, so meshes of either winding render; lights stay one-sided).
 
-use crate::accel::{self, Hits8, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
+use crate::accel::{self, Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
 use crate::scene::desc::{BrdfKind, CameraDesc, Material, SceneDesc};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec3, Vec4};
 
 /// A parallelogram area light a + u ab + v ac, one-sided, emitting towards `normal`.
 #[derive(Clone, Copy, Debug)]
@@ -134,8 +134,12 @@ pub struct Scene {
     pub tri_normal: Vec<Vec3>,
     /// per triangle: light index or u32::MAX
     pub tri_light: Vec<u32>,
-    /// per ellipsoid: material index
+    /// per sphere/ellipsoid of the desc: material index
     pub ell_material: Vec<u32>,
+    /// desc sphere index of each Embree sphere point (primID of [`GEOM_SPHERES`])
+    pub sphere_point_index: Vec<u32>,
+    /// desc sphere index of each user-geometry ellipsoid (primID of [`GEOM_ELLIPSOIDS`])
+    pub ellipsoid_index: Vec<u32>,
     /// per ellipsoid: world-to-object matrix
     pub ell_world_to_object: Vec<Mat4>,
     /// per ellipsoid: normal matrix (inverse transpose of the linear part)
@@ -237,10 +241,29 @@ impl Scene {
         }
         let extent = if lo.x.is_finite() { ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE) } else { 1.0 };
 
+        // Spheres and ellipsoids go to one Embree user geometry (f64 intersection). With
+        // STRATA_SPHERES=embree, spheres under similarity transforms go to Embree's own sphere
+        // points instead: faster in isolation (replayed packets), but measured 2-3x slower inside
+        // the renderer on the hw2 Cornell box, where tracing alternates with shading.
+        let embree_spheres = std::env::var("STRATA_SPHERES").is_ok_and(|v| v == "embree");
+        let (mut points, mut sphere_point_index, mut ell_user, mut ellipsoid_index) = (vec![], vec![], vec![], vec![]);
+        for (i, m) in ell_o2w.iter().enumerate() {
+            match as_sphere(m).filter(|_| embree_spheres) {
+                Some(p) => {
+                    points.push(p);
+                    sphere_point_index.push(i as u32);
+                }
+                None => {
+                    ell_user.push(*m);
+                    ellipsoid_index.push(i as u32);
+                }
+            }
+        }
         let device = accel::Device::new()?;
         let mut b = accel::SceneBuilder::new(&device)?;
         b.add_triangles(&vertices, &indices)?;
-        b.add_ellipsoids(&ell_o2w)?;
+        b.add_spheres(&points)?;
+        b.add_ellipsoids(&ell_user)?;
         let accel = b.commit()?;
         Ok(Self {
             desc,
@@ -251,6 +274,8 @@ impl Scene {
             tri_normal,
             tri_light,
             ell_material,
+            sphere_point_index,
+            ellipsoid_index,
             ell_world_to_object,
             ell_normal,
             extent,
@@ -291,9 +316,11 @@ impl Scene {
                     }
                     (self.tri_normal[prim], self.tri_material[prim])
                 }
-                GEOM_SPHERES => {
-                    let obj = self.ell_world_to_object[prim].transform_point3(ps[i]);
-                    ((self.ell_normal[prim] * obj).normalize_or_zero(), self.ell_material[prim])
+                GEOM_SPHERES | GEOM_ELLIPSOIDS => {
+                    let table = if geom[i] == GEOM_SPHERES { &self.sphere_point_index } else { &self.ellipsoid_index };
+                    let e = table[prim] as usize;
+                    let obj = self.ell_world_to_object[e].transform_point3(ps[i]);
+                    ((self.ell_normal[e] * obj).normalize_or_zero(), self.ell_material[e])
                 }
                 _ => (Vec3::Z, 0),
             };
@@ -328,5 +355,51 @@ impl Scene {
     pub fn offset_eps(&self, p: Vec3x8) -> F8 {
         let mag = p.x.abs().max(p.y.abs()).max(p.z.abs());
         mag.mul_add(F8::splat(3e-5), F8::splat(self.extent * 1e-5))
+    }
+}
+
+/// Centre and radius if the affine map `m` takes the unit sphere to a sphere (its linear part is
+/// a rotation times a uniform scale, to 1e-5 relative).
+fn as_sphere(m: &Mat4) -> Option<Vec4> {
+    let l = Mat3::from_mat4(*m);
+    let g = l.transpose() * l; // = r^2 I for a similarity
+    let r2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+    if !(r2 > 0.0) || !r2.is_finite() {
+        return None;
+    }
+    let off = (g - Mat3::from_diagonal(Vec3::splat(r2))).to_cols_array().iter().fold(0f32, |a, v| a.max(v.abs()));
+    (off <= 1e-5 * r2).then(|| m.w_axis.truncate().extend(r2.sqrt()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::desc::CameraDesc;
+
+    #[test]
+    fn similarity_transforms_are_spheres_others_ellipsoids() {
+        let m = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)) * Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.7) * Mat4::from_scale(Vec3::splat(0.25));
+        let s = as_sphere(&m).unwrap();
+        assert!((s - Vec4::new(1.0, 2.0, 3.0, 0.25)).abs().max_element() < 1e-6);
+        assert!(as_sphere(&Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0))).is_none());
+        assert!(as_sphere(&Mat4::from_scale(Vec3::ZERO)).is_none());
+    }
+
+    #[test]
+    fn camera_dirs_x8_match_scalar_per_lane() {
+        let desc = CameraDesc { eye: Vec3::new(0.1, 1.0, 3.0), center: Vec3::new(0.0, 1.0, 0.0), up: Vec3::Y, fovy_deg: 45.0 };
+        let cam = Camera::new(&desc, 640, 480);
+        let xs = [0.0, 0.5, 639.99, 320.0, 100.25, 7.0, 500.5, 320.5];
+        let ys = [0.0, 479.99, 0.5, 240.0, 13.75, 400.0, 99.0, 240.5];
+        let d = cam.dirs8(F8::new(xs), F8::new(ys));
+        for i in 0..8 {
+            assert!((d.lane(i) - cam.dir(xs[i], ys[i])).length() < 1e-6, "lane {i}");
+        }
+        // The image centre looks along the view direction; the top edge is fovy/2 above it.
+        assert!((cam.dir(320.0, 240.0) - cam.look).length() < 1e-6);
+        let top = cam.dir(320.0, 0.0);
+        assert!((top.dot(cam.look).acos().to_degrees() - 22.5).abs() < 1e-3);
+        assert!(top.dot(cam.up) > 0.0, "y grows downwards in the image");
+        assert!(cam.dir(639.0, 240.0).dot(cam.right) > 0.0, "x grows to the right");
     }
 }
