@@ -38,7 +38,32 @@ pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
     let renderer_mrays = stats.mrays_per_sec();
 
 
-    // The same packets, logged.
+    // The same packets, logged, then replayed through Embree alone.
+    let mut log = log_rays(scene, integrator, spp);
+    let lanes = |m: &crate::simd::Mask8| m.to_bitmask().count_ones() as u64;
+    let camera_rays: u64 = log.camera.iter().map(|(_, m)| lanes(m)).sum();
+    let shadow_rays: u64 = log.shadow.iter().map(|(_, m)| lanes(m)).sum();
+    let t0 = Instant::now();
+    replay_camera(scene, &mut log.camera);
+    let t_cam = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    replay_shadow(scene, &mut log.shadow);
+    let t_sh = t1.elapsed().as_secs_f64();
+    let mr = |n: u64, t: f64| n as f64 / t.max(1e-12) / 1e6;
+    let raw_mixed_mrays = mr(camera_rays + shadow_rays, t_cam + t_sh);
+    RayRates {
+        camera_rays,
+        shadow_rays,
+        renderer_mrays,
+        raw_camera_mrays: mr(camera_rays, t_cam),
+        raw_shadow_mrays: mr(shadow_rays, t_sh),
+        raw_mixed_mrays,
+        ratio: renderer_mrays / raw_mixed_mrays,
+    }
+}
+
+/// Every packet the renderer traces for samples `0..spp`, in the renderer's order (tile by tile).
+pub fn log_rays(scene: &Scene, integrator: &Integrator, spp: u32) -> RayLog {
     let mut log = RayLog::default();
     let mut c = Counters::default();
     let mut sc = Scratch::default();
@@ -52,29 +77,19 @@ pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
             }
         }
     }
-    let lanes = |m: &crate::simd::Mask8| m.to_bitmask().count_ones() as u64;
-    let camera_rays: u64 = log.camera.iter().map(|(_, m)| lanes(m)).sum();
-    let shadow_rays: u64 = log.shadow.iter().map(|(_, m)| lanes(m)).sum();
+    log
+}
 
-    let t0 = Instant::now();
-    for (rh, m) in log.camera.iter_mut() {
+/// Traces logged camera packets (closest hit, coherent flag as the renderer sets it), in place.
+pub fn replay_camera(scene: &Scene, packets: &mut [(crate::accel::RayHit8, crate::simd::Mask8)]) {
+    for (rh, m) in packets.iter_mut() {
         scene.accel.intersect8(rh, true, *m);
     }
-    let t_cam = t0.elapsed().as_secs_f64();
-    let t1 = Instant::now();
-    for (r, m) in log.shadow.iter_mut() {
+}
+
+/// Traces logged shadow packets (any hit), in place.
+pub fn replay_shadow(scene: &Scene, packets: &mut [(crate::accel::Ray8, crate::simd::Mask8)]) {
+    for (r, m) in packets.iter_mut() {
         scene.accel.occluded8(r, *m);
-    }
-    let t_sh = t1.elapsed().as_secs_f64();
-    let mr = |n: u64, t: f64| n as f64 / t.max(1e-12) / 1e6;
-    let raw_mixed_mrays = mr(camera_rays + shadow_rays, t_cam + t_sh);
-    RayRates {
-        camera_rays,
-        shadow_rays,
-        renderer_mrays,
-        raw_camera_mrays: mr(camera_rays, t_cam),
-        raw_shadow_mrays: mr(shadow_rays, t_sh),
-        raw_mixed_mrays,
-        ratio: renderer_mrays / raw_mixed_mrays,
     }
 }

@@ -90,9 +90,9 @@ pub fn render(
     let results: Vec<(TileResult, Counters)> = pool.install(|| {
         tiles
             .par_iter()
-            .map(|&(tx, ty)| {
+            .map_init(Scratch::default, |scratch, &(tx, ty)| {
                 let mut counters = Counters::default();
-                let r = render_tile(scene, integrator, tx * TILE, ty * TILE, w, h, samples.clone(), &mut counters);
+                let r = render_tile(scene, integrator, tx * TILE, ty * TILE, w, h, samples.clone(), scratch, &mut counters);
                 (r, counters)
             })
             .collect()
@@ -142,6 +142,7 @@ fn render_tile(
     w: u32,
     h: u32,
     samples: std::ops::Range<u32>,
+    scratch: &mut Scratch,
     counters: &mut Counters,
 ) -> TileResult {
     let tw = TILE.min(w - x0);
@@ -150,10 +151,9 @@ fn render_tile(
     let mut sum = vec![[0f64; 3]; n];
     let mut sum_sq = vec![[0f64; 3]; n];
     let packets = tile_packets(x0, y0, tw, th, w, h);
-    let mut scratch = Scratch::default();
     let mut radiance = Vec::with_capacity(packets.len());
     for s in samples.clone() {
-        integrator.radiance_tile(scene, &packets, s, &mut radiance, &mut scratch, counters, None);
+        integrator.radiance_tile(scene, &packets, s, &mut radiance, scratch, counters, None);
         for (pk, l) in packets.iter().zip(&radiance) {
             accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, l, counters);
         }

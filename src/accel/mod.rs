@@ -181,21 +181,32 @@ impl Ray8 {
     /// harmless ray. Resets mask, id, flags.
     #[inline]
     pub fn set(&mut self, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, active: Mask8) -> Mask8 {
-        let ok = active & org.is_finite() & dir.is_finite() & tnear.is_finite() & !tfar.is_nan();
-        let zero = F8::ZERO;
-        self.org_x = ok.select(org.x, zero).to_array();
-        self.org_y = ok.select(org.y, zero).to_array();
-        self.org_z = ok.select(org.z, zero).to_array();
-        self.dir_x = ok.select(dir.x, zero).to_array();
-        self.dir_y = ok.select(dir.y, zero).to_array();
-        self.dir_z = ok.select(dir.z, F8::ONE).to_array();
-        self.tnear = ok.select(tnear, zero).to_array();
-        self.tfar = ok.select(tfar, zero).to_array();
-        self.time = [0.0; 8];
-        self.mask = [u32::MAX; 8];
-        self.id = [0; 8];
-        self.flags = [0; 8];
+        let (ray, ok) = Self::new(org, dir, tnear, tfar, active);
+        *self = ray;
         ok
+    }
+
+    /// A packet from SoA origins/directions and the interval [tnear, tfar], as [`Ray8::set`]:
+    /// also returns the lanes that are `active` and finite.
+    #[inline]
+    pub fn new(org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, active: Mask8) -> (Self, Mask8) {
+        let ok = active & org.is_finite() & dir.is_finite() & tnear.is_finite() & !tfar.is_nan();
+        let z = F8::ZERO;
+        let ray = Self {
+            org_x: ok.select(org.x, z).to_array(),
+            org_y: ok.select(org.y, z).to_array(),
+            org_z: ok.select(org.z, z).to_array(),
+            tnear: ok.select(tnear, z).to_array(),
+            dir_x: ok.select(dir.x, z).to_array(),
+            dir_y: ok.select(dir.y, z).to_array(),
+            dir_z: ok.select(dir.z, F8::ONE).to_array(),
+            time: [0.0; 8],
+            tfar: ok.select(tfar, z).to_array(),
+            mask: [u32::MAX; 8],
+            id: [0; 8],
+            flags: [0; 8],
+        };
+        (ray, ok)
     }
 }
 

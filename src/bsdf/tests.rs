@@ -56,7 +56,11 @@ fn format_f(m: &Material, wo: Vec3, wi: Vec3) -> DVec3 {
         BrdfKind::Phong => {
             let r = 2.0 * n.dot(wo) * n - wo;
             let s = m.shininess as f64;
-            kd / PI + ks * (s + 2.0) / (2.0 * PI) * r.dot(wi).max(0.0).powf(s)
+            // max(0, x)^s, with 0^0 read as its limit from the lobe side (0 for x <= 0 also at s = 0),
+            // the reading under which the format's sampler (cos = xi^(1/(s+1)) around r) covers f's
+            // support; IEEE pow(0, 0) = 1 would make s = 0 Lambertian beyond r's hemisphere.
+            let lobe = if r.dot(wi) > 0.0 { r.dot(wi).powf(s) } else { 0.0 };
+            kd / PI + ks * (s + 2.0) / (2.0 * PI) * lobe
         }
         BrdfKind::Ggx => {
             let a = m.alpha.max(GGX_ALPHA_MIN) as f64;
@@ -165,12 +169,15 @@ fn x8_matches_scalar_per_lane() {
                 let rtol = if mats[i].kind == BrdfKind::Phong { 3e-5 } else { 0.0 };
                 let (f, p) = mats[i].eval_pdf(st, wo[i], wi[i]);
                 assert!(close3(f8.lane(i), f, rtol, 0.0) && close(p8[i], p, rtol), "{st:?} lane {i} {:?}: x8 ({}, {}) scalar ({f}, {p})", mats[i], f8.lane(i), p8[i]);
-                // samples: directions within a few ulp (sin_cos, ln, exp differ), so pdf and f within
-                // the lobe's sensitivity to direction; the x8 pdf is the x8 pdf of the x8 direction.
-                let (wi_s, p_s, f_s) = mats[i].sample(st, wo[i], u[i], ul[i]);
+                // samples: directions agree to a few ulp (sin_cos, ln, exp differ); pdf and f of the
+                // x8 direction agree with the scalar twin's at that same direction. (Comparing them at
+                // the two slightly different directions would measure conditioning, not the twins:
+                // the GGX pdf 1/|wo.h| with h = normalize(wi + wo) is ill-conditioned as wi -> -wo.)
+                let wi_s = mats[i].sample(st, wo[i], u[i], ul[i]).0;
                 let (w, sp, sf) = (swi8.lane(i), sp8.to_array()[i], sf8.lane(i));
                 assert!(close3(w, wi_s, 1e-5, 2e-6), "{st:?} lane {i}: wi x8 {w} scalar {wi_s}");
-                assert!(close(sp, p_s, 2e-3) && close3(sf, f_s, 2e-3, 1e-6), "{st:?} lane {i} {:?}: x8 ({sp}, {sf}) scalar ({p_s}, {f_s})", mats[i]);
+                let (f_s, p_s) = mats[i].eval_pdf(st, wo[i], w);
+                assert!(close(sp, p_s, rtol) && close3(sf, f_s, rtol, 0.0), "{st:?} lane {i} {:?}: x8 ({sp}, {sf}) scalar ({p_s}, {f_s})", mats[i]);
                 assert_eq!(sp.to_bits(), sp8_own[i].to_bits());
             }
         }
@@ -240,12 +247,18 @@ fn lobe_grid(m: &Material, wo: Vec3, n_core: usize, n_tail: usize, n_phi: usize)
 
 #[test]
 fn pdfs_integrate_to_one_for_every_strategy() {
-    let mats = [phong(0.4, 0.5, 0.0), phong(0.4, 0.5, 20.0), phong(0.1, 0.9, 1e4), phong(0.0, 1.0, 1e6), ggx(0.5, 0.3, 1e-3), ggx(0.5, 0.3, 0.1), ggx(0.0, 1.0, 1.0)];
+    // The s = 1e6 and alpha = 1e-3 lobes only about +z: about a tilted axis the f32 rounding of the
+    // quadrature's directions moves their pdf by ~1e-4 (see `chi2::simpson`).
+    let mats = [phong(0.4, 0.5, 0.0), phong(0.4, 0.5, 20.0), phong(0.1, 0.9, 1e4), phong(0.0, 1.0, 1e6), ggx(0.5, 0.3, 1e-3), ggx(0.5, 0.3, 0.02), ggx(0.5, 0.3, 0.1), ggx(0.0, 1.0, 1.0)];
     for m in mats {
-        for theta_o in [0.0, 45.0, 80.0, 89.0] {
+        let peaked = m.shininess > 1e5 || (m.kind == BrdfKind::Ggx && m.alpha < 0.01);
+        for theta_o in if peaked { &[0.0][..] } else { &[0.0, 45.0, 80.0, 89.0][..] } {
+            let theta_o = *theta_o;
             let wo = dir(theta_o, 0.7);
             for st in STRATEGIES {
-                let i = lobe_grid(&m, wo, 16, 16, 24).integrate_sphere(&|wi| m.pdf(st, wo, wi) as f64);
+                let t0 = std::time::Instant::now(); let cnt = std::cell::Cell::new(0u64);
+                let i = lobe_grid(&m, wo, 16, 16, 24).integrate_sphere(&|wi| { cnt.set(cnt.get() + 1); m.pdf(st, wo, wi) as f64 });
+                eprintln!("DBG {:?} {} {} {theta_o} {st:?} {:?} evals {}", m.kind, m.shininess, m.alpha, t0.elapsed(), cnt.get());
                 assert!((i - 1.0).abs() < 1e-4, "{m:?} {st:?} theta_o={theta_o}: integral {i}");
             }
         }

@@ -201,6 +201,8 @@ impl Integrator {
             sc.streams.extend(pks.iter().map(|pk| self.light_set.stream_x8(pk.pixel, sample_idx, dim, self.seed)));
             for k in 0..n_light {
                 sc.shadow.clear();
+                sc.contrib.clear();
+                sc.owner.clear();
                 for i in 0..pks.len() {
                     let (sh, shade) = (&sc.hits[i], sc.shade[i]);
                     if shade.none() {
@@ -221,22 +223,22 @@ impl Integrator {
                     }
                     // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
                     let f = brdf_eval(sh, wi, lit, any_spec);
-                    let contrib = f.scale(cos_i * cos_l / d2);
+                    sc.contrib.push(f.scale(cos_i * cos_l * inv_d * inv_d));
                     // Shadow packet from the offset point towards the light sample, stopping short.
                     let o = sh.n.mul_add(sc.eps[i], sh.p);
                     let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
-                    let mut ray = Ray8::default();
-                    let lit = ray.set(o, y - o, F8::ZERO, tfar, lit);
-                    sc.shadow.push((ray, lit, contrib, i as u32));
+                    let (ray, lit) = Ray8::new(o, y - o, F8::ZERO, tfar, lit);
+                    sc.shadow.push((ray, lit));
+                    sc.owner.push(i as u32);
                 }
                 if let Some(l) = log.as_deref_mut() {
-                    l.shadow.extend(sc.shadow.iter().map(|(r, m, _, _)| (*r, *m)));
+                    l.shadow.extend_from_slice(&sc.shadow);
                 }
-                for (ray, lit, contrib, i) in sc.shadow.iter_mut() {
+                for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
                     let occluded = scene.accel.occluded8(ray, *lit);
                     c.shadow += c.packet(*lit);
                     let visible = *lit & !occluded;
-                    sc.acc[*i as usize] += masked(*contrib, visible);
+                    sc.acc[sc.owner[j] as usize] += masked(sc.contrib[j], visible);
                 }
             }
             let scale = Vec3x8::splat(light.radiance).scale(inv_n * F8::splat(light.area));
@@ -255,7 +257,9 @@ pub struct Scratch {
     shade: Vec<Mask8>,
     eps: Vec<F8>,
     acc: Vec<Vec3x8>,
-    shadow: Vec<(Ray8, Mask8, Vec3x8, u32)>,
+    shadow: Vec<(Ray8, Mask8)>,
+    contrib: Vec<Vec3x8>,
+    owner: Vec<u32>,
     streams: Vec<Stream<U8>>,
 }
 

@@ -1,0 +1,84 @@
+//! The `strata` command line as other checks call it: flags, outputs, JSON keys, errors.
+
+mod common;
+
+use std::process::Command;
+
+fn strata() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_strata"))
+}
+
+fn tmpdir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("strata-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn render_default_scene_writes_exr_png_and_stats() {
+    let d = tmpdir("default");
+    let out = d.join("img");
+    let stats = d.join("stats.json");
+    let r = strata()
+        .args(["render", "--spp", "2", "--size", "64x48", "--seed", "3", "--threads", "2", "--light-sampler", "halton"])
+        .arg("-o")
+        .arg(&out)
+        .arg("--stats")
+        .arg(&stats)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let line = String::from_utf8_lossy(&r.stdout);
+    assert!(line.contains("Mrays/s") && line.contains("64x48"), "summary: {line}");
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    for key in ["seconds", "spp", "width", "height", "rays", "mrays_per_sec", "threads"] {
+        assert!(j.get(key).is_some(), "missing {key} in {j}");
+    }
+    assert_eq!(j["spp"], 2);
+    assert_eq!(j["width"], 64);
+    assert_eq!(j["height"], 48);
+    assert_eq!(j["threads"], 2);
+    assert_eq!(j["light_sampler"], "halton");
+    assert_eq!(j["rays"]["camera"], 64 * 48 * 2);
+    assert!(j["rays"]["shadow"].as_u64().unwrap() > 0);
+    assert_eq!(j["nonfinite_samples"], 0);
+    let img = strata::film::read_exr(&d.join("img.exr")).unwrap();
+    assert_eq!((img.width, img.height), (64, 48));
+    assert!(img.variance.is_some());
+    let meta: std::collections::HashMap<_, _> = img.meta.into_iter().collect();
+    assert_eq!(meta["strata.spp"], "2");
+    assert_eq!(meta["strata.seed"], "3");
+    assert_eq!(meta["strata.light_sampler"], "halton");
+    assert!(meta.contains_key("strata.render_seconds") && meta.contains_key("strata.version"));
+    assert!(std::fs::metadata(d.join("img.png")).unwrap().len() > 100);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn bad_scene_is_a_clear_error_with_file_and_line() {
+    let d = tmpdir("bad");
+    let scene = d.join("bad.test");
+    std::fs::write(&scene, "size 64 48\ncamera 0 0 5 0 0 0 0 1 0 45\nvertex 0 0 0\ntri 0 1 2\n").unwrap();
+    let r = strata().arg("render").arg(&scene).arg("-o").arg(d.join("x")).output().unwrap();
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("bad.test:4:"), "stderr: {err}");
+    assert!(!d.join("x.exr").exists());
+    let r = strata().args(["render", "--size", "10x0"]).output().unwrap();
+    assert!(!r.status.success());
+    let r = strata().args(["render", "--light-sampler", "nonsense"]).output().unwrap();
+    assert!(!r.status.success());
+    assert!(String::from_utf8_lossy(&r.stderr).contains("nonsense"));
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn rays_reports_renderer_next_to_embree() {
+    let r = strata().args(["rays", "--size", "48x48", "--spp", "1", "--json"]).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    for key in ["renderer_mrays", "raw_camera_mrays", "raw_shadow_mrays", "raw_mixed_mrays", "ratio"] {
+        assert!(j[key].as_f64().is_some_and(|v| v > 0.0), "{key} in {j}");
+    }
+    assert_eq!(j["camera_rays"], 48 * 48);
+}

@@ -1,0 +1,47 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use strata::app::RenderOptions;
+use strata::film::Film;
+
+/// The CSE168 corpus beside the checkout (`../shared/cse168`), or None with a printed reason.
+pub fn corpus() -> Option<PathBuf> {
+    let p = std::env::var_os("STRATA_CSE168")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168")));
+    if p.join("hw2").is_dir() {
+        Some(p)
+    } else {
+        eprintln!("skipped: CSE168 corpus not found at {} (set STRATA_CSE168)", p.display());
+        None
+    }
+}
+
+/// Render options for `scene` at a small size.
+pub fn opts(scene: PathBuf, w: u32, h: u32, spp: u32) -> RenderOptions {
+    RenderOptions { scene: Some(scene), size: Some((w, h)), spp: Some(spp), threads: 2, ..Default::default() }
+}
+
+/// Renders to a film (no files written).
+pub fn film(o: &RenderOptions) -> Film {
+    strata::app::render_to_film(o).unwrap_or_else(|e| panic!("render failed: {e}")).film
+}
+
+/// Per-pixel channel means as f64.
+pub fn means(f: &Film) -> Vec<[f64; 3]> {
+    f.sum.iter().zip(&f.count).map(|(s, &n)| s.map(|v| v / f64::from(n.max(1)))).collect()
+}
+
+/// Per-pixel channel variances of the mean (unbiased), as f64.
+pub fn var_of_mean(f: &Film) -> Vec<[f64; 3]> {
+    f.sum
+        .iter()
+        .zip(&f.sum_sq)
+        .zip(&f.count)
+        .map(|((s, q), &n)| {
+            let n = f64::from(n);
+            std::array::from_fn(|c| if n < 2.0 { 0.0 } else { ((q[c] - s[c] * s[c] / n) / (n - 1.0)).max(0.0) / n })
+        })
+        .collect()
+}
