@@ -167,7 +167,7 @@ fn simpson(f: &mut dyn FnMut(f64) -> f64, a: f64, b: f64, eps: f64) -> f64 {
         let x1 = if k == PANELS { b } else { a + h * k as f64 };
         let (fm, f1) = (f(0.5 * (x0 + x1)), f(x1));
         let whole = (x1 - x0) / 6.0 * (f0 + 4.0 * fm + f1);
-        sum += simpson_step(f, x0, x1, f0, fm, f1, whole, eps / PANELS as f64, 16);
+        sum += simpson_step(f, x0, x1, f0, fm, f1, whole, eps / PANELS as f64, 12);
         (x0, f0) = (x1, f1);
     }
     sum
