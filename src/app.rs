@@ -99,10 +99,10 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
 pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     let desc = load_scene(opts)?;
     match desc.integrator {
-        IntegratorKind::AnalyticDirect | IntegratorKind::Direct => {}
+        IntegratorKind::AnalyticDirect | IntegratorKind::Direct | IntegratorKind::PathTracer => {}
         k => {
             return Err(format!(
-                "{}: integrator `{}` is not implemented yet (this build renders analyticdirect and direct)",
+                "{}: integrator `{}` is not implemented yet (this build renders analyticdirect, direct and pathtracer)",
                 desc.source.display(),
                 integrator_name(k)
             ))

@@ -1,11 +1,13 @@
 //! strata: a SIMD packet ray tracer on Embree 4, built to compare sampling techniques.
 pub mod accel;
 pub mod app;
+pub mod bsdf;
 pub mod film;
 pub mod integrator;
 pub mod light;
 pub mod measure;
 pub mod render;
 pub mod sampler;
+pub mod sampling;
 pub mod scene;
 pub mod simd;

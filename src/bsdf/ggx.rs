@@ -9,8 +9,7 @@
 //! expression wherever it is defined (wi.z, wo.z > 0); elsewhere the caller sets f = 0.
 
 use crate::sampling::{
-    dot, fmadd, ggx_a2, ggx_a2_x8, ggx_d, ggx_d_x8, mul_add3, normalize_or_zero, sample_ggx_half,
-    sample_ggx_half_x8,
+    dot, fmadd, ggx_a2, ggx_a2_x8, ggx_d, ggx_d_x8, mul_add3, normalize_or_zero, sample_ggx_half, sample_ggx_half_x8,
 };
 use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;

@@ -10,11 +10,14 @@ use crate::light::polygonal::polygon_phi_x8;
 use crate::render::PixelPacket;
 use crate::sampler::{PointSet, SamplerKind, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
-use crate::scene::desc::IntegratorKind;
+use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 use serde::Serialize;
 use std::f32::consts::PI;
+
+mod path;
+pub use path::{PathScratch, DIM_PATH_BASE};
 
 /// Sampler dimension of the camera (pixel) jitter.
 pub const DIM_CAMERA: u32 = 0;
@@ -86,6 +89,16 @@ pub struct Integrator {
     pub pixel_set: PointSet,
     /// light sample layout (over the light samples of one pixel sample)
     pub light_set: PointSet,
+    /// path tracer: layout of every path dimension over the spp samples of a pixel
+    pub path_set: PointSet,
+    /// path tracer: next event estimation
+    pub nee: Nee,
+    /// path tracer: Russian roulette
+    pub russian_roulette: bool,
+    /// path tracer: direction sampling strategy
+    pub strategy: ImportanceSampling,
+    /// path tracer: maximum bounces (-1 = unbounded)
+    pub max_depth: i32,
 }
 
 impl Integrator {
@@ -107,6 +120,11 @@ impl Integrator {
             seed,
             pixel_set: PointSet::new(pixel_sampler.unwrap_or(SamplerKind::Stratified), spp.max(1)),
             light_set: PointSet::new(light_kind, n_light),
+            path_set: PointSet::new(SamplerKind::Stratified, spp.max(1)),
+            nee: d.nee,
+            russian_roulette: d.russian_roulette,
+            strategy: d.importance_sampling,
+            max_depth: d.max_depth,
         }
     }
 
@@ -132,6 +150,9 @@ impl Integrator {
         c: &mut Counters,
         mut log: Option<&mut RayLog>,
     ) {
+        if self.kind == IntegratorKind::PathTracer {
+            return self.path_tile(scene, pks, s, out, &mut sc.path, c, log);
+        }
         let n = pks.len();
         out.clear();
         sc.rh.clear();
@@ -156,7 +177,7 @@ impl Integrator {
             let org = Vec3x8::new(F8::new(rh.ray.org_x), F8::new(rh.ray.org_y), F8::new(rh.ray.org_z));
             let dir = Vec3x8::new(F8::new(rh.ray.dir_x), F8::new(rh.ray.dir_y), F8::new(rh.ray.dir_z));
             let sh = scene.gather(org, dir, &Hits8::from_rayhit(rh, *traced));
-            out.push(masked(sh.emitted, sh.valid));
+            out.push(masked(sh.emitted + sh.le, sh.valid));
             sc.hits.push(sh);
         }
         match self.kind {
@@ -261,6 +282,7 @@ pub struct Scratch {
     contrib: Vec<Vec3x8>,
     owner: Vec<u32>,
     streams: Vec<Stream<U8>>,
+    path: PathScratch,
 }
 
 /// `analyticdirect` without emission: kd/pi * sum over lights of L * max(0, Phi . n) (no visibility).

@@ -106,6 +106,37 @@ pub fn uniform_1d_x8(pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> F8 {
     unit(hash(TAG_UNIFORM, seed, dim, [pixel, sample, k]))
 }
 
+/// A keyed pseudo-random permutation of 0..n: `permute(i, n, key)` for i in 0..n visits every
+/// value of 0..n once. Used to shuffle strata independently per sampling dimension (so that the
+/// sample in stratum s of one dimension lands in an unrelated stratum of the next, as a padded
+/// stratified sampler does). Built from xorshift-multiply rounds that are bijections on the
+/// smallest power-of-two domain >= n, with cycle walking back into 0..n (expected < 2 rounds).
+/// i >= n is reduced modulo n first; n == 0 acts as 1.
+pub fn permute(i: u32, n: u32, key: u32) -> u32 {
+    let n = n.max(1);
+    if n == 1 {
+        return 0;
+    }
+    let bits = 32 - (n - 1).leading_zeros();
+    let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
+    let half = (bits / 2).max(1);
+    let key = fmix(key ^ 0x6a09_e667);
+    let mut x = i % n;
+    loop {
+        // Each step is a bijection of [0, 2^bits): xor with a constant, multiply by an odd
+        // constant mod 2^bits, xorshift right.
+        x ^= key & mask;
+        x = x.wrapping_mul(0x9e37_79b9 | 1) & mask;
+        x ^= x >> half;
+        x = x.wrapping_mul((key | 1).wrapping_mul(0x85eb_ca6b) | 1) & mask;
+        x ^= x >> half;
+        x ^= (key >> 16) & mask;
+        if x < n {
+            return x;
+        }
+    }
+}
+
 /// Grid shape used for n strata: (nx, ny) with nx * ny == n, nx <= ny, nx the largest divisor of n
 /// that is <= sqrt(n). Any n; n == 0 acts as 1, giving (1, 1).
 pub fn strata_shape(n: u32) -> (u32, u32) {
@@ -811,6 +842,25 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn permute_is_a_bijection_for_every_size_and_key() {
+        for n in [1u32, 2, 3, 5, 7, 8, 9, 16, 17, 64, 100, 1000, 4097] {
+            for key in [0u32, 1, 0xdead_beef, u32::MAX] {
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let p = permute(i, n, key);
+                    assert!(p < n && !seen[p as usize], "n={n} key={key} i={i}");
+                    seen[p as usize] = true;
+                }
+            }
+        }
+        // Different keys give different permutations (n = 16: all 16! are possible).
+        let a: Vec<u32> = (0..16).map(|i| permute(i, 16, 1)).collect();
+        let b: Vec<u32> = (0..16).map(|i| permute(i, 16, 2)).collect();
+        assert_ne!(a, b);
+        assert_ne!(a, (0..16).collect::<Vec<_>>());
     }
 
     #[test]

@@ -62,6 +62,7 @@ pub(crate) fn normalize_or_zero(v: Vec3) -> Vec3 {
 /// ratio is formed after dividing by max(pa, pb) so it neither overflows nor underflows. Returns a
 /// finite weight in [0, 1], and 0 when both pdfs are 0.
 #[inline]
+#[allow(clippy::manual_clamp)] // max-then-min maps NaN to 0; clamp would keep it
 pub fn power_heuristic(pa: f32, pb: f32) -> f32 {
     let (a, b) = (pa.max(0.0).min(f32::MAX), pb.max(0.0).min(f32::MAX));
     let m = a.max(b);

@@ -112,8 +112,10 @@ pub struct SurfaceHit8 {
     pub roughness: F8,
     /// lanes whose material is GGX
     pub ggx: Mask8,
-    /// radiance emitted towards wo: material emission plus a light's radiance on its emitting side
+    /// radiance emitted towards wo by the material (`emission`, every hit, any side)
     pub emitted: Vec3x8,
+    /// radiance emitted towards wo by a quad light (its radiance on its emitting side, else 0)
+    pub le: Vec3x8,
     /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
     pub light: U8,
 }
@@ -295,6 +297,7 @@ impl Scene {
         let mut kd = [Vec3::ZERO; 8];
         let mut ks = [Vec3::ZERO; 8];
         let mut emitted = [Vec3::ZERO; 8];
+        let mut le = [Vec3::ZERO; 8];
         let mut shin = [0f32; 8];
         let mut rough = [1f32; 8];
         let mut ggx = [false; 8];
@@ -311,7 +314,7 @@ impl Scene {
                         light[i] = l;
                         let q = &self.lights[l as usize];
                         if q.normal.dot(dirs[i]) < 0.0 {
-                            emitted[i] += q.radiance;
+                            le[i] = q.radiance;
                         }
                     }
                     (self.tri_normal[prim], self.tri_material[prim])
@@ -345,6 +348,7 @@ impl Scene {
             roughness: F8::new(rough),
             ggx: crate::simd::mask_from_bools(ggx),
             emitted: Vec3x8::from_lanes(emitted),
+            le: Vec3x8::from_lanes(le),
             light: U8::new(light),
         }
     }

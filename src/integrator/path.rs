@@ -1,0 +1,284 @@
+//! `pathtracer`: unidirectional path tracing with next event estimation (off, on, MIS with the
+//! power heuristic), Russian roulette and the format's importance-sampling strategies, run as a
+//! wavefront over a tile's paths. After every bounce the live paths are compacted into full packets
+//! of 8, so Embree sees full packets past the first bounce; shadow rays of a bounce are batched.
+//!
+//! Vertex numbering: vertex 1 is the camera hit. `maxdepth N` (FORMAT.md): with NEE, direct light
+//! is gathered at vertices 1..N (N = 1 is direct lighting); without NEE, emission is counted at
+//! vertices 1..N+1. Emission of quad lights follows the NEE mode (off: always; on: vertex 1 only;
+//! MIS: vertex 1, then weighted against the light-sampling pdf); `emission` of materials is not
+//! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping.
+//!
+//! Sampler dimensions of vertex v: `DIM_PATH_BASE + 4 (v-1) + {0: light point, 1: (light choice,
+//! lobe choice), 2: BSDF direction, 3: (Russian roulette, -)}`. Each is a stratified set over the
+//! pixel's spp samples whose strata are shuffled per (pixel, dimension), so dimensions are
+//! stratified independently of one another.
+
+use super::{masked, Counters, Integrator, RayLog};
+use crate::accel::{Hits8, Ray8, RayHit8};
+use crate::bsdf::Material8;
+use crate::render::PixelPacket;
+use crate::sampler::permute;
+use crate::sampling::power_heuristic_x8;
+use crate::scene::build::Scene;
+use crate::scene::desc::Nee;
+use crate::simd::{mask_from_bools, mask_to_bools, Frame8, Mask8, Vec3x8, F8, U8};
+use glam::Vec3;
+
+/// First sampler dimension of the path tracer's vertices.
+pub const DIM_PATH_BASE: u32 = 64;
+/// Hard cap on path vertices when `maxdepth -1` (Russian roulette normally ends paths far sooner).
+pub const MAX_VERTICES_UNBOUNDED: u32 = 4096;
+
+/// One live path between bounces (AoS, so that compaction is a plain copy).
+#[derive(Clone, Copy, Debug)]
+struct PathLane {
+    /// index of (tile packet, lane) whose pixel this path belongs to: packet * 8 + lane
+    slot: u32,
+    /// linear pixel index (sampler input)
+    pixel: u32,
+    /// next ray origin and unit direction
+    o: Vec3,
+    d: Vec3,
+    /// path throughput
+    beta: Vec3,
+    /// solid-angle pdf with which `d` was sampled (for the MIS weight of emission found along it)
+    pdf: f32,
+}
+
+/// Per-thread buffers of the path wavefront.
+#[derive(Default)]
+pub struct PathScratch {
+    lanes: Vec<PathLane>,
+    next: Vec<PathLane>,
+    rh: Vec<(RayHit8, Mask8)>,
+    radiance: Vec<Vec3>,
+    shadow: Vec<(Ray8, Mask8)>,
+    shadow_contrib: Vec<Vec3x8>,
+    shadow_slots: Vec<[u32; 8]>,
+}
+
+impl Integrator {
+    /// Stratified 2D point of dimension `dim` for pixel sample `s`, strata shuffled per (pixel, dim).
+    #[inline]
+    fn path_point(&self, pixel: U8, s: u32, dim: u32) -> (F8, F8) {
+        let n = self.spp;
+        let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
+        let k = U8::new(pixel.to_array().map(|p| permute(s, n, key_base ^ p.wrapping_mul(0x9e37_79b1))));
+        self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
+    }
+
+    /// Radiance of pixel sample `s` for each packet of `pks` (a tile) by path tracing, into `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn path_tile(
+        &self,
+        scene: &Scene,
+        pks: &[PixelPacket],
+        s: u32,
+        out: &mut Vec<Vec3x8>,
+        sc: &mut PathScratch,
+        c: &mut Counters,
+        mut log: Option<&mut RayLog>,
+    ) {
+        let nee = self.nee;
+        let n_lights = scene.lights.len() as u32;
+        let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
+        sc.radiance.clear();
+        sc.radiance.resize(pks.len() * 8, Vec3::ZERO);
+        sc.lanes.clear();
+        // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks).
+        for (p, pk) in pks.iter().enumerate() {
+            let (org, dir) = self.camera_rays(scene, pk, s);
+            let (inside, pix, dirs) = (mask_to_bools(pk.active), pk.pixel.to_array(), dir.to_lanes());
+            for i in 0..8 {
+                let slot = (p * 8 + i) as u32;
+                let live = inside[i];
+                // Lanes outside the image travel as inactive placeholders in the first packets.
+                sc.lanes.push(PathLane { slot: if live { slot } else { u32::MAX }, pixel: pix[i], o: org.lane(i), d: dirs[i], beta: Vec3::ONE, pdf: 0.0 });
+            }
+        }
+        let mut v = 1u32;
+        while !sc.lanes.is_empty() && v <= max_v {
+            let dims = DIM_PATH_BASE + 4 * (v - 1);
+            // Trace: full packets of 8 live paths (the first bounce keeps the camera packets).
+            sc.rh.clear();
+            for chunk in sc.lanes.chunks(8) {
+                let (org, dir, active) = soa_rays(chunk);
+                let mut rh = RayHit8::default();
+                let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
+                if let Some(l) = log.as_deref_mut() {
+                    l.camera.push((rh, active));
+                }
+                sc.rh.push((rh, active));
+            }
+            for (rh, active) in sc.rh.iter_mut() {
+                let traced = scene.accel.intersect8(rh, v == 1, *active);
+                let n = c.packet(traced);
+                if v == 1 {
+                    c.camera += n;
+                } else {
+                    c.bounce += n;
+                }
+                *active = traced;
+            }
+            sc.next.clear();
+            sc.shadow.clear();
+            sc.shadow_contrib.clear();
+            sc.shadow_slots.clear();
+            for (ci, chunk) in sc.lanes.chunks(8).enumerate() {
+                let (rh, traced) = &sc.rh[ci];
+                let (org, dir, _) = soa_rays(chunk);
+                let sh = scene.gather(org, dir, &Hits8::from_rayhit(rh, *traced));
+                let hit = sh.valid;
+                let beta = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::ZERO, |l| l.beta)));
+                let slots: [u32; 8] = std::array::from_fn(|i| chunk.get(i).map_or(u32::MAX, |l| l.slot));
+                let pixel = U8::new(std::array::from_fn(|i| chunk.get(i).map_or(0, |l| l.pixel)));
+                let prev_pdf = F8::new(std::array::from_fn(|i| chunk.get(i).map_or(0.0, |l| l.pdf)));
+
+                // Emission: materials always; quad lights by the NEE mode.
+                let mut le = masked(sh.emitted, hit);
+                let is_light = hit & F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
+                let light_w = match nee {
+                    Nee::Off => F8::ONE,
+                    Nee::On => F8::splat(if v == 1 { 1.0 } else { 0.0 }),
+                    Nee::Mis if v == 1 => F8::ONE,
+                    Nee::Mis => {
+                        let p_light = light_pdf_at_hit(scene, &sh, rh, is_light);
+                        power_heuristic_x8(prev_pdf, p_light, is_light)
+                    }
+                };
+                le += masked(sh.le, hit).scale(light_w);
+                add_lanes(&mut sc.radiance, &slots, beta.mul_elem(le));
+
+                // Shading frame: the normal faces wo, so wo.z > 0 in local coordinates.
+                let shade = hit & !is_light;
+                let nee_here = nee != Nee::Off && n_lights > 0 && v < max_v;
+                let bounce_here = match nee {
+                    Nee::On => v + 1 < max_v,
+                    _ => v < max_v,
+                };
+                if shade.none() || (!nee_here && !bounce_here) {
+                    continue;
+                }
+                let frame = Frame8::from_normal(sh.n);
+                let wo = frame.to_local(sh.wo);
+                let mat = Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx };
+                let eps = scene.offset_eps(sh.p);
+                let o = sh.n.mul_add(eps, sh.p);
+                let (u_choice, u_lobe) = self.path_point(pixel, s, dims + 1);
+
+                // Next event estimation: one light chosen uniformly, one point on it.
+                if nee_here {
+                    let (u, w) = self.path_point(pixel, s, dims);
+                    let pick = (u_choice * F8::splat(n_lights as f32)).to_array().map(|x| (x as u32).min(n_lights - 1));
+                    let lights = pick.map(|l| &scene.lights[l as usize]);
+                    let la = Vec3x8::from_lanes(lights.map(|l| l.a));
+                    let lab = Vec3x8::from_lanes(lights.map(|l| l.ab));
+                    let lac = Vec3x8::from_lanes(lights.map(|l| l.ac));
+                    let ln = Vec3x8::from_lanes(lights.map(|l| l.normal));
+                    let l_rad = Vec3x8::from_lanes(lights.map(|l| l.radiance));
+                    let area = F8::new(lights.map(|l| l.area));
+                    let y = lac.mul_add(w, lab.mul_add(u, la));
+                    let to = y - sh.p;
+                    let d2 = to.length_squared();
+                    let inv_d = F8::ONE / d2.sqrt();
+                    let wi = to.scale(inv_d);
+                    let cos_i = sh.n.dot(wi);
+                    let cos_l = -ln.dot(wi);
+                    let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                    if lit.any() {
+                        let (f, pdf_b) = mat.eval_pdf(self.strategy, wo, frame.to_local(wi), lit);
+                        // L f cos_i / p_light with p_light = d^2 / (A cos_l n_lights) (solid angle).
+                        let g = cos_i * cos_l * area * F8::splat(n_lights as f32) * inv_d * inv_d;
+                        let w_light = if nee == Nee::Mis {
+                            let p_light = d2 / (area * cos_l * F8::splat(n_lights as f32));
+                            power_heuristic_x8(p_light, pdf_b, lit)
+                        } else {
+                            F8::ONE
+                        };
+                        let contrib = beta.mul_elem(f).mul_elem(l_rad).scale(g * w_light);
+                        let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
+                        let (ray, lit) = Ray8::new(o, y - o, F8::ZERO, tfar, lit);
+                        sc.shadow.push((ray, lit));
+                        sc.shadow_contrib.push(contrib);
+                        sc.shadow_slots.push(slots);
+                    }
+                }
+
+                // Continue the path: sample the BSDF, then Russian roulette.
+                if bounce_here {
+                    let u2 = self.path_point(pixel, s, dims + 2);
+                    let (wi_l, pdf, f) = mat.sample(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
+                    let cos = wi_l.z;
+                    let ok = shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO);
+                    let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
+                    let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
+                    if self.russian_roulette {
+                        let (u_rr, _) = self.path_point(pixel, s, dims + 3);
+                        let q = nb.max_elem().min(F8::ONE);
+                        alive = alive & u_rr.simd_lt(q);
+                        nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
+                    }
+                    if alive.any() {
+                        let wi = frame.to_world(wi_l);
+                        let (alive_b, os, ds, bs, ps) = (mask_to_bools(alive), o.to_lanes(), wi.to_lanes(), nb.to_lanes(), pdf.to_array());
+                        for i in 0..8 {
+                            if alive_b[i] {
+                                sc.next.push(PathLane { slot: slots[i], pixel: pixel.to_array()[i], o: os[i], d: ds[i], beta: bs[i], pdf: ps[i] });
+                            }
+                        }
+                    }
+                }
+            }
+            // Shadow packets of this bounce, back to back.
+            if let Some(l) = log.as_deref_mut() {
+                l.shadow.extend_from_slice(&sc.shadow);
+            }
+            for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
+                let occluded = scene.accel.occluded8(ray, *lit);
+                c.shadow += c.packet(*lit);
+                let visible = *lit & !occluded;
+                add_lanes(&mut sc.radiance, &sc.shadow_slots[j], masked(sc.shadow_contrib[j], visible));
+            }
+            std::mem::swap(&mut sc.lanes, &mut sc.next);
+            v += 1;
+        }
+        out.clear();
+        out.extend(sc.radiance.chunks_exact(8).map(|l| Vec3x8::from_lanes(std::array::from_fn(|i| l[i]))));
+    }
+}
+
+/// SoA rays of up to 8 lanes; missing lanes and placeholders (slot u32::MAX) are inactive.
+#[inline]
+fn soa_rays(chunk: &[PathLane]) -> (Vec3x8, Vec3x8, Mask8) {
+    let get = |i: usize| chunk.get(i).filter(|l| l.slot != u32::MAX);
+    let o = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::ZERO, |l| l.o)));
+    let d = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::Z, |l| l.d)));
+    (o, d, mask_from_bools(std::array::from_fn(|i| get(i).is_some())))
+}
+
+/// Adds lane i of `v` to `radiance[slots[i]]` for every lane with a slot.
+#[inline]
+fn add_lanes(radiance: &mut [Vec3], slots: &[u32; 8], v: Vec3x8) {
+    let lanes = v.to_lanes();
+    for i in 0..8 {
+        if let Some(r) = radiance.get_mut(slots[i] as usize) {
+            *r += lanes[i];
+        }
+    }
+}
+
+/// Solid-angle pdf with which NEE would have picked the point hit on a light: (1/#lights) d^2 /
+/// (A cos_l); zero where `is_light` is off.
+#[inline]
+fn light_pdf_at_hit(scene: &Scene, sh: &crate::scene::build::SurfaceHit8, rh: &RayHit8, is_light: Mask8) -> F8 {
+    let n = scene.lights.len().max(1) as f32;
+    let ids = sh.light.to_array();
+    let pick = |i: usize| scene.lights.get(ids[i] as usize);
+    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
+    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
+    let t = F8::new(rh.ray.tfar);
+    let cos_l = ln.dot(sh.wo);
+    let p = t * t / (area * cos_l * F8::splat(n));
+    is_light.select(p, F8::ZERO)
+}

@@ -1,0 +1,430 @@
+//! Image error metrics, statistics over independent runs, and efficiency.
+//!
+//! All sums run in f64 over every channel of every pixel (M = 3 * pixels values). Inputs are
+//! validated first: a NaN or infinite value, an empty reference or a size mismatch is an error,
+//! so a returned metric is always a finite number.
+
+use super::ReportError;
+use serde::Serialize;
+
+/// The offset in the relative MSE's denominator, as in pbrt: `(v - r)^2 / (r + REL_EPS)^2`.
+pub const REL_EPS: f64 = 0.01;
+
+/// Degrees of freedom above this are evaluated at this value by [`student_t_quantile`]; the
+/// quantile then differs from the normal limit by less than 1e-5.
+pub const MAX_DOF: f64 = 1e6;
+
+/// Mean squared error over all pixels and channels: mean of `(v - r)^2`.
+pub fn mse(img: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, ReportError> {
+    check_reference(reference)?;
+    check_image(img, "image", reference.len())?;
+    Ok(error_means(img, reference).sq)
+}
+
+/// Relative MSE in pbrt's form: mean over all pixels and channels of `(v - r)^2 / (r + 0.01)^2`.
+/// A negative reference value (possible with negative-lobed filters) counts as 0 in the
+/// denominator, which therefore never drops below `0.01^2`.
+pub fn rel_mse(img: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, ReportError> {
+    check_reference(reference)?;
+    check_image(img, "image", reference.len())?;
+    Ok(error_means(img, reference).rel)
+}
+
+/// Monte Carlo efficiency `1 / (mse * seconds)`. A zero product (zero error or zero time) gives
+/// `f64::INFINITY`; a NaN, infinite or negative argument is an error, so the result is never NaN.
+pub fn efficiency(mse: f64, seconds: f64) -> Result<f64, ReportError> {
+    for (name, value) in [("mse", mse), ("seconds", seconds)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(ReportError::InvalidArgument { name, value });
+        }
+    }
+    let cost = mse * seconds;
+    Ok(if cost == 0.0 { f64::INFINITY } else { 1.0 / cost })
+}
+
+/// Statistics of K >= 2 independent runs of one technique against a reference.
+///
+/// With values `x[k][i]` (run k, value i over all pixels and channels, M values), reference
+/// `r[i]`, across-run mean `m[i] = mean_k x[k][i]` and per-run mean error `e[k] = mean_i (x[k][i] - r[i])`:
+/// - `bias = mean_i (m[i] - r[i]) = mean_k e[k]` (signed; errors of opposite sign cancel),
+/// - `bias_se = sqrt(s_e^2 / K)` with `s_e^2 = sum_k (e[k] - bias)^2 / (K - 1)`,
+/// - `bias_ci = bias -/+ t(0.975, K - 1) * bias_se` (two-sided 95%, Student t),
+/// - `variance = mean_i s[i]^2` with the unbiased `s[i]^2 = sum_k (x[k][i] - m[i])^2 / (K - 1)`,
+/// - `mse = mean_k mse(x[k], r)`, `rel_mse = mean_k rel_mse(x[k], r)`,
+/// - `bias_sq = mean_i (m[i] - r[i])^2 - variance / K`, the unbiased estimate of the mean squared
+///   per-value bias (it can come out slightly negative when the bias is small next to the noise).
+///
+/// Algebraically `mse = bias_sq + variance` exactly (per value,
+/// `mean_k (x - r)^2 = (m - r)^2 + (K - 1)/K * s^2`); [`RunStats::decomposition_residual`]
+/// returns what rounding leaves of that identity.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct RunStats {
+    /// K, the number of runs
+    pub runs: usize,
+    /// mean signed error of the mean image
+    pub bias: f64,
+    /// standard error of `bias`, from the spread of the per-run mean errors
+    pub bias_se: f64,
+    /// two-sided 95% confidence interval of `bias`
+    pub bias_ci: (f64, f64),
+    /// unbiased estimate of the mean squared per-value bias
+    pub bias_sq: f64,
+    /// mean over values of the unbiased across-run variance
+    pub variance: f64,
+    /// mean over runs of each run's MSE
+    pub mse: f64,
+    /// mean over runs of each run's relative MSE
+    pub rel_mse: f64,
+}
+
+impl RunStats {
+    /// Computes the statistics of `runs` (K >= 2 images) against `reference`; see [`RunStats`].
+    pub fn from_runs(runs: &[Vec<[f32; 3]>], reference: &[[f32; 3]]) -> Result<Self, ReportError> {
+        let k = runs.len();
+        if k < 2 {
+            return Err(ReportError::TooFewRuns(k));
+        }
+        check_reference(reference)?;
+        for (i, run) in runs.iter().enumerate() {
+            check_image(run, &format!("run {i}"), reference.len())?;
+        }
+        let kf = k as f64;
+        let per_run: Vec<ErrorMeans> = runs.iter().map(|run| error_means(run, reference)).collect();
+        let over_runs = |f: fn(&ErrorMeans) -> f64| per_run.iter().map(f).sum::<f64>() / kf;
+        let bias = over_runs(|e| e.err);
+        let spread = per_run.iter().map(|e| (e.err - bias).powi(2)).sum::<f64>() / (kf - 1.0);
+
+        let (mut mean_sq_err, mut var_sum) = (0.0, 0.0);
+        for (i, px) in reference.iter().enumerate() {
+            for (c, &r) in px.iter().enumerate() {
+                let mean = runs.iter().map(|run| run[i][c] as f64).sum::<f64>() / kf;
+                var_sum += runs.iter().map(|run| (run[i][c] as f64 - mean).powi(2)).sum::<f64>();
+                mean_sq_err += (mean - r as f64).powi(2);
+            }
+        }
+        let m = 3.0 * reference.len() as f64;
+        let variance = var_sum / (kf - 1.0) / m;
+        let mut stats = RunStats {
+            runs: k,
+            bias,
+            bias_se: (spread / kf).sqrt(),
+            bias_ci: (bias, bias),
+            bias_sq: mean_sq_err / m - variance / kf,
+            variance,
+            mse: over_runs(|e| e.sq),
+            rel_mse: over_runs(|e| e.rel),
+        };
+        stats.bias_ci = stats.bias_ci_at(0.95);
+        Ok(stats)
+    }
+
+    /// Two-sided confidence interval of `bias` at `level` (e.g. 0.95), Student t with K - 1 dof.
+    ///
+    /// # Panics
+    /// If `level` is not strictly between 0 and 1.
+    pub fn bias_ci_at(&self, level: f64) -> (f64, f64) {
+        let half = student_t_quantile(0.5 + 0.5 * level, (self.runs - 1) as f64) * self.bias_se;
+        (self.bias - half, self.bias + half)
+    }
+
+    /// `mse - (bias_sq + variance)`: zero up to rounding, since the identity is exact.
+    pub fn decomposition_residual(&self) -> f64 {
+        self.mse - (self.bias_sq + self.variance)
+    }
+}
+
+/// Means over all values of the signed, squared and relative squared error of one image.
+struct ErrorMeans {
+    err: f64,
+    sq: f64,
+    rel: f64,
+}
+
+/// Error means of a validated image against a validated reference of the same size.
+fn error_means(img: &[[f32; 3]], reference: &[[f32; 3]]) -> ErrorMeans {
+    let (mut err, mut sq, mut rel) = (0.0, 0.0, 0.0);
+    for (p, q) in img.iter().zip(reference) {
+        for (&v, &r) in p.iter().zip(q) {
+            let d = v as f64 - r as f64;
+            err += d;
+            sq += d * d;
+            rel += d * d / (r.max(0.0) as f64 + REL_EPS).powi(2);
+        }
+    }
+    let m = 3.0 * img.len() as f64;
+    ErrorMeans { err: err / m, sq: sq / m, rel: rel / m }
+}
+
+/// The reference must be non-empty and finite.
+fn check_reference(reference: &[[f32; 3]]) -> Result<(), ReportError> {
+    if reference.is_empty() {
+        return Err(ReportError::Empty);
+    }
+    check_image(reference, "reference", reference.len())
+}
+
+/// `img` must have `pixels` pixels, all finite; `name` labels it in the error.
+fn check_image(img: &[[f32; 3]], name: &str, pixels: usize) -> Result<(), ReportError> {
+    if img.len() != pixels {
+        return Err(ReportError::SizeMismatch { image: name.into(), pixels: img.len(), reference: pixels });
+    }
+    for (pixel, p) in img.iter().enumerate() {
+        if let Some(channel) = p.iter().position(|v| !v.is_finite()) {
+            return Err(ReportError::NonFinite { image: name.into(), pixel, channel, value: p[channel] });
+        }
+    }
+    Ok(())
+}
+
+/// Quantile of Student's t distribution: the `t` with `P(T <= t) = p` for `dof` degrees of freedom
+/// (`dof` need not be an integer; values above [`MAX_DOF`] are evaluated at `MAX_DOF`). Found by
+/// bisection on the exact CDF `P(|T| > t) = I(dof / (dof + t^2); dof/2, 1/2)` (regularized
+/// incomplete beta), accurate to about 1e-9 relative.
+///
+/// # Panics
+/// If `p` is not strictly between 0 and 1 or `dof` is not positive.
+pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
+    assert!(p > 0.0 && p < 1.0 && dof > 0.0, "student_t_quantile: need 0 < p < 1 and dof > 0, got p={p}, dof={dof}");
+    if p < 0.5 {
+        return -student_t_quantile(1.0 - p, dof);
+    }
+    let dof = dof.min(MAX_DOF);
+    let tail = 2.0 * (1.0 - p); // target P(|T| > t), decreasing in t
+    let two_tail = |t: f64| inc_beta(0.5 * dof, 0.5, dof / (dof + t * t));
+    let (mut lo, mut hi) = (0.0, 1.0);
+    while two_tail(hi) > tail {
+        (lo, hi) = (hi, 2.0 * hi);
+    }
+    while hi - lo > 1e-12 * hi {
+        let mid = 0.5 * (lo + hi);
+        if two_tail(mid) > tail {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Regularized incomplete beta function `I_x(a, b)` for `a, b > 0`, by its continued fraction,
+/// evaluated on the side of the symmetry `I_x(a, b) = 1 - I_{1-x}(b, a)` where it converges fast.
+fn inc_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let front = (a * x.ln() + b * (1.0 - x).ln() - ln_gamma(a) - ln_gamma(b) + ln_gamma(a + b)).exp();
+    if x < (a + 1.0) / (a + b + 2.0) {
+        front * beta_fraction(a, b, x) / a
+    } else {
+        1.0 - front * beta_fraction(b, a, 1.0 - x) / b
+    }
+}
+
+/// The continued fraction `1 / (1 + d1 / (1 + d2 / (1 + ...)))` of the incomplete beta function,
+/// with `d(2m+1) = -(a+m)(a+b+m)x / ((a+2m)(a+2m+1))` and `d(2m) = m(b-m)x / ((a+2m-1)(a+2m))`,
+/// evaluated front to back with the modified Lentz method.
+fn beta_fraction(a: f64, b: f64, x: f64) -> f64 {
+    const TINY: f64 = 1e-300;
+    let guard = |v: f64| if v.abs() < TINY { TINY } else { v };
+    // Lentz on f = 0 + 1/(1 + d1/(1 + d2/(...))): partial numerators 1, d1, d2, ...
+    let (mut f, mut c, mut d) = (TINY, TINY, 0.0);
+    for j in 0..100_000u32 {
+        let numerator = if j == 0 {
+            1.0
+        } else {
+            let m = (j / 2) as f64;
+            if j % 2 == 1 {
+                -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
+            } else {
+                m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m))
+            }
+        };
+        d = 1.0 / guard(1.0 + numerator * d);
+        c = guard(1.0 + numerator / c);
+        f *= c * d;
+        if (c * d - 1.0).abs() < 1e-15 {
+            break;
+        }
+    }
+    f
+}
+
+/// `ln Γ(x)` for `x > 0`: Stirling's series at `x >= 10`, shifted there by `Γ(x+1) = x Γ(x)`
+/// (absolute error below 1e-12).
+fn ln_gamma(x: f64) -> f64 {
+    let (mut x, mut shift) = (x, 0.0);
+    while x < 10.0 {
+        shift += x.ln();
+        x += 1.0;
+    }
+    let inv = 1.0 / x;
+    let inv2 = inv * inv;
+    let series = inv * (1.0 / 12.0 - inv2 * (1.0 / 360.0 - inv2 * (1.0 / 1260.0 - inv2 / 1680.0)));
+    (x - 0.5) * x.ln() - x + 0.5 * (2.0 * std::f64::consts::PI).ln() + series - shift
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const REF: [f32; 3] = [1.0, 1.0, 1.0];
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol * (1.0 + b.abs())
+    }
+
+    /// K runs over `n` pixels of a constant-1 reference: run k, value j is
+    /// `1 + b + d * (-1)^j + s * (-1)^k`: per-value bias `b +- d`, mean bias `b`, and a
+    /// run-to-run offset `+-s` that is constant within a run (so the per-run means spread too).
+    fn synthetic(k: usize, n: usize, b: f32, d: f32, s: f32) -> Vec<Vec<[f32; 3]>> {
+        let sign = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+        (0..k)
+            .map(|run| (0..n).map(|p| std::array::from_fn(|c| 1.0 + b + d * sign(3 * p + c) + s * sign(run))).collect())
+            .collect()
+    }
+
+    #[test]
+    fn run_stats_recover_known_bias_variance_and_mse() {
+        // Values chosen exactly representable so the expectations are exact up to f64 rounding.
+        let (b, d, s) = (0.25f32, 0.125f32, 0.5f32);
+        let (b, d, s, n) = (b as f64, d as f64, s as f64, 10);
+        for k in [2usize, 4, 8, 16] {
+            let kf = k as f64;
+            let st = RunStats::from_runs(&synthetic(k, n, b as f32, d as f32, s as f32), &vec![REF; n]).unwrap();
+            assert_eq!(st.runs, k);
+            assert!(close(st.bias, b, 1e-12), "bias {}", st.bias);
+            // Each value takes +-s equally often over an even K: unbiased variance = s^2 K/(K-1).
+            assert!(close(st.variance, s * s * kf / (kf - 1.0), 1e-12), "variance {}", st.variance);
+            // Every run: error b +- d +- s with the cross terms cancelling -> mse = b^2 + d^2 + s^2.
+            assert!(close(st.mse, b * b + d * d + s * s, 1e-12), "mse {}", st.mse);
+            // Mean image is exactly 1 + b +- d: bias_sq = b^2 + d^2 - variance/K.
+            assert!(close(st.bias_sq, b * b + d * d - s * s / (kf - 1.0), 1e-12));
+            assert!(st.decomposition_residual().abs() < 1e-12);
+            // rel_mse: the reference is 1, denominator 1.01^2.
+            assert!(close(st.rel_mse, st.mse / 1.01f64.powi(2), 1e-12));
+            // Per-run mean errors are b +- s: s_e^2 = s^2 K/(K-1), half-width t * s / sqrt(K-1).
+            let half = student_t_quantile(0.975, kf - 1.0) * s / (kf - 1.0).sqrt();
+            assert!(close(st.bias_ci.0, b - half, 1e-9) && close(st.bias_ci.1, b + half, 1e-9));
+            assert!(st.bias_ci.0 < b && b < st.bias_ci.1);
+        }
+    }
+
+    #[test]
+    fn confidence_interval_shrinks_like_inverse_sqrt_k() {
+        let width = |k: usize| {
+            let st = RunStats::from_runs(&synthetic(k, 4, 0.1, 0.0, 0.5), &[REF; 4]).unwrap();
+            assert!(st.bias_ci.0 < 0.1 && 0.1 < st.bias_ci.1);
+            st.bias_ci.1 - st.bias_ci.0
+        };
+        // Quadrupling K halves the width, up to the t quantile and (K-1)/K factors.
+        let ratio = width(400) / width(100);
+        assert!((ratio - 0.5).abs() < 0.01, "ratio {ratio}");
+        assert!(width(4) > width(8) && width(8) > width(16));
+    }
+
+    /// splitmix64 -> uniform (0, 1) -> Box-Muller normal; deterministic.
+    fn normals(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        let mut uniform = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 + 0.5 / (1u64 << 53) as f64
+        };
+        move || (-2.0 * uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * uniform()).cos()
+    }
+
+    #[test]
+    fn confidence_interval_covers_95_percent_with_gaussian_noise() {
+        // With K = 5 a normal quantile (1.96 instead of 2.776) would cover only ~88%.
+        let (k, trials, bias) = (5, 4000, 0.3);
+        let mut noise = normals(7);
+        let reference = [REF; 3];
+        let mut covered = 0;
+        for _ in 0..trials {
+            let runs: Vec<Vec<[f32; 3]>> = (0..k)
+                .map(|_| reference.iter().map(|p| p.map(|r| r + bias as f32 + 0.2 * noise() as f32)).collect())
+                .collect();
+            let st = RunStats::from_runs(&runs, &reference).unwrap();
+            covered += (st.bias_ci.0 <= bias && bias <= st.bias_ci.1) as usize;
+            assert!(st.decomposition_residual().abs() < 1e-12);
+        }
+        let coverage = covered as f64 / trials as f64;
+        assert!((coverage - 0.95).abs() < 0.012, "coverage {coverage}");
+    }
+
+    #[test]
+    fn mse_and_rel_mse_known_values() {
+        let reference = [[1.0, 0.0, 2.0], [0.5, 0.0, 0.0]];
+        let img = [[1.5, 0.1, 2.0], [0.5, 0.0, -0.2]];
+        assert_eq!(mse(&reference, &reference).unwrap(), 0.0);
+        assert_eq!(rel_mse(&reference, &reference).unwrap(), 0.0);
+        // Squared errors 0.25, 0.01, 0, 0, 0, 0.04 over 6 values (f32 inputs -> tolerance).
+        assert!(close(mse(&img, &reference).unwrap(), 0.3 / 6.0, 1e-6));
+        let rel = (0.25 / 1.01f64.powi(2) + 0.01 / 0.0001 + 0.04 / 0.0001) / 6.0;
+        assert!(close(rel_mse(&img, &reference).unwrap(), rel, 1e-6));
+        // A negative reference value counts as 0 in the denominator: never a division by zero.
+        assert!(close(rel_mse(&[[0.0; 3]], &[[-0.01, 0.0, 0.0]]).unwrap(), 0.0001 / 0.0001 / 3.0, 1e-6));
+    }
+
+    #[test]
+    fn efficiency_known_and_guarded() {
+        assert_eq!(efficiency(0.01, 4.0).unwrap(), 25.0);
+        assert_eq!(efficiency(0.0, 4.0).unwrap(), f64::INFINITY);
+        assert_eq!(efficiency(0.5, 0.0).unwrap(), f64::INFINITY);
+        assert_eq!(efficiency(1e-200, 1e-200).unwrap(), f64::INFINITY); // underflowing product
+        assert_eq!(efficiency(-0.0, 1.0).unwrap(), f64::INFINITY); // not 1 / -0 = -inf
+        for (m, s) in [(f64::NAN, 1.0), (1.0, f64::INFINITY), (-1.0, 1.0)] {
+            assert!(matches!(efficiency(m, s), Err(ReportError::InvalidArgument { .. })));
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let good = vec![REF; 4];
+        let mut nan = good.clone();
+        nan[2][1] = f32::NAN;
+        let e = mse(&nan, &good).unwrap_err();
+        assert!(
+            matches!(e, ReportError::NonFinite { ref image, pixel: 2, channel: 1, value } if image == "image" && value.is_nan())
+        );
+        let mut inf = good.clone();
+        inf[3][0] = f32::INFINITY;
+        assert!(
+            matches!(rel_mse(&good, &inf), Err(ReportError::NonFinite { ref image, pixel: 3, channel: 0, .. }) if image == "reference")
+        );
+        let small = vec![REF; 3];
+        let e = mse(&small, &good).unwrap_err();
+        assert_eq!(e, ReportError::SizeMismatch { image: "image".into(), pixels: 3, reference: 4 });
+        assert!(e.to_string().contains('3') && e.to_string().contains('4'));
+        assert_eq!(mse(&[], &[]), Err(ReportError::Empty));
+        assert_eq!(RunStats::from_runs(std::slice::from_ref(&good), &good), Err(ReportError::TooFewRuns(1)));
+        let e = RunStats::from_runs(&[good.clone(), inf.clone()], &good).unwrap_err();
+        assert!(matches!(e, ReportError::NonFinite { ref image, .. } if image == "run 1"));
+        let e = RunStats::from_runs(&[good.clone(), small], &good).unwrap_err();
+        assert_eq!(e.to_string(), "size mismatch: run 1 has 3 pixels but the reference has 4");
+    }
+
+    #[test]
+    fn t_quantiles() {
+        for (dof, want) in [(1.0, 12.706), (4.0, 2.776), (30.0, 2.042), (1e9, 1.960), (f64::INFINITY, 1.960)] {
+            let t = student_t_quantile(0.975, dof);
+            assert!((t - want).abs() < 1e-3, "t(0.975, {dof}) = {t}, want {want}");
+        }
+        // Closed forms: dof 1 is Cauchy, dof 2 is (2p-1)/sqrt(2p(1-p)); also symmetry.
+        for p in [0.01, 0.3, 0.6, 0.9, 0.975, 0.999] {
+            let cauchy = (std::f64::consts::PI * (p - 0.5)).tan();
+            assert!(close(student_t_quantile(p, 1.0), cauchy, 1e-9), "p={p}");
+            let two = (2.0 * p - 1.0) / (2.0 * p * (1.0 - p)).sqrt();
+            assert!(close(student_t_quantile(p, 2.0), two, 1e-9), "p={p}");
+            assert!(close(student_t_quantile(1.0 - p, 7.5), -student_t_quantile(p, 7.5), 1e-9));
+        }
+        // More digits than the brief asks for (standard tables).
+        assert!((student_t_quantile(0.975, 10.0) - 2.228139).abs() < 1e-6);
+        assert!((student_t_quantile(0.995, 3.0) - 5.840909).abs() < 1e-6);
+    }
+}
