@@ -7,6 +7,7 @@ pub mod integrator;
 pub mod light;
 pub mod measure;
 pub mod render;
+pub mod report;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;

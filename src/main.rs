@@ -43,7 +43,7 @@ struct RenderArgs {
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     threads: usize,
-    /// Light sample layout: independent (random), stratified, grid-center (biased), halton.
+    /// Light sample layout: independent (random), stratified, grid-center (biased), halton, sobol, pmj02.
     #[arg(long, value_parser = parse_sampler)]
     light_sampler: Option<SamplerKind>,
     /// Light samples per light (default: the scene's lightsamples).
@@ -92,7 +92,7 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
-    SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton)"))
+    SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton, sobol, pmj02)"))
 }
 
 fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, String> {

@@ -31,6 +31,9 @@
 
 use crate::simd::{i32x8, F8, U8};
 
+pub mod pmj;
+pub mod sobol;
+
 // ------------------------------------------------------------------------------------------------
 // Public API
 // ------------------------------------------------------------------------------------------------
@@ -46,21 +49,34 @@ pub enum SamplerKind {
     GridCenter,
     /// Owen-scrambled Halton points (bases 2, 3) at index `sample * n + k`.
     Halton,
+    /// Owen-scrambled Sobol' (dimensions 0, 1; hash-based nested scrambling) at `sample * n + k`.
+    Sobol,
+    /// Progressive multi-jittered (0,2) sequence (table-based, XOR-scrambled) at `sample * n + k`.
+    Pmj02,
 }
 
 impl SamplerKind {
     /// Every kind, in declaration order.
-    pub const ALL: [SamplerKind; 4] =
-        [SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::GridCenter, SamplerKind::Halton];
+    pub const ALL: [SamplerKind; 6] = [
+        SamplerKind::Independent,
+        SamplerKind::Stratified,
+        SamplerKind::GridCenter,
+        SamplerKind::Halton,
+        SamplerKind::Sobol,
+        SamplerKind::Pmj02,
+    ];
 
     /// Kind for a name (case-insensitive, surrounding spaces ignored): "independent" | "random",
-    /// "stratified" | "jittered", "grid" | "grid-center" | "center", "halton"; `None` otherwise.
+    /// "stratified" | "jittered", "grid" | "grid-center" | "center", "halton", "sobol",
+    /// "pmj02" | "pmj"; `None` otherwise.
     pub fn parse(name: &str) -> Option<Self> {
         match name.trim().to_ascii_lowercase().as_str() {
             "independent" | "random" => Some(Self::Independent),
             "stratified" | "jittered" => Some(Self::Stratified),
             "grid" | "grid-center" | "center" => Some(Self::GridCenter),
             "halton" => Some(Self::Halton),
+            "sobol" => Some(Self::Sobol),
+            "pmj02" | "pmj" => Some(Self::Pmj02),
             _ => None,
         }
     }
@@ -72,6 +88,8 @@ impl SamplerKind {
             Self::Stratified => "stratified",
             Self::GridCenter => "grid-center",
             Self::Halton => "halton",
+            Self::Sobol => "sobol",
+            Self::Pmj02 => "pmj02",
         }
     }
 
@@ -184,6 +202,8 @@ impl PointSet {
             SamplerKind::Stratified => Layout::Grid { grid: Grid::new(n), jitter: true },
             SamplerKind::GridCenter => Layout::Grid { grid: Grid::new(n), jitter: false },
             SamplerKind::Halton => Layout::Halton,
+            SamplerKind::Sobol => Layout::Sobol,
+            SamplerKind::Pmj02 => Layout::Pmj02,
         };
         Self { kind, n, layout }
     }
@@ -226,8 +246,9 @@ impl PointSet {
             Layout::Independent => mix(mix(L::splat(stream_key(TAG_INDEPENDENT, seed, dim)), pixel), sample),
             Layout::Grid { .. } => mix(mix(L::splat(stream_key(TAG_STRATIFIED, seed, dim)), pixel), sample),
             Layout::Halton => mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel),
+            Layout::Sobol | Layout::Pmj02 => pixel,
         };
-        Stream { set: *self, prefix, base: sample.mul(L::splat(self.n)) }
+        Stream { set: *self, prefix, base: sample.mul(L::splat(self.n)), sample, dim, seed }
     }
 
     fn eval<L: Lanes>(&self, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
@@ -255,6 +276,8 @@ impl PointSet {
                 let y = RADIX3.inverse(index, Some(mix(key, L::splat(3))));
                 (x.unit24(), y.unit24())
             }
+            Layout::Sobol => L::sobol(pixel, sample, dim, k, self.n, seed),
+            Layout::Pmj02 => L::pmj02(pixel, sample, dim, k, self.n, seed),
         }
     }
 }
@@ -267,6 +290,9 @@ pub struct Stream<L> {
     prefix: L,
     /// Halton: sample * n
     base: L,
+    sample: L,
+    dim: u32,
+    seed: u64,
 }
 
 impl<L: Lanes> Stream<L> {
@@ -299,6 +325,8 @@ impl<L: Lanes> Stream<L> {
                 let y = RADIX3.inverse(index, Some(mix(self.prefix, L::splat(3))));
                 (x.unit24(), y.unit24())
             }
+            Layout::Sobol => L::sobol(self.prefix, self.sample, self.dim, L::splat(k), self.set.n, self.seed),
+            Layout::Pmj02 => L::pmj02(self.prefix, self.sample, self.dim, L::splat(k), self.set.n, self.seed),
         }
     }
 }
@@ -308,6 +336,8 @@ enum Layout {
     Independent,
     Grid { grid: Grid, jitter: bool },
     Halton,
+    Sobol,
+    Pmj02,
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -335,6 +365,10 @@ pub trait Lanes: Copy {
     fn lt_select(self, o: Self, a: Self, b: Self) -> Self;
     /// Per lane `self * 2^-24` as f32; exact for self < 2^24.
     fn unit24(self) -> Self::F;
+    /// The Owen-scrambled Sobol' point of `sobol.rs` for these lanes.
+    fn sobol(pixel: Self, sample: Self, dim: u32, k: Self, n: u32, seed: u64) -> (Self::F, Self::F);
+    /// The pmj02 point of `pmj.rs` for these lanes.
+    fn pmj02(pixel: Self, sample: Self, dim: u32, k: Self, n: u32, seed: u64) -> (Self::F, Self::F);
     /// High word of the 64-bit product.
     fn mulhi(self, o: Self) -> Self {
         self.mul_wide(o).1
@@ -385,6 +419,14 @@ impl Lanes for u32 {
     }
     fn unit24(self) -> f32 {
         self as f32 * INV_2_24
+    }
+    fn sobol(pixel: u32, sample: u32, dim: u32, k: u32, n: u32, seed: u64) -> (f32, f32) {
+        let [x, y] = sobol::sobol_owen_2d(pixel, sample, dim, k, n, seed);
+        (x, y)
+    }
+    fn pmj02(pixel: u32, sample: u32, dim: u32, k: u32, n: u32, seed: u64) -> (f32, f32) {
+        let [x, y] = pmj::pmj02_2d(pixel, sample, dim, k, n, seed);
+        (x, y)
     }
 }
 
@@ -438,6 +480,14 @@ impl Lanes for U8 {
     fn unit24(self) -> F8 {
         // Lanes are < 2^24, so the signed conversion is exact.
         F8::from_i32x8(wide::bytemuck::cast::<U8, i32x8>(self)) * F8::splat(INV_2_24)
+    }
+    #[inline]
+    fn sobol(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) -> (F8, F8) {
+        sobol::sobol_owen_2d_x8(pixel, sample, dim, k, n, seed)
+    }
+    #[inline]
+    fn pmj02(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) -> (F8, F8) {
+        pmj::pmj02_2d_x8(pixel, sample, dim, k, n, seed)
     }
 }
 
@@ -702,7 +752,8 @@ mod tests {
         assert_eq!(SamplerKind::parse("Jittered"), Some(SamplerKind::Stratified));
         assert_eq!(SamplerKind::parse("grid"), Some(SamplerKind::GridCenter));
         assert_eq!(SamplerKind::parse(" center "), Some(SamplerKind::GridCenter));
-        assert_eq!(SamplerKind::parse("sobol"), None);
+        assert_eq!(SamplerKind::parse("pmj"), Some(SamplerKind::Pmj02));
+        assert_eq!(SamplerKind::parse("owen"), None);
     }
 
     #[test]
