@@ -185,8 +185,14 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "light_samples": out.integrator.light_set.n(),
         "rays": { "camera": c.camera, "shadow": c.shadow, "bounce": c.bounce, "total": c.total_rays() },
         "mrays_per_sec": out.stats.mrays_per_sec(),
-        "packets": c.packets,
+        "packets": { "camera": c.camera_packets, "bounce": c.bounce_packets, "shadow": c.shadow_packets },
         "occupancy": c.occupancy(),
+        "occupancy_by_kind": { "bounce": c.bounce_occupancy(), "shadow": c.shadow_occupancy() },
+        "mean_path_length": c.mean_path_length(),
+        "max_depth": out.integrator.max_depth,
+        "nee": format!("{:?}", out.integrator.nee).to_lowercase(),
+        "russian_roulette": out.integrator.russian_roulette,
+        "importance_sampling": format!("{:?}", out.integrator.strategy).to_lowercase(),
         "nonfinite_samples": c.nonfinite,
         "version": env!("CARGO_PKG_VERSION"),
     })
@@ -197,7 +203,7 @@ pub fn summary(out: &RenderOutput) -> String {
     let d = &out.scene.desc;
     let c = &out.stats.counters;
     format!(
-        "{} {}x{} {} spp {} (light {} x{}): {:.3} s, {:.2} Mrays/s (camera {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
+        "{} {}x{} {} spp {} (light {} x{}): {:.3} s, {:.2} Mrays/s (camera {}, bounce {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
         d.source.display(),
         d.width,
         d.height,
@@ -208,6 +214,7 @@ pub fn summary(out: &RenderOutput) -> String {
         out.stats.seconds,
         out.stats.mrays_per_sec(),
         c.camera,
+        c.bounce,
         c.shadow,
         100.0 * c.occupancy(),
         out.stats.threads,
@@ -245,12 +252,14 @@ pub fn run_rays(opts: &RenderOptions) -> Result<(crate::measure::RayRates, Strin
 /// A small table of [`crate::measure::RayRates`].
 pub fn rates_table(name: &str, r: &crate::measure::RayRates) -> String {
     format!(
-        "{name}: {} camera + {} shadow rays, 1 thread\n  renderer          {:8.2} Mrays/s\n  Embree raw mixed  {:8.2} Mrays/s  (camera {:.2}, shadow {:.2})\n  renderer / raw    {:8.1} %",
+        "{name}: {} camera + {} bounce + {} shadow rays, 1 thread\n  renderer          {:8.2} Mrays/s\n  Embree raw mixed  {:8.2} Mrays/s  (camera {:.2}, bounce {:.2}, shadow {:.2})\n  renderer / raw    {:8.1} %",
         r.camera_rays,
+        r.bounce_rays,
         r.shadow_rays,
         r.renderer_mrays,
         r.raw_mixed_mrays,
         r.raw_camera_mrays,
+        r.raw_bounce_mrays,
         r.raw_shadow_mrays,
         100.0 * r.ratio
     )

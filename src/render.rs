@@ -14,6 +14,8 @@ use std::time::Instant;
 
 /// Tile side in pixels.
 pub const TILE: u32 = 16;
+/// Pixel samples of a tile traced as one wavefront.
+pub const SAMPLE_BATCH: u32 = 16;
 /// Packet footprint: 4 pixels wide, 2 tall.
 pub const PACKET_W: u32 = 4;
 /// Packet footprint height.
@@ -151,12 +153,19 @@ fn render_tile(
     let mut sum = vec![[0f64; 3]; n];
     let mut sum_sq = vec![[0f64; 3]; n];
     let packets = tile_packets(x0, y0, tw, th, w, h);
-    let mut radiance = Vec::with_capacity(packets.len());
-    for s in samples.clone() {
-        integrator.radiance_tile(scene, &packets, s, &mut radiance, scratch, counters, None);
-        for (pk, l) in packets.iter().zip(&radiance) {
-            accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, l, counters);
+    let mut radiance = Vec::with_capacity(packets.len() * SAMPLE_BATCH as usize);
+    let mut start = samples.start;
+    while start < samples.end {
+        // A batch of samples is one wavefront (full packets for the path tracer); samples are
+        // still accumulated in increasing order.
+        let batch = start..samples.end.min(start + SAMPLE_BATCH);
+        integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None);
+        for per_sample in radiance.chunks_exact(packets.len()) {
+            for (pk, l) in packets.iter().zip(per_sample) {
+                accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, l, counters);
+            }
         }
+        start = batch.end;
     }
     TileResult { x0, y0, tw, th, sum, sum_sq, count: samples.len() as u32 }
 }

@@ -33,12 +33,25 @@ pub struct Counters {
     pub shadow: u64,
     /// bounce rays traced
     pub bounce: u64,
-    /// packets sent to Embree
-    pub packets: u64,
-    /// active lanes summed over those packets
-    pub packet_lanes: u64,
+    /// camera packets sent to Embree
+    pub camera_packets: u64,
+    /// shadow packets sent to Embree
+    pub shadow_packets: u64,
+    /// bounce packets sent to Embree
+    pub bounce_packets: u64,
     /// samples whose value was not finite (replaced by zero; must stay 0)
     pub nonfinite: u64,
+}
+
+/// Which kind of ray a packet carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// primary rays from the camera
+    Camera,
+    /// path continuation rays
+    Bounce,
+    /// occlusion rays towards light samples
+    Shadow,
 }
 
 impl Counters {
@@ -47,23 +60,53 @@ impl Counters {
         self.camera += o.camera;
         self.shadow += o.shadow;
         self.bounce += o.bounce;
-        self.packets += o.packets;
-        self.packet_lanes += o.packet_lanes;
+        self.camera_packets += o.camera_packets;
+        self.shadow_packets += o.shadow_packets;
+        self.bounce_packets += o.bounce_packets;
         self.nonfinite += o.nonfinite;
     }
     /// All rays traced.
     pub fn total_rays(&self) -> u64 {
         self.camera + self.shadow + self.bounce
     }
-    /// Mean fraction of active lanes in the packets sent to Embree.
-    pub fn occupancy(&self) -> f64 {
-        self.packet_lanes as f64 / (8.0 * self.packets.max(1) as f64)
+    /// All packets sent to Embree.
+    pub fn packets(&self) -> u64 {
+        self.camera_packets + self.shadow_packets + self.bounce_packets
     }
-    fn packet(&mut self, traced: Mask8) -> u64 {
+    /// Mean fraction of active lanes over all packets sent to Embree.
+    pub fn occupancy(&self) -> f64 {
+        ratio(self.total_rays(), 8 * self.packets())
+    }
+    /// Mean fraction of active lanes in bounce packets (paths past the first bounce).
+    pub fn bounce_occupancy(&self) -> f64 {
+        ratio(self.bounce, 8 * self.bounce_packets)
+    }
+    /// Mean fraction of active lanes in shadow packets.
+    pub fn shadow_occupancy(&self) -> f64 {
+        ratio(self.shadow, 8 * self.shadow_packets)
+    }
+    /// Mean number of rays traced per camera ray along a path (camera + bounce segments).
+    pub fn mean_path_length(&self) -> f64 {
+        ratio(self.camera + self.bounce, self.camera)
+    }
+    /// Counts one packet of `kind` whose traced lanes are `traced`.
+    fn packet(&mut self, kind: RayKind, traced: Mask8) {
         let n = traced.to_bitmask().count_ones() as u64;
-        self.packets += 1;
-        self.packet_lanes += n;
-        n
+        let (rays, packets) = match kind {
+            RayKind::Camera => (&mut self.camera, &mut self.camera_packets),
+            RayKind::Bounce => (&mut self.bounce, &mut self.bounce_packets),
+            RayKind::Shadow => (&mut self.shadow, &mut self.shadow_packets),
+        };
+        *rays += n;
+        *packets += 1;
+    }
+}
+
+fn ratio(a: u64, b: u64) -> f64 {
+    if b == 0 {
+        0.0
+    } else {
+        a as f64 / b as f64
     }
 }
 
@@ -72,6 +115,8 @@ impl Counters {
 pub struct RayLog {
     /// camera packets (rays and their active masks)
     pub camera: Vec<(RayHit8, Mask8)>,
+    /// bounce packets (path continuation rays)
+    pub bounce: Vec<(RayHit8, Mask8)>,
     /// shadow packets
     pub shadow: Vec<(Ray8, Mask8)>,
 }
@@ -136,11 +181,37 @@ impl Integrator {
         (Vec3x8::splat(scene.camera.eye), dir)
     }
 
-    /// Radiance of pixel sample `s` for each packet of `pks` (a tile), into `out` (one `Vec3x8`
-    /// per packet; inactive lanes zero). The tile is processed as a wavefront: all camera packets
-    /// are traced, then gathered, then for each (light, light sample) all shadow packets are built
-    /// and traced back to back, so Embree runs in tight loops. `log` records every packet traced.
+    /// Radiance of pixel samples `samples` for each packet of `pks` (a tile), into `out`,
+    /// sample-major: `out[si * pks.len() + p]` is packet p at sample `samples.start + si`
+    /// (inactive lanes zero). `log` records every packet traced.
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance_tile(
+        &self,
+        scene: &Scene,
+        pks: &[PixelPacket],
+        samples: std::ops::Range<u32>,
+        out: &mut Vec<Vec3x8>,
+        sc: &mut Scratch,
+        c: &mut Counters,
+        mut log: Option<&mut RayLog>,
+    ) {
+        if self.kind == IntegratorKind::PathTracer {
+            return self.path_tile(scene, pks, samples, out, &mut sc.path, c, log);
+        }
+        out.clear();
+        let mut one = std::mem::take(&mut sc.one);
+        for s in samples {
+            self.radiance_tile_1(scene, pks, s, &mut one, sc, c, log.as_deref_mut());
+            out.extend_from_slice(&one);
+        }
+        sc.one = one;
+    }
+
+    /// Radiance of pixel sample `s` for each packet of `pks` (direct lighting integrators): the
+    /// tile is processed as a wavefront: all camera packets are traced, then gathered, then for each
+    /// (light, light sample) all shadow packets are built and traced back to back.
+    #[allow(clippy::too_many_arguments)]
+    fn radiance_tile_1(
         &self,
         scene: &Scene,
         pks: &[PixelPacket],
@@ -150,9 +221,6 @@ impl Integrator {
         c: &mut Counters,
         mut log: Option<&mut RayLog>,
     ) {
-        if self.kind == IntegratorKind::PathTracer {
-            return self.path_tile(scene, pks, s, out, &mut sc.path, c, log);
-        }
         let n = pks.len();
         out.clear();
         sc.rh.clear();
@@ -169,7 +237,7 @@ impl Integrator {
         }
         for (rh, active) in sc.rh.iter_mut() {
             let traced = scene.accel.intersect8(rh, true, *active);
-            c.camera += c.packet(traced);
+            c.packet(RayKind::Camera, traced);
             *active = traced;
         }
         // Gather: hit records to SoA shading records; emission.
@@ -257,7 +325,7 @@ impl Integrator {
                 }
                 for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
                     let occluded = scene.accel.occluded8(ray, *lit);
-                    c.shadow += c.packet(*lit);
+                    c.packet(RayKind::Shadow, *lit);
                     let visible = *lit & !occluded;
                     sc.acc[sc.owner[j] as usize] += masked(sc.contrib[j], visible);
                 }
@@ -283,6 +351,7 @@ pub struct Scratch {
     owner: Vec<u32>,
     streams: Vec<Stream<U8>>,
     path: PathScratch,
+    one: Vec<Vec3x8>,
 }
 
 /// `analyticdirect` without emission: kd/pi * sum over lights of L * max(0, Phi . n) (no visibility).

@@ -14,7 +14,7 @@
 //! pixel's spp samples whose strata are shuffled per (pixel, dimension), so dimensions are
 //! stratified independently of one another.
 
-use super::{masked, Counters, Integrator, RayLog};
+use super::{masked, Counters, Integrator, RayKind, RayLog};
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::Material8;
 use crate::render::PixelPacket;
@@ -37,6 +37,8 @@ struct PathLane {
     slot: u32,
     /// linear pixel index (sampler input)
     pixel: u32,
+    /// pixel sample index (sampler input)
+    sample: u32,
     /// next ray origin and unit direction
     o: Vec3,
     d: Vec3,
@@ -46,6 +48,17 @@ struct PathLane {
     pdf: f32,
 }
 
+/// One shadow ray waiting to be packed: origin, unnormalized direction to the light sample,
+/// interval end, and the contribution added to `slot` if it is unoccluded.
+#[derive(Clone, Copy, Debug)]
+struct ShadowLane {
+    slot: u32,
+    o: Vec3,
+    d: Vec3,
+    tfar: f32,
+    contrib: Vec3,
+}
+
 /// Per-thread buffers of the path wavefront.
 #[derive(Default)]
 pub struct PathScratch {
@@ -53,6 +66,7 @@ pub struct PathScratch {
     next: Vec<PathLane>,
     rh: Vec<(RayHit8, Mask8)>,
     radiance: Vec<Vec3>,
+    shadow_lanes: Vec<ShadowLane>,
     shadow: Vec<(Ray8, Mask8)>,
     shadow_contrib: Vec<Vec3x8>,
     shadow_slots: Vec<[u32; 8]>,
@@ -61,20 +75,23 @@ pub struct PathScratch {
 impl Integrator {
     /// Stratified 2D point of dimension `dim` for pixel sample `s`, strata shuffled per (pixel, dim).
     #[inline]
-    fn path_point(&self, pixel: U8, s: u32, dim: u32) -> (F8, F8) {
+    fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
         let n = self.spp;
         let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-        let k = U8::new(pixel.to_array().map(|p| permute(s, n, key_base ^ p.wrapping_mul(0x9e37_79b1))));
+        let (ps, ss) = (pixel.to_array(), s.to_array());
+        let k = U8::new(std::array::from_fn(|i| permute(ss[i], n, key_base ^ ps[i].wrapping_mul(0x9e37_79b1))));
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
     }
 
-    /// Radiance of pixel sample `s` for each packet of `pks` (a tile) by path tracing, into `out`.
+    /// Radiance of pixel samples `samples` for each packet of `pks` (a tile) by path tracing, into
+    /// `out` (sample-major: `out[si * pks.len() + p]`). All paths of all these samples form one
+    /// wavefront, so packets stay full even when Russian roulette thins the paths out.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn path_tile(
         &self,
         scene: &Scene,
         pks: &[PixelPacket],
-        s: u32,
+        samples: std::ops::Range<u32>,
         out: &mut Vec<Vec3x8>,
         sc: &mut PathScratch,
         c: &mut Counters,
@@ -84,17 +101,20 @@ impl Integrator {
         let n_lights = scene.lights.len() as u32;
         let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
         sc.radiance.clear();
-        sc.radiance.resize(pks.len() * 8, Vec3::ZERO);
+        let n_samples = samples.len();
+        sc.radiance.resize(pks.len() * 8 * n_samples, Vec3::ZERO);
         sc.lanes.clear();
         // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks).
-        for (p, pk) in pks.iter().enumerate() {
-            let (org, dir) = self.camera_rays(scene, pk, s);
-            let (inside, pix, dirs) = (mask_to_bools(pk.active), pk.pixel.to_array(), dir.to_lanes());
-            for i in 0..8 {
-                let slot = (p * 8 + i) as u32;
-                let live = inside[i];
-                // Lanes outside the image travel as inactive placeholders in the first packets.
-                sc.lanes.push(PathLane { slot: if live { slot } else { u32::MAX }, pixel: pix[i], o: org.lane(i), d: dirs[i], beta: Vec3::ONE, pdf: 0.0 });
+        for (si, s) in samples.enumerate() {
+            for (p, pk) in pks.iter().enumerate() {
+                let (org, dir) = self.camera_rays(scene, pk, s);
+                let (inside, pix, dirs) = (mask_to_bools(pk.active), pk.pixel.to_array(), dir.to_lanes());
+                for i in 0..8 {
+                    let slot = ((si * pks.len() + p) * 8 + i) as u32;
+                    // Lanes outside the image travel as inactive placeholders in the first packets.
+                    let slot = if inside[i] { slot } else { u32::MAX };
+                    sc.lanes.push(PathLane { slot, pixel: pix[i], sample: s, o: org.lane(i), d: dirs[i], beta: Vec3::ONE, pdf: 0.0 });
+                }
             }
         }
         let mut v = 1u32;
@@ -107,21 +127,17 @@ impl Integrator {
                 let mut rh = RayHit8::default();
                 let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
                 if let Some(l) = log.as_deref_mut() {
-                    l.camera.push((rh, active));
+                    if v == 1 { &mut l.camera } else { &mut l.bounce }.push((rh, active));
                 }
                 sc.rh.push((rh, active));
             }
             for (rh, active) in sc.rh.iter_mut() {
                 let traced = scene.accel.intersect8(rh, v == 1, *active);
-                let n = c.packet(traced);
-                if v == 1 {
-                    c.camera += n;
-                } else {
-                    c.bounce += n;
-                }
+                c.packet(if v == 1 { RayKind::Camera } else { RayKind::Bounce }, traced);
                 *active = traced;
             }
             sc.next.clear();
+            sc.shadow_lanes.clear();
             sc.shadow.clear();
             sc.shadow_contrib.clear();
             sc.shadow_slots.clear();
@@ -133,6 +149,7 @@ impl Integrator {
                 let beta = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::ZERO, |l| l.beta)));
                 let slots: [u32; 8] = std::array::from_fn(|i| chunk.get(i).map_or(u32::MAX, |l| l.slot));
                 let pixel = U8::new(std::array::from_fn(|i| chunk.get(i).map_or(0, |l| l.pixel)));
+                let s = U8::new(std::array::from_fn(|i| chunk.get(i).map_or(0, |l| l.sample)));
                 let prev_pdf = F8::new(std::array::from_fn(|i| chunk.get(i).map_or(0.0, |l| l.pdf)));
 
                 // Emission: materials always; quad lights by the NEE mode.
@@ -198,10 +215,13 @@ impl Integrator {
                         };
                         let contrib = beta.mul_elem(f).mul_elem(l_rad).scale(g * w_light);
                         let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
-                        let (ray, lit) = Ray8::new(o, y - o, F8::ZERO, tfar, lit);
-                        sc.shadow.push((ray, lit));
-                        sc.shadow_contrib.push(contrib);
-                        sc.shadow_slots.push(slots);
+                        // Shadow rays are compacted per lane and sent in full packets below.
+                        let (lit_b, os, ds, tf, cs) = (mask_to_bools(lit), o.to_lanes(), (y - o).to_lanes(), tfar.to_array(), contrib.to_lanes());
+                        for i in 0..8 {
+                            if lit_b[i] {
+                                sc.shadow_lanes.push(ShadowLane { slot: slots[i], o: os[i], d: ds[i], tfar: tf[i], contrib: cs[i] });
+                            }
+                        }
                     }
                 }
 
@@ -222,21 +242,33 @@ impl Integrator {
                     if alive.any() {
                         let wi = frame.to_world(wi_l);
                         let (alive_b, os, ds, bs, ps) = (mask_to_bools(alive), o.to_lanes(), wi.to_lanes(), nb.to_lanes(), pdf.to_array());
+                        let (pix, smp) = (pixel.to_array(), s.to_array());
                         for i in 0..8 {
                             if alive_b[i] {
-                                sc.next.push(PathLane { slot: slots[i], pixel: pixel.to_array()[i], o: os[i], d: ds[i], beta: bs[i], pdf: ps[i] });
+                                sc.next.push(PathLane { slot: slots[i], pixel: pix[i], sample: smp[i], o: os[i], d: ds[i], beta: bs[i], pdf: ps[i] });
                             }
                         }
                     }
                 }
             }
-            // Shadow packets of this bounce, back to back.
+            // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
+            for chunk in sc.shadow_lanes.chunks(8) {
+                let get = |i: usize| chunk.get(i);
+                let o = Vec3x8::from_lanes(std::array::from_fn(|i| get(i).map_or(Vec3::ZERO, |l| l.o)));
+                let d = Vec3x8::from_lanes(std::array::from_fn(|i| get(i).map_or(Vec3::Z, |l| l.d)));
+                let tfar = F8::new(std::array::from_fn(|i| get(i).map_or(0.0, |l| l.tfar)));
+                let active = mask_from_bools(std::array::from_fn(|i| i < chunk.len()));
+                let (ray, lit) = Ray8::new(o, d, F8::ZERO, tfar, active);
+                sc.shadow.push((ray, lit));
+                sc.shadow_contrib.push(Vec3x8::from_lanes(std::array::from_fn(|i| get(i).map_or(Vec3::ZERO, |l| l.contrib))));
+                sc.shadow_slots.push(std::array::from_fn(|i| get(i).map_or(u32::MAX, |l| l.slot)));
+            }
             if let Some(l) = log.as_deref_mut() {
                 l.shadow.extend_from_slice(&sc.shadow);
             }
             for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
                 let occluded = scene.accel.occluded8(ray, *lit);
-                c.shadow += c.packet(*lit);
+                c.packet(RayKind::Shadow, *lit);
                 let visible = *lit & !occluded;
                 add_lanes(&mut sc.radiance, &sc.shadow_slots[j], masked(sc.shadow_contrib[j], visible));
             }
