@@ -53,7 +53,7 @@ struct RenderArgs {
     /// --spp 1 puts the sample at the pixel centre).
     #[arg(long, value_parser = parse_sampler)]
     pixel_sampler: Option<SamplerKind>,
-    /// Integrator override: analyticdirect, direct.
+    /// Integrator override: analyticdirect, direct, pathtracer (raytracer is not implemented yet).
     #[arg(long, value_parser = parse_integrator)]
     integrator: Option<strata::scene::desc::IntegratorKind>,
     /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
@@ -96,7 +96,7 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
 }
 
 fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, String> {
-    app::parse_integrator(s).ok_or_else(|| format!("unknown integrator `{s}` (analyticdirect, direct)"))
+    app::parse_integrator(s).ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
 }
 
 fn main() -> ExitCode {

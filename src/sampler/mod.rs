@@ -365,6 +365,8 @@ pub trait Lanes: Copy {
     fn lt_select(self, o: Self, a: Self, b: Self) -> Self;
     /// Per lane `self * 2^-24` as f32; exact for self < 2^24.
     fn unit24(self) -> Self::F;
+    /// `f` applied to every lane (table look-ups).
+    fn map(self, f: impl Fn(u32) -> u32) -> Self;
     /// The Owen-scrambled Sobol' point of `sobol.rs` for these lanes.
     fn sobol(pixel: Self, sample: Self, dim: u32, k: Self, n: u32, seed: u64) -> (Self::F, Self::F);
     /// The pmj02 point of `pmj.rs` for these lanes.
@@ -419,6 +421,9 @@ impl Lanes for u32 {
     }
     fn unit24(self) -> f32 {
         self as f32 * INV_2_24
+    }
+    fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        f(self)
     }
     fn sobol(pixel: u32, sample: u32, dim: u32, k: u32, n: u32, seed: u64) -> (f32, f32) {
         let [x, y] = sobol::sobol_owen_2d(pixel, sample, dim, k, n, seed);
@@ -480,6 +485,10 @@ impl Lanes for U8 {
     fn unit24(self) -> F8 {
         // Lanes are < 2^24, so the signed conversion is exact.
         F8::from_i32x8(wide::bytemuck::cast::<U8, i32x8>(self)) * F8::splat(INV_2_24)
+    }
+    #[inline]
+    fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        U8::new(self.to_array().map(f))
     }
     #[inline]
     fn sobol(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) -> (F8, F8) {

@@ -39,7 +39,7 @@
 //! bit. The hash (murmur3's public-domain `fmix32` finalizer and `combine`) is local to this module
 //! and shared with `pmj`; its domain tags differ from `mod.rs`'s.
 
-use crate::simd::{i32x8, F8, U8};
+use crate::simd::{F8, U8};
 
 /// Point k of the n-point Owen-scrambled Sobol' set of stream (pixel, sample, dim) under seed:
 /// index `sample * n + k` (wrapping; n == 0 acts as 1). Any inputs; both coordinates in [0, 1), on
@@ -113,105 +113,9 @@ fn reverse_bits<L: Words>(x: L) -> L {
 // Lanes and hash, shared with `pmj`
 // ------------------------------------------------------------------------------------------------
 
-/// u32 lanes: `u32` (one) or [`U8`] (eight). Generators are written once against this trait, so both
-/// instantiations run the same integer operations (all wrapping modulo 2^32).
-pub(super) trait Words: Copy {
-    /// Matching float lanes.
-    type F;
-    fn splat(x: u32) -> Self;
-    fn add(self, o: Self) -> Self;
-    fn mul(self, o: Self) -> Self;
-    fn xor(self, o: Self) -> Self;
-    fn or(self, o: Self) -> Self;
-    fn and(self, o: Self) -> Self;
-    fn shr(self, s: u32) -> Self;
-    fn shl(self, s: u32) -> Self;
-    /// `f` applied to every lane (table look-ups).
-    fn map(self, f: impl Fn(u32) -> u32) -> Self;
-    /// `self * 2^-24` as float; exact for lanes < 2^24.
-    fn unit24(self) -> Self::F;
-}
-
-const INV_2_24: f32 = 1.0 / 16_777_216.0;
-
-impl Words for u32 {
-    type F = f32;
-    fn splat(x: u32) -> Self {
-        x
-    }
-    fn add(self, o: Self) -> Self {
-        self.wrapping_add(o)
-    }
-    fn mul(self, o: Self) -> Self {
-        self.wrapping_mul(o)
-    }
-    fn xor(self, o: Self) -> Self {
-        self ^ o
-    }
-    fn or(self, o: Self) -> Self {
-        self | o
-    }
-    fn and(self, o: Self) -> Self {
-        self & o
-    }
-    fn shr(self, s: u32) -> Self {
-        self >> s
-    }
-    fn shl(self, s: u32) -> Self {
-        self << s
-    }
-    fn map(self, f: impl Fn(u32) -> u32) -> Self {
-        f(self)
-    }
-    fn unit24(self) -> f32 {
-        self as f32 * INV_2_24
-    }
-}
-
-impl Words for U8 {
-    type F = F8;
-    #[inline]
-    fn splat(x: u32) -> Self {
-        U8::splat(x)
-    }
-    #[inline]
-    fn add(self, o: Self) -> Self {
-        self + o
-    }
-    #[inline]
-    fn mul(self, o: Self) -> Self {
-        self * o
-    }
-    #[inline]
-    fn xor(self, o: Self) -> Self {
-        self ^ o
-    }
-    #[inline]
-    fn or(self, o: Self) -> Self {
-        self | o
-    }
-    #[inline]
-    fn and(self, o: Self) -> Self {
-        self & o
-    }
-    #[inline]
-    fn shr(self, s: u32) -> Self {
-        self >> s
-    }
-    #[inline]
-    fn shl(self, s: u32) -> Self {
-        self << s
-    }
-    #[inline]
-    fn map(self, f: impl Fn(u32) -> u32) -> Self {
-        U8::new(self.to_array().map(f))
-    }
-    #[inline]
-    fn unit24(self) -> F8 {
-        // Lanes are < 2^24: the signed conversion is exact, the scaling by 2^-24 too.
-        F8::from_i32x8(wide::bytemuck::cast::<U8, i32x8>(self)) * F8::splat(INV_2_24)
-    }
-}
+/// The sampler module's lane abstraction (`u32` or [`U8`]), so that scalar and x8 run the same
+/// integer operations as the other generators.
+pub(super) use super::Lanes as Words;
 
 /// murmur3 `fmix32` finalizer (public domain): a bijection of u32 with full avalanche.
 #[inline]
