@@ -38,6 +38,8 @@ pub struct RenderOptions {
     pub stats: Option<PathBuf>,
     /// integrator override
     pub integrator: Option<IntegratorKind>,
+    /// print progress (spp done, Mrays/s, ETA) on stderr while rendering
+    pub progress: bool,
 }
 
 /// Everything a render produced.
@@ -98,15 +100,10 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
 /// Parses, checks and builds the scene and the integrator of `opts`.
 pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     let desc = load_scene(opts)?;
+    // Every integrator of the format is implemented (raytracer, analyticdirect, direct,
+    // pathtracer); a new kind must be handled here and in `Integrator::radiance_tile`.
     match desc.integrator {
-        IntegratorKind::AnalyticDirect | IntegratorKind::Direct | IntegratorKind::PathTracer => {}
-        k => {
-            return Err(format!(
-                "{}: integrator `{}` is not implemented yet (this build renders analyticdirect, direct and pathtracer)",
-                desc.source.display(),
-                integrator_name(k)
-            ))
-        }
+        IntegratorKind::RayTracer | IntegratorKind::AnalyticDirect | IntegratorKind::Direct | IntegratorKind::PathTracer => {}
     }
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
@@ -120,8 +117,49 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
     let spp = integrator.spp;
     let pool = render::thread_pool(opts.threads).map_err(|e| e.to_string())?;
     let mut film = Film::new(scene.desc.width, scene.desc.height);
-    let stats = render::render(&scene, &integrator, &mut film, 0..spp, &pool);
+    let stats = render_passes(&scene, &integrator, &mut film, 0..spp, &pool, opts.progress);
     Ok(RenderOutput { scene, integrator, film, stats, out: None })
+}
+
+/// Renders `samples` in passes (about 1% of the samples each, at least one), so that progress can
+/// be shown; the image is bit-identical to one pass (running sums continue across passes).
+pub fn render_passes(
+    scene: &Scene,
+    integ: &Integrator,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+    pool: &rayon::ThreadPool,
+    progress: bool,
+) -> RenderStats {
+    let total = samples.len() as u32;
+    let pass = (total / 100).max(render::SAMPLE_BATCH).max(1);
+    let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
+    let is_tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let mut last_line = std::time::Instant::now();
+    let mut s = samples.start;
+    while s < samples.end {
+        let e = samples.end.min(s + pass);
+        let st = render::render(scene, integ, film, s..e, pool);
+        stats.seconds += st.seconds;
+        stats.counters.merge(&st.counters);
+        s = e;
+        if progress {
+            let done = s - samples.start;
+            let eta = stats.seconds / f64::from(done) * f64::from(total - done);
+            let line = format!("{done}/{total} spp, {:.2} Mrays/s, ETA {eta:.1} s", stats.mrays_per_sec());
+            if is_tty {
+                let bar = (40 * done / total.max(1)) as usize;
+                eprint!("\r[{}{}] {line}   ", "#".repeat(bar), ".".repeat(40 - bar));
+            } else if last_line.elapsed().as_secs_f64() > 5.0 || done == total {
+                eprintln!("strata: {line}");
+                last_line = std::time::Instant::now();
+            }
+        }
+    }
+    if progress && is_tty {
+        eprintln!();
+    }
+    stats
 }
 
 /// Output stem: `-o OUT`, else the scene's `output` file name without extension (directories

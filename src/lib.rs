@@ -4,6 +4,7 @@ pub mod app;
 pub mod bsdf;
 pub mod film;
 pub mod integrator;
+pub mod lab;
 pub mod light;
 pub mod measure;
 pub mod render;

@@ -17,6 +17,40 @@ struct Cli {
 enum Cmd {
     /// Render a CSE168 .test scene (or the built-in Cornell box) to OUT.exr and OUT.png.
     Render(RenderArgs),
+    /// Render a high-spp reference: linear EXR with a per-pixel variance layer (and a PNG), with
+    /// progress and ETA. Same flags as `render`; give --spp and -o.
+    Reference(RenderArgs),
+    /// Compare sampling techniques against a reference: K independent runs per variant at equal spp
+    /// (--spp-ladder) or equal time (--budget); writes rows.csv, rows.json, table.md, error.svg.
+    Compare {
+        /// Scene file (.test); omitted: the built-in Cornell box.
+        scene: Option<PathBuf>,
+        /// Reference EXR (from `strata reference`), same size as the renders.
+        #[arg(long)]
+        reference: PathBuf,
+        /// NAME=OPTIONS, OPTIONS being render flags, e.g. strat=--light-sampler=stratified
+        /// (several flags separated by spaces). Repeat for each variant.
+        #[arg(long = "variant", required = true)]
+        variants: Vec<String>,
+        /// Independent runs per variant (seeds differ), at least 2.
+        #[arg(long, default_value_t = 4)]
+        runs: usize,
+        /// Equal time: seconds per run (passes of one sample until spent).
+        #[arg(long, conflicts_with = "spp_ladder")]
+        budget: Option<f64>,
+        /// Equal spp: comma-separated spp values, e.g. 1,2,4,8.
+        #[arg(long, value_delimiter = ',')]
+        spp_ladder: Option<Vec<u32>>,
+        /// Image size WxH for every variant (must match the reference).
+        #[arg(long, value_parser = parse_size)]
+        size: Option<(u32, u32)>,
+        /// Worker threads (0 = all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Output folder.
+        #[arg(long, default_value = "compare")]
+        out: PathBuf,
+    },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
         #[command(flatten)]
@@ -53,7 +87,7 @@ struct RenderArgs {
     /// --spp 1 puts the sample at the pixel centre).
     #[arg(long, value_parser = parse_sampler)]
     pixel_sampler: Option<SamplerKind>,
-    /// Integrator override: analyticdirect, direct, pathtracer (raytracer is not implemented yet).
+    /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
     #[arg(long, value_parser = parse_integrator)]
     integrator: Option<strata::scene::desc::IntegratorKind>,
     /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
@@ -81,6 +115,7 @@ impl RenderArgs {
             out: self.out,
             stats: self.stats,
             integrator: self.integrator,
+            progress: !self.quiet,
         }
     }
 }
@@ -102,13 +137,16 @@ fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, Stri
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.cmd {
-        Cmd::Render(args) => {
+        Cmd::Render(args) | Cmd::Reference(args) => {
             let quiet = args.quiet;
             app::run_render(&args.options()).map(|o| {
                 if !quiet {
                     println!("{}", app::summary(&o));
                 }
             })
+        }
+        Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
+            run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
         }
         Cmd::Rays { args, json } => app::run_rays(&args.options()).map(|(rates, name)| {
             if json {
@@ -125,4 +163,45 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_compare(
+    scene: Option<PathBuf>,
+    reference: &std::path::Path,
+    specs: &[String],
+    runs: usize,
+    budget: Option<f64>,
+    ladder: Option<Vec<u32>>,
+    size: Option<(u32, u32)>,
+    threads: usize,
+    out: &std::path::Path,
+) -> Result<(), String> {
+    let mut variants = Vec::new();
+    for spec in specs {
+        let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
+        let mut argv = vec!["strata".to_string(), "render".to_string()];
+        argv.extend(scene.iter().map(|p| p.display().to_string()));
+        argv.extend(flags.split_whitespace().map(str::to_string));
+        let cli = Cli::try_parse_from(&argv).map_err(|e| format!("--variant {name}: {}", e.to_string().lines().next().unwrap_or("")))?;
+        let Cmd::Render(args) = cli.cmd else { unreachable!("parsed as render") };
+        let mut opts = args.options();
+        opts.size = size.or(opts.size);
+        opts.threads = threads;
+        opts.progress = false;
+        variants.push(strata::lab::Variant { name: name.to_string(), opts });
+    }
+    let mode = match (budget, ladder) {
+        (Some(b), _) if b > 0.0 && b.is_finite() => strata::lab::Mode::Budget(b),
+        (Some(b), _) => return Err(format!("--budget {b}: expected a positive number of seconds")),
+        (None, Some(l)) if !l.is_empty() && l.iter().all(|&s| s > 0) => strata::lab::Mode::Ladder(l),
+        (None, Some(_)) => return Err("--spp-ladder: expected positive spp values".into()),
+        (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
+    };
+    let rows = strata::lab::compare(&variants, reference, runs, &mode)?;
+    let title = format!("{} vs {}", scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()), reference.display());
+    let md = strata::lab::write_outputs(&rows, out, &title)?;
+    println!("{md}");
+    println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", out.display());
+    Ok(())
 }

@@ -89,12 +89,14 @@ pub fn render(
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     let start = Instant::now();
+    let film_in: &Film = film;
     let results: Vec<(TileResult, Counters)> = pool.install(|| {
         tiles
             .par_iter()
             .map_init(Scratch::default, |scratch, &(tx, ty)| {
                 let mut counters = Counters::default();
-                let r = render_tile(scene, integrator, tx * TILE, ty * TILE, w, h, samples.clone(), scratch, &mut counters);
+                let mut r = TileResult::from_film(film_in, tx * TILE, ty * TILE);
+                render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
                 (r, counters)
             })
             .collect()
@@ -103,7 +105,7 @@ pub fn render(
     let mut counters = Counters::default();
     for (tile, c) in &results {
         counters.merge(c);
-        tile.add_to(film);
+        tile.store(film);
     }
     RenderStats { seconds, counters, threads: pool.current_num_threads() }
 }
@@ -120,15 +122,31 @@ struct TileResult {
 }
 
 impl TileResult {
-    fn add_to(&self, film: &mut Film) {
+    /// The film's current sums for the tile at (x0, y0): samples continue the same running sums,
+    /// so an image is bit-identical however its samples are split into passes.
+    fn from_film(film: &Film, x0: u32, y0: u32) -> Self {
+        let (tw, th) = (TILE.min(film.width - x0), TILE.min(film.height - y0));
+        let idx = |tx: u32, ty: u32| ((y0 + ty) * film.width + x0 + tx) as usize;
+        let cells = || (0..th).flat_map(move |ty| (0..tw).map(move |tx| (tx, ty)));
+        Self {
+            x0,
+            y0,
+            tw,
+            th,
+            sum: cells().map(|(x, y)| film.sum[idx(x, y)]).collect(),
+            sum_sq: cells().map(|(x, y)| film.sum_sq[idx(x, y)]).collect(),
+            count: 0,
+        }
+    }
+
+    /// Writes the running sums back and adds the samples taken.
+    fn store(&self, film: &mut Film) {
         for ty in 0..self.th {
             for tx in 0..self.tw {
                 let i = (ty * self.tw + tx) as usize;
                 let j = ((self.y0 + ty) * film.width + self.x0 + tx) as usize;
-                for c in 0..3 {
-                    film.sum[j][c] += self.sum[i][c];
-                    film.sum_sq[j][c] += self.sum_sq[i][c];
-                }
+                film.sum[j] = self.sum[i];
+                film.sum_sq[j] = self.sum_sq[i];
                 film.count[j] += self.count;
             }
         }
@@ -139,19 +157,13 @@ impl TileResult {
 fn render_tile(
     scene: &Scene,
     integrator: &Integrator,
-    x0: u32,
-    y0: u32,
-    w: u32,
-    h: u32,
+    tile: &mut TileResult,
     samples: std::ops::Range<u32>,
     scratch: &mut Scratch,
     counters: &mut Counters,
-) -> TileResult {
-    let tw = TILE.min(w - x0);
-    let th = TILE.min(h - y0);
-    let n = (tw * th) as usize;
-    let mut sum = vec![[0f64; 3]; n];
-    let mut sum_sq = vec![[0f64; 3]; n];
+) {
+    let (x0, y0, tw, th) = (tile.x0, tile.y0, tile.tw, tile.th);
+    let (w, h) = (scene.desc.width, scene.desc.height);
     let packets = tile_packets(x0, y0, tw, th, w, h);
     let mut radiance = Vec::with_capacity(packets.len() * SAMPLE_BATCH as usize);
     let mut start = samples.start;
@@ -162,12 +174,12 @@ fn render_tile(
         integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None);
         for per_sample in radiance.chunks_exact(packets.len()) {
             for (pk, l) in packets.iter().zip(per_sample) {
-                accumulate(&mut sum, &mut sum_sq, pk, x0, y0, tw, l, counters);
+                accumulate(&mut tile.sum, &mut tile.sum_sq, pk, x0, y0, tw, l, counters);
             }
         }
         start = batch.end;
     }
-    TileResult { x0, y0, tw, th, sum, sum_sq, count: samples.len() as u32 }
+    tile.count += samples.len() as u32;
 }
 
 /// Adds one sample per active lane; a non-finite lane value is counted and replaced by zero so

@@ -82,3 +82,40 @@ fn rays_reports_renderer_next_to_embree() {
     }
     assert_eq!(j["camera_rays"], 48 * 48);
 }
+
+#[test]
+fn reference_then_compare_writes_tables_and_plot() {
+    let d = tmpdir("compare");
+    let reference = d.join("ref");
+    let r = strata().args(["reference", "--size", "32x24", "--spp", "16", "-q", "-o"]).arg(&reference).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let img = strata::film::read_exr(&d.join("ref.exr")).unwrap();
+    assert!(img.variance.is_some(), "a reference carries its variance layer");
+    let out = d.join("cmp");
+    let r = strata()
+        .args(["compare", "--size", "32x24", "--runs", "2", "--spp-ladder", "1,2"])
+        .arg("--reference")
+        .arg(d.join("ref.exr"))
+        .args(["--variant", "random=--light-sampler=independent", "--variant", "strat=--light-sampler=stratified --light-samples 4"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let csv = std::fs::read_to_string(out.join("rows.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 4, "header + 2 variants x 2 ladder steps:\n{csv}");
+    let svg = std::fs::read_to_string(out.join("error.svg")).unwrap();
+    assert!(svg.matches("<polyline").count() >= 3, "two series and the guide");
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("rows.json")).unwrap()).unwrap();
+    assert!(j.as_array().unwrap().iter().all(|r| r["mse"].as_f64().unwrap() > 0.0));
+    // Bad variant options are a clear error.
+    let r = strata()
+        .args(["compare", "--runs", "2", "--spp-ladder", "1", "--reference"])
+        .arg(d.join("ref.exr"))
+        .args(["--variant", "x=--no-such-flag"])
+        .output()
+        .unwrap();
+    assert!(!r.status.success());
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--variant x"));
+    std::fs::remove_dir_all(&d).ok();
+}

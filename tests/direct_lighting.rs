@@ -207,3 +207,20 @@ fn every_hw2_scene_renders() {
         assert_eq!(out.stats.counters.camera, 64 * 48, "{name}: one camera ray per pixel");
     }
 }
+
+/// Rendering in passes continues the same per-pixel running sums: 0..3 then 3..7 gives the very
+/// bits of 0..7 (progressive rendering and, later, resume depend on it).
+#[test]
+fn passes_are_bit_identical_to_one_render() {
+    let o = strata::app::RenderOptions { size: Some((40, 24)), spp: Some(7), seed: 5, threads: 2, ..Default::default() };
+    let (scene, integ) = strata::app::prepare(&o).unwrap();
+    let pool = strata::render::thread_pool(2).unwrap();
+    let mut one = strata::film::Film::new(40, 24);
+    strata::render::render(&scene, &integ, &mut one, 0..7, &pool);
+    let mut parts = strata::film::Film::new(40, 24);
+    strata::render::render(&scene, &integ, &mut parts, 0..3, &pool);
+    strata::render::render(&scene, &integ, &mut parts, 3..7, &pool);
+    assert_eq!(one.count, parts.count);
+    let bits = |f: &strata::film::Film| f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&one), bits(&parts));
+}

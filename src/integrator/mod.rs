@@ -17,6 +17,7 @@ use serde::Serialize;
 use std::f32::consts::PI;
 
 mod path;
+mod whitted;
 pub use path::{PathScratch, DIM_PATH_BASE};
 
 /// Sampler dimension of the camera (pixel) jitter.
@@ -173,6 +174,26 @@ impl Integrator {
         }
     }
 
+    /// The same integrator for `spp` samples per pixel: the per-pixel layouts (pixel jitter, path
+    /// dimensions) are rebuilt for that count. `None` (an spp not known in advance, as in
+    /// equal-time runs) makes them independent, since a stratified layout needs its count.
+    pub fn resampled(&self, spp: Option<u32>) -> Self {
+        let mut it = self.clone();
+        match spp {
+            Some(n) => {
+                it.spp = n.max(1);
+                it.pixel_set = PointSet::new(self.pixel_set.kind(), it.spp);
+                it.path_set = PointSet::new(self.path_set.kind(), it.spp);
+            }
+            None => {
+                it.spp = u32::MAX;
+                it.pixel_set = PointSet::new(SamplerKind::Independent, 1);
+                it.path_set = PointSet::new(SamplerKind::Independent, 1);
+            }
+        }
+        it
+    }
+
     /// Camera rays of packet `pk` for pixel sample `s`: origins and unit directions.
     #[inline]
     pub fn camera_rays(&self, scene: &Scene, pk: &PixelPacket, s: u32) -> (Vec3x8, Vec3x8) {
@@ -252,6 +273,11 @@ impl Integrator {
             IntegratorKind::AnalyticDirect => {
                 for (o, sh) in out.iter_mut().zip(&sc.hits) {
                     *o += analytic_direct(scene, sh);
+                }
+            }
+            IntegratorKind::RayTracer => {
+                for (o, sh) in out.iter_mut().zip(&sc.hits) {
+                    *o += whitted::radiance(scene, self.max_depth, sh, c, log.as_deref_mut());
                 }
             }
             _ => self.direct_tile(scene, pks, s, out, sc, c, log),

@@ -114,6 +114,8 @@ pub struct SurfaceHit8 {
     pub ggx: Mask8,
     /// radiance emitted towards wo by the material (`emission`, every hit, any side)
     pub emitted: Vec3x8,
+    /// ambient term of the material (`raytracer` only; zero on lights and misses)
+    pub ambient: Vec3x8,
     /// radiance emitted towards wo by a quad light (its radiance on its emitting side, else 0)
     pub le: Vec3x8,
     /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
@@ -297,6 +299,7 @@ impl Scene {
         let mut kd = [Vec3::ZERO; 8];
         let mut ks = [Vec3::ZERO; 8];
         let mut emitted = [Vec3::ZERO; 8];
+        let mut ambient = [Vec3::ZERO; 8];
         let mut le = [Vec3::ZERO; 8];
         let mut shin = [0f32; 8];
         let mut rough = [1f32; 8];
@@ -336,6 +339,7 @@ impl Scene {
             rough[i] = m.roughness;
             ggx[i] = m.brdf == BrdfKind::Ggx;
             emitted[i] += m.emission;
+            ambient[i] = m.ambient;
         }
         SurfaceHit8 {
             valid: hits.hit,
@@ -348,6 +352,7 @@ impl Scene {
             roughness: F8::new(rough),
             ggx: crate::simd::mask_from_bools(ggx),
             emitted: Vec3x8::from_lanes(emitted),
+            ambient: Vec3x8::from_lanes(ambient),
             le: Vec3x8::from_lanes(le),
             light: U8::new(light),
         }

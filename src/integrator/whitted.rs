@@ -1,0 +1,113 @@
+//! `raytracer` (hw1): Whitted ray tracing with point and directional lights.
+//!
+//! At every hit: ambient + emission + sum over lights of
+//! V * (kd max(n.l, 0) + ks max(n.h, 0)^s) * colour (/ (c0 + c1 d + c2 d^2) for point lights),
+//! h = normalize(l + wo), V from a shadow ray; plus ks times the radiance along the mirror
+//! direction r = 2 (n.wo) n - wo. The term is not gated on n.l (the format's formula as stated).
+//! `maxdepth` is the maximum number of mirror bounces after the camera hit (negative: 64).
+//! Quad lights, if any, are visible emitters only (`le`). Packets keep dead lanes masked.
+
+use super::{masked, Counters, RayKind, RayLog};
+use crate::accel::{Hits8, Ray8, RayHit8};
+use crate::scene::build::{Scene, SurfaceHit8};
+use crate::simd::{Mask8, Vec3x8, F8};
+
+/// Mirror bounces when `maxdepth` is negative (unbounded is not meaningful without roulette).
+const UNBOUNDED_DEPTH: i32 = 64;
+
+/// Radiance added to the camera hit `sh0` (its emission `emitted + le` is already counted by the
+/// caller): local shading of the camera hit and every mirror bounce, weighted by the product of ks.
+pub(super) fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, c: &mut Counters, mut log: Option<&mut RayLog>) -> Vec3x8 {
+    let bounces = if max_depth < 0 { UNBOUNDED_DEPTH } else { max_depth };
+    let mut l_out = Vec3x8::ZERO;
+    let mut sh = *sh0;
+    let mut alive = sh.valid;
+    let mut weight = Vec3x8::splat(glam::Vec3::ONE);
+    let mut depth = 0;
+    loop {
+        if alive.none() {
+            break;
+        }
+        let mut local = local_shading(scene, &sh, alive, c, log.as_deref_mut());
+        if depth > 0 {
+            local += sh.emitted + sh.le;
+        }
+        l_out += masked(weight.mul_elem(local), alive);
+        if depth >= bounces {
+            break;
+        }
+        weight = weight.mul_elem(sh.ks);
+        alive &= weight.max_elem().simd_gt(F8::ZERO);
+        if alive.none() {
+            break;
+        }
+        // Mirror ray from the offset hit point.
+        let r = sh.n.scale(F8::splat(2.0) * sh.n.dot(sh.wo)) - sh.wo;
+        let org = sh.n.mul_add(scene.offset_eps(sh.p), sh.p);
+        let mut rh = RayHit8::default();
+        let active = rh.ray.set(org, r, F8::ZERO, F8::splat(f32::INFINITY), alive);
+        if let Some(l) = log.as_deref_mut() {
+            l.bounce.push((rh, active));
+        }
+        let traced = scene.accel.intersect8(&mut rh, false, active);
+        c.packet(RayKind::Bounce, traced);
+        let dir = Vec3x8::new(F8::new(rh.ray.dir_x), F8::new(rh.ray.dir_y), F8::new(rh.ray.dir_z));
+        let org = Vec3x8::new(F8::new(rh.ray.org_x), F8::new(rh.ray.org_y), F8::new(rh.ray.org_z));
+        sh = scene.gather(org, dir, &Hits8::from_rayhit(&rh, traced));
+        alive &= sh.valid;
+        depth += 1;
+    }
+    l_out
+}
+
+/// Ambient + Blinn-Phong from every point and directional light with shadow rays, on `alive` lanes
+/// (emission excluded); zero elsewhere.
+fn local_shading(scene: &Scene, sh: &SurfaceHit8, alive: Mask8, c: &mut Counters, mut log: Option<&mut RayLog>) -> Vec3x8 {
+    let mut acc = masked(sh.ambient, alive);
+    let eps = scene.offset_eps(sh.p);
+    let o = sh.n.mul_add(eps, sh.p);
+    let mut shade = |wi: Vec3x8, to: Vec3x8, tfar: F8, colour: Vec3x8, c: &mut Counters, log: Option<&mut RayLog>| {
+        let f = blinn_phong(sh, wi, alive);
+        let lit = alive & f.max_elem().simd_gt(F8::ZERO);
+        if lit.none() {
+            return;
+        }
+        let (mut ray, lit) = Ray8::new(o, to, F8::ZERO, tfar, lit);
+        if let Some(l) = log {
+            l.shadow.push((ray, lit));
+        }
+        let occluded = scene.accel.occluded8(&mut ray, lit);
+        c.packet(RayKind::Shadow, lit);
+        acc += masked(f.mul_elem(colour), lit & !occluded);
+    };
+    for pl in &scene.desc.point_lights {
+        let pos = Vec3x8::splat(pl.position);
+        let to_p = pos - sh.p;
+        let d = to_p.length();
+        let wi = to_p.normalize_or_zero();
+        let att = pl.attenuation;
+        let denom = F8::splat(att.z).mul_add(d * d, F8::splat(att.y).mul_add(d, F8::splat(att.x)));
+        let colour = Vec3x8::splat(pl.color).scale(F8::ONE / denom);
+        // Shadow ray from the offset point to the light, stopping just short of it.
+        let inv_d = alive.select(F8::ONE / d, F8::ZERO);
+        let tfar = F8::ONE - eps * inv_d;
+        shade(wi, pos - o, tfar, colour, c, log.as_deref_mut());
+    }
+    for dl in &scene.desc.directional_lights {
+        let wi = Vec3x8::splat(dl.direction.normalize_or_zero());
+        shade(wi, wi, F8::splat(f32::INFINITY), Vec3x8::splat(dl.color), c, log.as_deref_mut());
+    }
+    acc
+}
+
+/// kd max(n.l, 0) + ks max(n.h, 0)^s with h = normalize(l + wo); zero on inactive lanes.
+#[inline]
+fn blinn_phong(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
+    let cos_l = sh.n.dot(wi).max(F8::ZERO);
+    let h = (wi + sh.wo).normalize_or_zero();
+    let nh = sh.n.dot(h);
+    let has_spec = nh.simd_gt(F8::ZERO);
+    // x^s = exp(s ln x), only where x > 0.
+    let pow = has_spec.select((sh.shininess * has_spec.select(nh, F8::ONE).ln()).exp(), F8::ZERO);
+    masked(sh.kd.scale(cos_l) + sh.ks.scale(pow), active)
+}

@@ -1,0 +1,106 @@
+//! `strata compare`: sampling techniques against a reference, K independent runs per variant, at
+//! equal spp (a ladder) or equal time (a budget); writes CSV, JSON, a Markdown table and a
+//! log-log plot of RMSE against seconds.
+
+use crate::app::{self, RenderOptions};
+use crate::film::{self, Film};
+use crate::render;
+use crate::report::{self, Row, RunStats, Series};
+use std::path::{Path, PathBuf};
+
+/// One technique: a name and the render options that define it.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// label in tables and plots
+    pub name: String,
+    /// render options (scene, samplers, ...); seed and spp are set per run
+    pub opts: RenderOptions,
+}
+
+/// Equal-spp ladder or equal-time budget.
+#[derive(Clone, Debug)]
+pub enum Mode {
+    /// render each run at each of these spp
+    Ladder(Vec<u32>),
+    /// render each run in passes until this many seconds are spent
+    Budget(f64),
+}
+
+/// Runs every variant `runs` times (seeds 1..=runs, independent streams) under `mode`, compares
+/// with the reference image and returns one row per (variant, ladder step).
+pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, String> {
+    let img = film::read_exr(reference).map_err(|e| format!("{}: {e}", reference.display()))?;
+    if runs < 2 {
+        return Err("--runs must be at least 2 (bias and variance need independent runs)".into());
+    }
+    let mut rows = Vec::new();
+    for v in variants {
+        let (scene, integ) = app::prepare(&v.opts)?;
+        if (scene.desc.width, scene.desc.height) != (img.width, img.height) {
+            return Err(format!(
+                "variant {}: image {}x{} but the reference is {}x{} (use --size)",
+                v.name, scene.desc.width, scene.desc.height, img.width, img.height
+            ));
+        }
+        let pool = render::thread_pool(v.opts.threads).map_err(|e| e.to_string())?;
+        let steps: Vec<Option<u32>> = match mode {
+            Mode::Ladder(l) => l.iter().map(|&s| Some(s)).collect(),
+            Mode::Budget(_) => vec![None],
+        };
+        for step in steps {
+            let (mut images, mut secs, mut spps) = (Vec::new(), 0.0, 0.0);
+            for run in 0..runs {
+                let mut it = integ.clone();
+                it.seed = v.opts.seed.wrapping_add(1 + run as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                let mut film = Film::new(img.width, img.height);
+                let (seconds, spp) = match (step, mode) {
+                    (Some(spp), _) => {
+                        it = it.resampled(Some(spp));
+                        let st = render::render(&scene, &it, &mut film, 0..spp, &pool);
+                        (st.seconds, spp)
+                    }
+                    (None, Mode::Budget(b)) => {
+                        // Equal time: whole passes of one sample until the budget is spent. The
+                        // pixel layout assumes an spp it cannot know in advance: independent.
+                        it = it.resampled(None);
+                        let (mut t, mut s) = (0.0, 0u32);
+                        while t < *b {
+                            t += render::render(&scene, &it, &mut film, s..s + 1, &pool).seconds;
+                            s += 1;
+                        }
+                        (t, s)
+                    }
+                    (None, Mode::Ladder(_)) => unreachable!("ladder steps are Some"),
+                };
+                secs += seconds;
+                spps += f64::from(spp);
+                images.push(film.mean());
+            }
+            let stats = RunStats::from_runs(&images, &img.rgb).map_err(|e| format!("variant {}: {e}", v.name))?;
+            rows.push(Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats).map_err(|e| e.to_string())?);
+        }
+    }
+    Ok(rows)
+}
+
+/// Writes rows.csv, rows.json, table.md and error.svg (RMSE against seconds, slope -1/2 guide)
+/// into `dir`; returns the Markdown table.
+pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let md = report::to_markdown(rows);
+    let json = serde_json::to_string_pretty(&report::to_json(rows)).map_err(|e| e.to_string())?;
+    let mut series: Vec<Series> = Vec::new();
+    for r in rows {
+        let p = (r.seconds, r.mse.sqrt());
+        match series.iter_mut().find(|s| s.name == r.variant) {
+            Some(s) => s.points.push(p),
+            None => series.push(Series { name: r.variant.clone(), points: vec![p] }),
+        }
+    }
+    let svg = report::loglog_svg(&series, title, "seconds", "RMSE", report::plot::RMSE_SLOPE);
+    for (name, text) in [("rows.csv", report::to_csv(rows)), ("rows.json", json), ("table.md", md.clone()), ("error.svg", svg)] {
+        let p: PathBuf = dir.join(name);
+        film::write_atomic(&p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
+    }
+    Ok(md)
+}
