@@ -147,7 +147,7 @@ fn build_table(t: u32) -> Vec<[u32; 2]> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::sobol::tests::{assert_net, estimate_stats, exact_integral, fixed, lcg, random_point};
+    use super::super::sobol::tests::{assert_net, assert_x8_matches_scalar, estimate_stats, exact_integral, fixed, random_point};
     use super::*;
 
     fn table_point(t: u32, i: u32) -> [f32; 2] {
@@ -236,28 +236,7 @@ mod tests {
 
     #[test]
     fn scalar_and_x8_agree_bit_for_bit() {
-        let mut st = 9u64;
-        for round in 0..4000 {
-            let pick = |st: &mut u64| match lcg(st) % 4 {
-                0 => lcg(st) % 8,
-                1 => u32::MAX - lcg(st) % 8,
-                _ => lcg(st),
-            };
-            let (px, sa, kk): ([u32; 8], [u32; 8], [u32; 8]) = (
-                std::array::from_fn(|_| pick(&mut st)),
-                std::array::from_fn(|_| pick(&mut st)),
-                std::array::from_fn(|_| pick(&mut st)),
-            );
-            let (dim, n) = (pick(&mut st), if round % 3 == 0 { 0 } else { pick(&mut st) % 300 });
-            let seed = u64::from(lcg(&mut st)) << 32 | u64::from(pick(&mut st));
-            let (x8, y8) = pmj02_2d_x8(U8::new(px), U8::new(sa), dim, U8::new(kk), n, seed);
-            for i in 0..8 {
-                let p = pmj02_2d(px[i], sa[i], dim, kk[i], n, seed);
-                assert_eq!([x8.to_array()[i].to_bits(), y8.to_array()[i].to_bits()], p.map(f32::to_bits));
-                fixed(p[0]);
-                fixed(p[1]);
-            }
-        }
+        assert_x8_matches_scalar(pmj02_2d, pmj02_2d_x8, 9);
     }
 
     #[test]

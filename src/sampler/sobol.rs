@@ -117,13 +117,8 @@ fn reverse_bits<L: Words>(x: L) -> L {
 /// integer operations as the other generators.
 pub(super) use super::Lanes as Words;
 
-/// murmur3 `fmix32` finalizer (public domain): a bijection of u32 with full avalanche.
-#[inline]
-pub(super) fn fmix<L: Words>(h: L) -> L {
-    let h = h.xor(h.shr(16)).mul(L::splat(0x85eb_ca6b));
-    let h = h.xor(h.shr(13)).mul(L::splat(0xc2b2_ae35));
-    h.xor(h.shr(16))
-}
+/// The sampler module's murmur3 `fmix32` finalizer.
+pub(super) use super::fmix;
 
 /// Folds word `w` into hash state `h`; a bijection in each argument when the other is fixed.
 #[inline]
@@ -291,9 +286,12 @@ pub(super) mod tests {
         }
     }
 
-    #[test]
-    fn scalar_and_x8_agree_bit_for_bit() {
-        let mut st = 5u64;
+    /// A 2D generator's x8 and scalar forms agree bit for bit over random and extreme inputs.
+    pub(in crate::sampler) fn assert_x8_matches_scalar(
+        scalar: fn(u32, u32, u32, u32, u32, u64) -> [f32; 2],
+        x8: fn(U8, U8, u32, U8, u32, u64) -> (F8, F8),
+        mut st: u64,
+    ) {
         for round in 0..4000 {
             let pick = |st: &mut u64| match lcg(st) % 4 {
                 0 => lcg(st) % 8,
@@ -307,14 +305,19 @@ pub(super) mod tests {
             );
             let (dim, n) = (pick(&mut st), if round % 3 == 0 { 0 } else { pick(&mut st) % 300 });
             let seed = u64::from(lcg(&mut st)) << 32 | u64::from(pick(&mut st));
-            let (x8, y8) = sobol_owen_2d_x8(U8::new(px), U8::new(sa), dim, U8::new(kk), n, seed);
+            let (xs, ys) = x8(U8::new(px), U8::new(sa), dim, U8::new(kk), n, seed);
             for i in 0..8 {
-                let p = sobol_owen_2d(px[i], sa[i], dim, kk[i], n, seed);
-                assert_eq!([x8.to_array()[i].to_bits(), y8.to_array()[i].to_bits()], p.map(f32::to_bits));
+                let p = scalar(px[i], sa[i], dim, kk[i], n, seed);
+                assert_eq!([xs.to_array()[i].to_bits(), ys.to_array()[i].to_bits()], p.map(f32::to_bits));
                 fixed(p[0]);
                 fixed(p[1]);
             }
         }
+    }
+
+    #[test]
+    fn scalar_and_x8_agree_bit_for_bit() {
+        assert_x8_matches_scalar(sobol_owen_2d, sobol_owen_2d_x8, 5);
     }
 
     #[test]
