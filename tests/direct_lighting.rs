@@ -5,26 +5,10 @@
 mod common;
 
 use common::*;
-use glam::DVec3;
 use strata::sampler::SamplerKind;
 use strata::scene::desc::IntegratorKind;
 use strata::scene::parse::{parse_file, Limits};
 
-/// Ray-triangle distance (Moller-Trumbore in f64), if hit in front.
-fn hit_triangle(o: DVec3, d: DVec3, v: [DVec3; 3]) -> Option<f64> {
-    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-14 {
-        return None;
-    }
-    let t0 = o - v[0];
-    let u = t0.dot(p) / det;
-    let q = t0.cross(e1);
-    let w = d.dot(q) / det;
-    let t = e2.dot(q) / det;
-    (u >= 0.0 && w >= 0.0 && u + w <= 1.0 && t > 1e-9).then_some(t)
-}
 
 /// `analyticdirect` on hw2/analytic.test at pixel centres against an evaluation written here from
 /// the format's definitions: our own camera rays and ray-triangle hits, and the irradiance as a

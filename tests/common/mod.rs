@@ -45,3 +45,19 @@ pub fn var_of_mean(f: &Film) -> Vec<[f64; 3]> {
         })
         .collect()
 }
+
+/// Ray-triangle distance (Moller-Trumbore in f64), if hit in front: the tests' independent tracer.
+pub fn hit_triangle(o: glam::DVec3, d: glam::DVec3, v: [glam::DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-14 {
+        return None;
+    }
+    let t0 = o - v[0];
+    let u = t0.dot(p) / det;
+    let q = t0.cross(e1);
+    let w = d.dot(q) / det;
+    let t = e2.dot(q) / det;
+    (u >= 0.0 && w >= 0.0 && u + w <= 1.0 && t > 1e-9).then_some(t)
+}
