@@ -641,35 +641,56 @@ unsafe fn soa(base: *mut u32, n: usize, field: usize, lane: usize) -> *mut u32 {
     unsafe { base.add(field * n + lane) }
 }
 
+/// Runs the ellipsoid `prim` against every valid lane of an Embree SoA ray block of width `n` and
+/// calls `on_hit(lane, t)` for each lane it hits inside (tnear, tfar).
+///
+/// # Safety
+/// `valid` must hold `n` ints and `base` point to an RTCRayN (or the ray part of an RTCRayHitN) of
+/// width `n`; `user` must be the Vec<Ellipsoid> set in add_ellipsoids with `prim` < its length.
+unsafe fn each_ellipsoid_hit(
+    valid: *const i32,
+    user: *mut c_void,
+    prim: u32,
+    base: *mut u32,
+    n: usize,
+    mut on_hit: impl FnMut(usize, f32),
+) {
+    // SAFETY: guaranteed by the caller (see the function's contract).
+    unsafe {
+        let prims = &*(user as *const Vec<Ellipsoid>);
+        let e = &prims[prim as usize];
+        let f = |field: usize, lane: usize| f32::from_bits(*soa(base, n, field, lane));
+        for lane in 0..n {
+            if *valid.add(lane) != -1 {
+                continue;
+            }
+            let o = [f(0, lane), f(1, lane), f(2, lane)];
+            let d = [f(4, lane), f(5, lane), f(6, lane)];
+            if let Some(t) = e.hit(o, d, f(3, lane), f(8, lane)) {
+                on_hit(lane, t);
+            }
+        }
+    }
+}
+
 unsafe extern "C" fn ellipsoid_intersect(args: *const sys::RTCIntersectFunctionNArguments) {
     // SAFETY: Embree passes `valid` with N ints, `rayhit` as an RTCRayHitN of width N in the 4.4
     // layout (12 ray fields then 9 hit fields, one instance level), the user pointer set in
     // add_ellipsoids, and primID < the primitive count.
     unsafe {
         let a = &*args;
-        let n = a.N as usize;
-        let prims = &*(a.geometryUserPtr as *const Vec<Ellipsoid>);
-        let e = &prims[a.primID as usize];
-        let base = a.rayhit as *mut u32;
+        let (n, base) = (a.N as usize, a.rayhit as *mut u32);
         let ctx = &*(a.context as *const RayQueryContext);
-        let f = |field: usize, lane: usize| f32::from_bits(*soa(base, n, field, lane));
-        for lane in 0..n {
-            if *a.valid.add(lane) != -1 {
-                continue;
+        each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, t| {
+            *soa(base, n, 8, lane) = t.to_bits();
+            for field in 12..17 {
+                *soa(base, n, field, lane) = 0; // Ng and u, v: strata computes its own normals
             }
-            let o = [f(0, lane), f(1, lane), f(2, lane)];
-            let d = [f(4, lane), f(5, lane), f(6, lane)];
-            if let Some(t) = e.hit(o, d, f(3, lane), f(8, lane)) {
-                *soa(base, n, 8, lane) = t.to_bits();
-                for field in 12..17 {
-                    *soa(base, n, field, lane) = 0; // Ng and u, v: strata computes its own normals
-                }
-                *soa(base, n, 17, lane) = a.primID;
-                *soa(base, n, 18, lane) = a.geomID;
-                *soa(base, n, 19, lane) = ctx.inst_id[0];
-                *soa(base, n, 20, lane) = ctx.inst_prim_id[0];
-            }
-        }
+            *soa(base, n, 17, lane) = a.primID;
+            *soa(base, n, 18, lane) = a.geomID;
+            *soa(base, n, 19, lane) = ctx.inst_id[0];
+            *soa(base, n, 20, lane) = ctx.inst_prim_id[0];
+        });
     }
 }
 
@@ -677,21 +698,10 @@ unsafe extern "C" fn ellipsoid_occluded(args: *const sys::RTCOccludedFunctionNAr
     // SAFETY: as in ellipsoid_intersect, with `ray` an RTCRayN of width N (12 fields).
     unsafe {
         let a = &*args;
-        let n = a.N as usize;
-        let prims = &*(a.geometryUserPtr as *const Vec<Ellipsoid>);
-        let e = &prims[a.primID as usize];
-        let base = a.ray as *mut u32;
-        let f = |field: usize, lane: usize| f32::from_bits(*soa(base, n, field, lane));
-        for lane in 0..n {
-            if *a.valid.add(lane) != -1 {
-                continue;
-            }
-            let o = [f(0, lane), f(1, lane), f(2, lane)];
-            let d = [f(4, lane), f(5, lane), f(6, lane)];
-            if e.hit(o, d, f(3, lane), f(8, lane)).is_some() {
-                *soa(base, n, 8, lane) = f32::NEG_INFINITY.to_bits();
-            }
-        }
+        let (n, base) = (a.N as usize, a.ray as *mut u32);
+        each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, _| {
+            *soa(base, n, 8, lane) = f32::NEG_INFINITY.to_bits();
+        });
     }
 }
 
@@ -741,11 +751,6 @@ impl Hits8 {
 /// Path of the Embree library this binary was linked against (from build.rs).
 pub const EMBREE_LIBDIR: &str = env!("STRATA_EMBREE_LIBDIR");
 
-/// Ray origins/directions helper: sets a whole [`RayHit8`] for `intersect8` from SoA vectors.
-#[inline]
-pub fn set_rayhit(rh: &mut RayHit8, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, active: Mask8) -> Mask8 {
-    rh.ray.set(org, dir, tnear, tfar, active)
-}
 
 #[cfg(test)]
 mod tests {
@@ -795,7 +800,7 @@ mod tests {
         let ys = [0.0, 3.0, 0.0, 3.1, 0.0, 0.05, 0.0, -0.9];
         let (org, dir) = packet(xs, ys);
         let mut c = Canaried { value: RayHit8::default(), canary: [CANARY; 64] };
-        set_rayhit(&mut c.value, org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
+        c.value.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
         let traced = scene.intersect8(&mut c.value, false, mask_all());
         assert!(c.canary.iter().all(|&w| w == CANARY), "Embree wrote past RayHit8");
         let h = Hits8::from_rayhit(&c.value, traced);
@@ -837,7 +842,7 @@ mod tests {
         let (org, dir) = packet(xs, [0.0; 8]);
         let mut rh = RayHit8::default();
         let active = crate::simd::mask_first(6);
-        set_rayhit(&mut rh, org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
+        rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
         // A NaN smuggled in after set() must still be dropped by intersect8.
         rh.ray.org_x[3] = f32::NAN;
         let traced = scene.intersect8(&mut rh, true, active);

@@ -12,7 +12,6 @@ use crate::sampler::{PointSet, SamplerKind, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
-use glam::Vec3;
 use serde::Serialize;
 use std::f32::consts::PI;
 
@@ -413,9 +412,4 @@ fn brdf_eval(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8, any_spec: bool) -> Vec
 #[inline]
 fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
     Vec3x8::new(m.select(v.x, F8::ZERO), m.select(v.y, F8::ZERO), m.select(v.z, F8::ZERO))
-}
-
-/// Scalar radiance of a diffuse point lit by one quad light, exact (for tests and the report).
-pub fn analytic_irradiance_scalar(x: Vec3, n: Vec3, corners: &[Vec3; 4]) -> f32 {
-    crate::light::polygonal::polygon_phi(x, corners).dot(n).max(0.0)
 }

@@ -32,10 +32,6 @@ impl QuadLight {
     pub fn corners(&self) -> [Vec3; 4] {
         [self.a, self.a + self.ab, self.a + self.ab + self.ac, self.a + self.ac]
     }
-    /// Power (radiant flux) per unit radiance scale: pi * area * luminance-free max channel.
-    pub fn power(&self) -> f32 {
-        std::f32::consts::PI * self.area * self.radiance.max_element()
-    }
 }
 
 /// Pinhole camera, look-at, full vertical field of view.

@@ -60,17 +60,6 @@ pub fn and_mask(v: F8, m: Mask8) -> F8 {
     m.select(v, F8::ZERO)
 }
 
-/// Reinterprets u32 lanes as a mask/float bit pattern.
-#[inline]
-pub fn u8_to_bits(v: U8) -> F8 {
-    bytemuck_cast(v)
-}
-
-#[inline]
-fn bytemuck_cast<A: wide::bytemuck::Pod, B: wide::bytemuck::Pod>(a: A) -> B {
-    wide::bytemuck::cast(a)
-}
-
 /// Converts u32 lanes to f32 (exact below 2^24).
 #[inline]
 pub fn u8_to_f8(v: U8) -> F8 {
