@@ -176,6 +176,18 @@ impl Default for RayHit8 {
 }
 
 impl Ray8 {
+    /// The packet's origins, world space (zero in lanes that were inactive when it was set).
+    #[inline]
+    pub fn org(&self) -> Vec3x8 {
+        Vec3x8::new(F8::new(self.org_x), F8::new(self.org_y), F8::new(self.org_z))
+    }
+
+    /// The packet's directions as set, world space (zero in lanes that were inactive).
+    #[inline]
+    pub fn dir(&self) -> Vec3x8 {
+        Vec3x8::new(F8::new(self.dir_x), F8::new(self.dir_y), F8::new(self.dir_z))
+    }
+
     /// Fills the packet from SoA origins/directions and the interval [tnear, tfar]; returns the
     /// lanes that are `active` and finite (NaN must never reach Embree). Inactive lanes get a
     /// harmless ray. Resets mask, id, flags.

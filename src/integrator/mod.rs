@@ -8,7 +8,7 @@
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::light::polygonal::polygon_phi_x8;
 use crate::render::PixelPacket;
-use crate::sampler::{PointSet, SamplerKind, Stream};
+use crate::sampler::{GridTable, PointSet, SamplerKind, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
@@ -135,7 +135,7 @@ pub struct Integrator {
     /// light sample layout (over the light samples of one pixel sample)
     pub light_set: PointSet,
     /// path tracer: layout of every path dimension over the spp samples of a pixel
-    pub path_set: PointSet,
+    pub path_set: GridTable,
     /// path tracer: next event estimation
     pub nee: Nee,
     /// path tracer: Russian roulette
@@ -165,7 +165,7 @@ impl Integrator {
             seed,
             pixel_set: PointSet::new(pixel_sampler.unwrap_or(SamplerKind::Stratified), spp.max(1)),
             light_set: PointSet::new(light_kind, n_light),
-            path_set: PointSet::new(SamplerKind::Stratified, spp.max(1)),
+            path_set: GridTable::new(PointSet::new(SamplerKind::Stratified, spp.max(1))),
             nee: d.nee,
             russian_roulette: d.russian_roulette,
             strategy: d.importance_sampling,
@@ -182,12 +182,12 @@ impl Integrator {
             Some(n) => {
                 it.spp = n.max(1);
                 it.pixel_set = PointSet::new(self.pixel_set.kind(), it.spp);
-                it.path_set = PointSet::new(self.path_set.kind(), it.spp);
+                it.path_set = GridTable::new(PointSet::new(self.path_set.set().kind(), it.spp));
             }
             None => {
                 it.spp = u32::MAX;
                 it.pixel_set = PointSet::new(SamplerKind::Independent, 1);
-                it.path_set = PointSet::new(SamplerKind::Independent, 1);
+                it.path_set = GridTable::new(PointSet::new(SamplerKind::Independent, 1));
             }
         }
         it

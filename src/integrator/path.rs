@@ -18,7 +18,7 @@ use super::{masked, Counters, Integrator, RayKind, RayLog};
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::Material8;
 use crate::render::PixelPacket;
-use crate::sampler::permute;
+use crate::sampler::permute_x8;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
 use crate::scene::desc::Nee;
@@ -78,8 +78,7 @@ impl Integrator {
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
         let n = self.spp;
         let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-        let (ps, ss) = (pixel.to_array(), s.to_array());
-        let k = U8::new(std::array::from_fn(|i| permute(ss[i], n, key_base ^ ps[i].wrapping_mul(0x9e37_79b1))));
+        let k = permute_x8(s, n, U8::splat(key_base) ^ pixel * U8::splat(0x9e37_79b1));
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
     }
 
@@ -143,7 +142,7 @@ impl Integrator {
             sc.shadow_slots.clear();
             for (ci, chunk) in sc.lanes.chunks(8).enumerate() {
                 let (rh, traced) = &sc.rh[ci];
-                let (org, dir, _) = soa_rays(chunk);
+                let (org, dir) = (rh.ray.org(), rh.ray.dir());
                 let sh = scene.gather(org, dir, &Hits8::from_rayhit(rh, *traced));
                 let hit = sh.valid;
                 let beta = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::ZERO, |l| l.beta)));

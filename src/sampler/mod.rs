@@ -135,24 +135,60 @@ pub fn permute(i: u32, n: u32, key: u32) -> u32 {
     if n == 1 {
         return 0;
     }
-    let bits = 32 - (n - 1).leading_zeros();
-    let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
-    let half = (bits / 2).max(1);
+    let (mask, half) = permute_domain(n);
     let key = fmix(key ^ 0x6a09_e667);
     let mut x = i % n;
     loop {
-        // Each step is a bijection of [0, 2^bits): xor with a constant, multiply by an odd
-        // constant mod 2^bits, xorshift right.
-        x ^= key & mask;
-        x = x.wrapping_mul(0x9e37_79b9 | 1) & mask;
-        x ^= x >> half;
-        x = x.wrapping_mul((key | 1).wrapping_mul(0x85eb_ca6b) | 1) & mask;
-        x ^= x >> half;
-        x ^= (key >> 16) & mask;
+        x = permute_round(x, key, mask, half);
         if x < n {
             return x;
         }
     }
+}
+
+/// Eight lanes of [`permute`] with a lane-uniform n and per-lane keys, bit-identical to it per
+/// lane: the rounds run on all lanes until every lane has walked back into 0..n.
+pub fn permute_x8(i: U8, n: u32, key: U8) -> U8 {
+    let n = n.max(1);
+    if n == 1 {
+        return U8::splat(0);
+    }
+    let (mask, half) = permute_domain(n);
+    let key = fmix(key ^ U8::splat(0x6a09_e667));
+    let nn = U8::splat(n);
+    let mut x = Divisor::new(n).rem(i);
+    let mut out = U8::splat(0);
+    let mut done = U8::splat(0);
+    loop {
+        x = permute_round(x, key, mask, half);
+        // First round in range wins: lanes already done keep their value.
+        let inside = x.simd_lt(nn) & !done;
+        out = inside.select(x, out);
+        done |= inside;
+        if done.all() {
+            return out;
+        }
+    }
+}
+
+/// Power-of-two domain of [`permute`] for n >= 2: (mask 2^bits - 1, xorshift amount).
+fn permute_domain(n: u32) -> (u32, u32) {
+    let bits = 32 - (n - 1).leading_zeros();
+    let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
+    (mask, (bits / 2).max(1))
+}
+
+/// One bijective round of [`permute`] on [0, 2^bits): xor with the key, multiply by an odd
+/// constant, xorshift right, multiply by an odd key-dependent constant, xorshift, xor.
+#[inline]
+fn permute_round<L: Lanes>(x: L, key: L, mask: u32, half: u32) -> L {
+    let m = L::splat(mask);
+    let x = x.xor(key.and(m));
+    let x = x.mul(L::splat(0x9e37_79b9 | 1)).and(m);
+    let x = x.xor(x.shr(half));
+    let x = x.mul(key.or(L::splat(1)).mul(L::splat(0x85eb_ca6b)).or(L::splat(1))).and(m);
+    let x = x.xor(x.shr(half));
+    x.xor(key.shr(16).and(m))
 }
 
 /// Grid shape used for n strata: (nx, ny) with nx * ny == n, nx <= ny, nx the largest divisor of n
@@ -279,6 +315,74 @@ impl PointSet {
             Layout::Sobol => L::sobol(pixel, sample, dim, k, self.n, seed),
             Layout::Pmj02 => L::pmj02(pixel, sample, dim, k, self.n, seed),
         }
+    }
+}
+
+/// A [`PointSet`] with every cell's 24-bit span precomputed for grid layouts (stratified and grid
+/// centres) of at most [`GridTable::MAX_CELLS`] cells, so points with a lane-varying k cost one
+/// table look-up per lane instead of exact fixed-point divisions. `point`/`point_x8` equal the
+/// set's `point`/`point_x8` bit for bit for every layout (other layouts and larger sets simply
+/// call the set).
+#[derive(Clone, Debug)]
+pub struct GridTable {
+    set: PointSet,
+    /// per cell k: [x lo, x hi, y lo, y hi] in 24-bit fixed point (grid centres: lo == hi)
+    spans: Vec<[u32; 4]>,
+}
+
+impl GridTable {
+    /// Largest set with a table (16 bytes a cell: 1 MiB).
+    pub const MAX_CELLS: u32 = 1 << 16;
+
+    /// The table of `set` (empty unless `set` is a grid layout of at most `MAX_CELLS` cells).
+    pub fn new(set: PointSet) -> Self {
+        let spans = match set.layout {
+            Layout::Grid { grid, jitter } if set.n <= Self::MAX_CELLS => (0..set.n)
+                .map(|k| {
+                    let (cy, cx) = grid.nx.div_rem(k);
+                    if jitter {
+                        let ((xl, xh), (yl, yh)) = (cell_span(cx, grid.nx), cell_span(cy, grid.ny));
+                        [xl, xh, yl, yh]
+                    } else {
+                        let (x, y) = (cell_centre(cx, grid.nx), cell_centre(cy, grid.ny));
+                        [x, x, y, y]
+                    }
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        Self { set, spans }
+    }
+
+    /// The point set this table belongs to.
+    pub fn set(&self) -> &PointSet {
+        &self.set
+    }
+
+    /// As [`PointSet::point`], bit for bit; coordinates in [0, 1).
+    pub fn point(&self, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> [f32; 2] {
+        if self.spans.is_empty() {
+            return self.set.point(pixel, sample, dim, k, seed);
+        }
+        let k = k % self.set.n;
+        let [xl, xh, yl, yh] = self.spans[k as usize];
+        let h = hash(TAG_STRATIFIED, seed, dim, [pixel, sample, k]);
+        [jittered((xl, xh), h), jittered((yl, yh), mix(h, 1))]
+    }
+
+    /// As [`PointSet::point_x8`], bit for bit per lane; coordinates in [0, 1).
+    #[inline]
+    pub fn point_x8(&self, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
+        if self.spans.is_empty() {
+            return self.set.point_x8(pixel, sample, dim, k, seed);
+        }
+        let Layout::Grid { grid, .. } = self.set.layout else { unreachable!("tables exist for grid layouts only") };
+        let k = grid.n.rem(k);
+        let ks = k.to_array();
+        let cells: [[u32; 4]; 8] = std::array::from_fn(|i| self.spans[ks[i] as usize]);
+        let col = |j: usize| U8::new(std::array::from_fn(|i| cells[i][j]));
+        let h = hash(TAG_STRATIFIED, seed, dim, [pixel, sample, k]);
+        (jittered((col(0), col(1)), h), jittered((col(2), col(3)), mix(h, U8::splat(1))))
     }
 }
 
@@ -898,6 +1002,41 @@ mod tests {
                         assert_eq!(x8b.to_array()[i].to_bits(), x.to_bits());
                         assert_eq!(y8b.to_array()[i].to_bits(), y.to_bits());
                         assert_eq!(uniform_1d(p[i], s[i], dim, kk[i], seed).to_bits(), u8v[i].to_bits());
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn permute_x8_and_grid_table_equal_their_scalar_forms_bit_for_bit() {
+        let mut st = 11u64;
+        for n in interesting_n() {
+            for _ in 0..20 {
+                let i = u8_from(|l| if l == 7 { u32::MAX } else { lcg(&mut st) % (2 * n.max(1)) });
+                let key = u8_from(|_| lcg(&mut st));
+                let p = permute_x8(i, n, key).to_array();
+                let (ia, ka) = (i.to_array(), key.to_array());
+                for l in 0..8 {
+                    assert_eq!(p[l], permute(ia[l], n, ka[l]), "n={n} lane {l}");
+                }
+            }
+            for kind in SamplerKind::ALL {
+                let set = PointSet::new(kind, n);
+                let table = GridTable::new(set);
+                let seed = u64::from(lcg(&mut st)) << 32 | u64::from(lcg(&mut st));
+                for dim in [0, 3, 64] {
+                    let pixel = u8_from(|_| lcg(&mut st) % 100_000);
+                    let sample = u8_from(|_| lcg(&mut st) % 64);
+                    let k = u8_from(|l| if l == 0 { u32::MAX } else { lcg(&mut st) % (3 * n.max(1)) });
+                    let (tx, ty) = table.point_x8(pixel, sample, dim, k, seed);
+                    let (sx, sy) = set.point_x8(pixel, sample, dim, k, seed);
+                    assert_eq!(tx.to_array().map(f32::to_bits), sx.to_array().map(f32::to_bits), "{kind:?} n={n}");
+                    assert_eq!(ty.to_array().map(f32::to_bits), sy.to_array().map(f32::to_bits), "{kind:?} n={n}");
+                    let (p, s, kk) = (pixel.to_array(), sample.to_array(), k.to_array());
+                    for l in 0..8 {
+                        let q = table.point(p[l], s[l], dim, kk[l], seed);
+                        assert_eq!(q.map(f32::to_bits), set.point(p[l], s[l], dim, kk[l], seed).map(f32::to_bits));
                     }
                 }
             }
