@@ -3,7 +3,8 @@
 //! For each scene: `render` times a full single-threaded render (camera + shadow rays, all shading);
 //! `embree_camera` and `embree_shadow` replay the packets that render traced, through Embree alone.
 //! Criterion's "thrpt" lines are rays per second. A summary table (one measured run) follows.
-//! Scenes: the built-in Cornell box; hw2 cornell, direct3x3, dragon (direct lighting) and hw3
+//! Scenes: the built-in Cornell box, `scenes/cornell_diffuse_path.test` (diffuse, path traced with
+//! NEE); hw2 cornell, direct3x3, dragon (direct lighting) and hw3
 //! cornellNEE, hw4 cornellMIS, dragon (path tracing) from ../shared/cse168
 //! (skipped with a note when the corpus is absent).
 
@@ -14,7 +15,12 @@ use strata::film::Film;
 use strata::measure;
 
 fn scenes() -> Vec<(String, RenderOptions)> {
-    let mut v = vec![("builtin-cornell".to_string(), RenderOptions { size: Some((256, 256)), spp: Some(1), ..Default::default() })];
+    let own = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell_diffuse_path.test"));
+    let mut v = vec![
+        ("builtin-cornell".to_string(), RenderOptions { size: Some((256, 256)), spp: Some(1), ..Default::default() }),
+        // The path tracer's target scene: diffuse Cornell box with NEE.
+        ("cornell-diffuse-path".to_string(), RenderOptions { scene: Some(own), size: Some((256, 256)), spp: Some(4), ..Default::default() }),
+    ];
     let corpus = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168"));
     if corpus.is_dir() {
         for name in ["hw2/cornell", "hw2/direct3x3", "hw2/dragon", "hw3/cornellNEE", "hw4/cornellMIS", "hw4/dragon"] {

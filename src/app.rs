@@ -1,6 +1,7 @@
 //! The `strata render` command as a library function (the binary, tests and benches share it).
 
 use crate::film::{self, Film, Metadata};
+use crate::integrator::kernel::{features_json, Kernel};
 use crate::integrator::Integrator;
 use crate::render::{self, RenderStats};
 use crate::sampler::SamplerKind;
@@ -40,6 +41,8 @@ pub struct RenderOptions {
     pub integrator: Option<IntegratorKind>,
     /// print progress (spp done, Mrays/s, ETA) on stderr while rendering
     pub progress: bool,
+    /// run the general kernel instead of the one specialized for the scene's features
+    pub general_kernel: bool,
 }
 
 /// Everything a render produced.
@@ -107,7 +110,10 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     }
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
-    let integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    let mut integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    if opts.general_kernel {
+        integrator.kernel = Kernel::GENERAL;
+    }
     Ok((scene, integrator))
 }
 
@@ -232,6 +238,8 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "russian_roulette": out.integrator.russian_roulette,
         "importance_sampling": format!("{:?}", out.integrator.strategy).to_lowercase(),
         "nonfinite_samples": c.nonfinite,
+        "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
+        "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
     })
 }
@@ -240,15 +248,28 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
 pub fn summary(out: &RenderOutput) -> String {
     let d = &out.scene.desc;
     let c = &out.stats.counters;
+    let it = &out.integrator;
+    // The settings that matter for this integrator only.
+    let technique = match d.integrator {
+        IntegratorKind::Direct => format!(" (light {} x{})", it.light_set.kind().name(), it.light_set.n()),
+        IntegratorKind::PathTracer => format!(
+            " (nee {}, {} sampling, rr {}, maxdepth {})",
+            format!("{:?}", it.nee).to_lowercase(),
+            format!("{:?}", it.strategy).to_lowercase(),
+            if it.russian_roulette { "on" } else { "off" },
+            it.max_depth
+        ),
+        _ => String::new(),
+    };
     format!(
-        "{} {}x{} {} spp {} (light {} x{}): {:.3} s, {:.2} Mrays/s (camera {}, bounce {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
+        "{} {}x{} {} spp {}{}, kernel {}: {:.3} s, {:.2} Mrays/s (camera {}, bounce {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
         d.source.display(),
         d.width,
         d.height,
-        out.integrator.spp,
+        it.spp,
         integrator_name(d.integrator),
-        out.integrator.light_set.kind().name(),
-        out.integrator.light_set.n(),
+        technique,
+        it.kernel.name(d.integrator),
         out.stats.seconds,
         out.stats.mrays_per_sec(),
         c.camera,

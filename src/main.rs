@@ -99,6 +99,10 @@ struct RenderArgs {
     /// Print nothing on success.
     #[arg(long, short = 'q')]
     quiet: bool,
+    /// Shading kernel: `auto` runs the one compiled for the scene's features (see `features` and
+    /// `kernel` in --stats), `general` the one with every feature compiled in. Same image either way.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "general"])]
+    kernel: String,
 }
 
 impl RenderArgs {
@@ -116,6 +120,7 @@ impl RenderArgs {
             stats: self.stats,
             integrator: self.integrator,
             progress: !self.quiet,
+            general_kernel: self.kernel == "general",
         }
     }
 }

@@ -164,16 +164,17 @@ impl Material8 {
         self.ggx.select(t.max(F8::splat(0.25)), t)
     }
 
-    /// Eight-lane `Material::lobe`: only the models present among the active lanes are evaluated.
+    /// Eight-lane `Material::lobe`: only the models present among the active lanes are evaluated,
+    /// and only those a kernel compiled in (`PHONG`, `GGX`; see [`Lobes`]).
     #[inline]
-    fn lobe(&self, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> (Vec3x8, F8) {
+    fn lobe<const PHONG: bool, const GGX: bool>(&self, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> (Vec3x8, F8) {
         let (ph, gg) = (active & !self.ggx, active & self.ggx);
         let (mut f, mut p) = (Vec3x8::ZERO, F8::ZERO);
-        if ph.any() {
+        if PHONG && ph.any() {
             let (fp, pp) = phong::lobe_x8(wo, wi, self.ks, self.shininess);
             (f, p) = (Vec3x8::select(ph, fp, f), ph.select(pp, p));
         }
-        if gg.any() {
+        if GGX && gg.any() {
             let (fg, pg) = ggx::lobe_x8(wo, wi, self.ks, self.alpha);
             (f, p) = (Vec3x8::select(gg, fg, f), gg.select(pg, p));
         }
@@ -183,7 +184,20 @@ impl Material8 {
     /// Eight-lane [`Material::eval_pdf`].
     #[inline]
     pub fn eval_pdf(&self, strategy: ImportanceSampling, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> (Vec3x8, F8) {
-        let (fs, ps) = self.lobe(wo, wi, active);
+        self.eval_pdf_k::<true, true>(strategy, wo, wi, active)
+    }
+
+    /// [`Material8::eval_pdf`] compiled for the lobes a scene has: bit-identical to it on lanes that
+    /// satisfy the [`Lobes`] promise of `PHONG` and `GGX`.
+    #[inline]
+    pub fn eval_pdf_k<const PHONG: bool, const GGX: bool>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        wi: Vec3x8,
+        active: Mask8,
+    ) -> (Vec3x8, F8) {
+        let (fs, ps) = self.lobe::<PHONG, GGX>(wo, wi, active);
         let up = active & wo.z.simd_gt(F8::ZERO) & wi.z.simd_gt(F8::ZERO);
         let f = Vec3x8::select(up, self.kd.mul_add(F8::FRAC_1_PI, fs), Vec3x8::ZERO);
         let pdf = match strategy {
@@ -219,6 +233,20 @@ impl Material8 {
         u_lobe: F8,
         active: Mask8,
     ) -> (Vec3x8, F8, Vec3x8) {
+        self.sample_k::<true, true>(strategy, wo, u, u_lobe, active)
+    }
+
+    /// [`Material8::sample`] compiled for the lobes a scene has: bit-identical to it on lanes that
+    /// satisfy the [`Lobes`] promise of `PHONG` and `GGX`.
+    #[inline]
+    pub fn sample_k<const PHONG: bool, const GGX: bool>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        u: [F8; 2],
+        u_lobe: F8,
+        active: Mask8,
+    ) -> (Vec3x8, F8, Vec3x8) {
         let wi = match strategy {
             ImportanceSampling::Hemisphere => sample_uniform_hemisphere_x8(u, active).0,
             ImportanceSampling::Cosine => sample_cosine_hemisphere_x8(u, active).0,
@@ -226,16 +254,44 @@ impl Material8 {
                 let spec = active & u_lobe.simd_lt(self.specular_probability());
                 let (ph, gg) = (spec & !self.ggx, spec & self.ggx);
                 let mut wi = sample_cosine_hemisphere_x8(u, active & !spec).0;
-                if ph.any() {
+                if PHONG && ph.any() {
                     wi = Vec3x8::select(ph, phong::sample_x8(wo, u, self.shininess, ph), wi);
                 }
-                if gg.any() {
+                if GGX && gg.any() {
                     wi = Vec3x8::select(gg, ggx::sample_x8(wo, u, self.alpha, gg), wi);
                 }
                 wi
             }
         };
-        let (f, pdf) = self.eval_pdf(strategy, wo, wi, active);
+        let (f, pdf) = self.eval_pdf_k::<PHONG, GGX>(strategy, wo, wi, active);
         (wi, pdf, f)
+    }
+}
+
+/// The specular lobes a scene's materials have, decided at load time; kernels are compiled for
+/// them (`Material8::*_k::<PHONG, GGX>`).
+///
+/// The promise a kernel relies on: with `phong == false` every Phong material has ks = 0 (its lobe
+/// is exactly zero and is never picked by BRDF sampling, since t = 0); with `ggx == false` no
+/// material is GGX. Under that promise the compiled-out lobes change nothing, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Lobes {
+    /// some Phong material has a nonzero ks
+    pub phong: bool,
+    /// some material is GGX (whose Fresnel makes a lobe even with ks = 0)
+    pub ggx: bool,
+}
+
+impl Lobes {
+    /// Every lobe compiled in: the general kernel, right for any scene.
+    pub const ALL: Self = Self { phong: true, ggx: true };
+
+    /// The lobes of a set of materials.
+    pub fn of<'a>(materials: impl IntoIterator<Item = &'a crate::scene::desc::Material>) -> Self {
+        materials.into_iter().fold(Self { phong: false, ggx: false }, |l, m| match m.brdf {
+            BrdfKind::Ggx => Self { ggx: true, ..l },
+            BrdfKind::Phong if m.specular != glam::Vec3::ZERO => Self { phong: true, ..l },
+            BrdfKind::Phong => l,
+        })
     }
 }

@@ -9,12 +9,14 @@ use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::light::polygonal::polygon_phi_x8;
 use crate::render::PixelPacket;
 use crate::sampler::{GridTable, PointSet, SamplerKind, Stream};
+use kernel::Kernel;
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use serde::Serialize;
 use std::f32::consts::PI;
 
+pub mod kernel;
 mod path;
 mod whitted;
 pub use path::{PathScratch, DIM_PATH_BASE};
@@ -144,6 +146,8 @@ pub struct Integrator {
     pub strategy: ImportanceSampling,
     /// path tracer: maximum bounces (-1 = unbounded)
     pub max_depth: i32,
+    /// the kernel that runs (specialized for the scene's features, or [`Kernel::GENERAL`])
+    pub kernel: Kernel,
 }
 
 impl Integrator {
@@ -170,6 +174,7 @@ impl Integrator {
             russian_roulette: d.russian_roulette,
             strategy: d.importance_sampling,
             max_depth: d.max_depth,
+            kernel: Kernel::for_scene(scene),
         }
     }
 
@@ -216,7 +221,14 @@ impl Integrator {
         mut log: Option<&mut RayLog>,
     ) {
         if self.kind == IntegratorKind::PathTracer {
-            return self.path_tile(scene, pks, samples, out, &mut sc.path, c, log);
+            // The kernel compiled for the scene's lobes (see `kernel`).
+            let sp = &mut sc.path;
+            return match (self.kernel.lobes.phong, self.kernel.lobes.ggx) {
+                (false, false) => self.path_tile::<false, false>(scene, pks, samples, out, sp, c, log),
+                (true, false) => self.path_tile::<true, false>(scene, pks, samples, out, sp, c, log),
+                (false, true) => self.path_tile::<false, true>(scene, pks, samples, out, sp, c, log),
+                (true, true) => self.path_tile::<true, true>(scene, pks, samples, out, sp, c, log),
+            };
         }
         out.clear();
         let mut one = std::mem::take(&mut sc.one);
@@ -305,7 +317,8 @@ impl Integrator {
         sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into())));
         sc.eps.clear();
         sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
-        let any_spec = sc.hits.iter().any(|sh| sh.ks.max_elem().simd_gt(F8::ZERO).any());
+        // The Phong lobe is evaluated only in kernels that have it, and only where a hit has ks > 0.
+        let any_spec = self.kernel.lobes.phong && sc.hits.iter().any(|sh| sh.ks.max_elem().simd_gt(F8::ZERO).any());
         for (li, light) in scene.lights.iter().enumerate() {
             let dim = DIM_LIGHT_BASE + li as u32;
             let (la, lab, lac, ln) = (Vec3x8::splat(light.a), Vec3x8::splat(light.ab), Vec3x8::splat(light.ac), Vec3x8::splat(light.normal));

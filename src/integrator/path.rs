@@ -86,7 +86,7 @@ impl Integrator {
     /// `out` (sample-major: `out[si * pks.len() + p]`). All paths of all these samples form one
     /// wavefront, so packets stay full even when Russian roulette thins the paths out.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn path_tile(
+    pub(super) fn path_tile<const PHONG: bool, const GGX: bool>(
         &self,
         scene: &Scene,
         pks: &[PixelPacket],
@@ -203,7 +203,7 @@ impl Integrator {
                     let cos_l = -ln.dot(wi);
                     let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
                     if lit.any() {
-                        let (f, pdf_b) = mat.eval_pdf(self.strategy, wo, frame.to_local(wi), lit);
+                        let (f, pdf_b) = mat.eval_pdf_k::<PHONG, GGX>(self.strategy, wo, frame.to_local(wi), lit);
                         // L f cos_i / p_light with p_light = d^2 / (A cos_l n_lights) (solid angle).
                         let g = cos_i * cos_l * area * F8::splat(n_lights as f32) * inv_d * inv_d;
                         let w_light = if nee == Nee::Mis {
@@ -227,7 +227,7 @@ impl Integrator {
                 // Continue the path: sample the BSDF, then Russian roulette.
                 if bounce_here {
                     let u2 = self.path_point(pixel, s, dims + 2);
-                    let (wi_l, pdf, f) = mat.sample(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
+                    let (wi_l, pdf, f) = mat.sample_k::<PHONG, GGX>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
                     let cos = wi_l.z;
                     let ok = shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO);
                     let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));

@@ -1,0 +1,81 @@
+//! Feature analysis and kernel choice: at load time a scene is analysed (materials, lights,
+//! geometry kinds, integrator settings) and the integrators run a kernel monomorphized for the
+//! specular lobes it actually has, so a diffuse-only scene never evaluates a Phong or GGX lobe.
+//!
+//! Specialization changes speed, never results: a specialized kernel differs from the general one
+//! only by code that, under the scene's [`Lobes`] promise, adds exact zeros (tested bit for bit
+//! in `tests/kernels.rs`). Settings that are uniform over a render (NEE mode, Russian roulette,
+//! strategy) are branched on once per packet and are not worth a monomorphized copy.
+
+use crate::bsdf::Lobes;
+use crate::scene::build::Scene;
+use crate::scene::desc::{BrdfKind, ImportanceSampling, IntegratorKind, Nee};
+use serde_json::{json, Value};
+
+/// Which kernel runs: the general one (every lobe compiled in) or one specialized for the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Kernel {
+    /// specular lobes compiled in
+    pub lobes: Lobes,
+}
+
+impl Kernel {
+    /// The fully general kernel, right for any scene.
+    pub const GENERAL: Self = Self { lobes: Lobes::ALL };
+
+    /// The kernel specialized for `scene`'s materials.
+    pub fn for_scene(scene: &Scene) -> Self {
+        Self { lobes: Lobes::of(&scene.materials) }
+    }
+
+    /// Name reported in the summary and `--stats` (`kernel`): `general`, or the integrator's kernel
+    /// with the lobes compiled in, e.g. `pathtracer<lobes=none>`.
+    pub fn name(&self, integrator: IntegratorKind) -> String {
+        if *self == Self::GENERAL {
+            return "general".into();
+        }
+        let lobes = match (self.lobes.phong, self.lobes.ggx) {
+            (false, false) => "none",
+            (true, false) => "phong",
+            (false, true) => "ggx",
+            (true, true) => "phong+ggx",
+        };
+        format!("{}<lobes={lobes}>", crate::app::integrator_name(integrator))
+    }
+}
+
+/// The features a scene uses, as reported under `features` in `--stats`.
+pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, strategy: ImportanceSampling) -> Value {
+    let d = &scene.desc;
+    let mats = &d.materials;
+    let lobes = Lobes::of(mats);
+    let mut materials = vec!["diffuse"];
+    if lobes.phong {
+        materials.push("phong");
+    }
+    if mats.iter().any(|m| m.brdf == BrdfKind::Ggx) {
+        materials.push("ggx");
+    }
+    if mats.iter().any(|m| m.emission != glam::Vec3::ZERO) {
+        materials.push("emission");
+    }
+    let mut geometry = Vec::new();
+    if !d.triangles.is_empty() {
+        geometry.push("triangles");
+    }
+    if !d.spheres.is_empty() {
+        geometry.push("spheres");
+    }
+    let path = kind == IntegratorKind::PathTracer;
+    json!({
+        "materials": materials,
+        "geometry": geometry,
+        "quad_lights": scene.lights.len(),
+        "point_lights": d.point_lights.len(),
+        "directional_lights": d.directional_lights.len(),
+        "integrator": crate::app::integrator_name(kind),
+        "nee": if path { Some(format!("{nee:?}").to_lowercase()) } else { None },
+        "russian_roulette": path && rr,
+        "importance_sampling": if path { Some(format!("{strategy:?}").to_lowercase()) } else { None },
+    })
+}

@@ -1,0 +1,68 @@
+//! Feature-specialized kernels: the kernel compiled for a scene's features must give the same
+//! image, bit for bit, as the general kernel (specialization changes speed, never results).
+
+mod common;
+
+use common::{corpus, opts};
+use std::path::PathBuf;
+use strata::app::{render_to_film, stats_json, RenderOptions};
+
+fn own(name: &str) -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes")).join(name)
+}
+
+/// Renders `o` with the specialized and with the general kernel; asserts identical mean and
+/// variance bits and returns the two kernel names.
+fn same_bits(o: &RenderOptions) -> (String, String) {
+    let spec = render_to_film(o).expect("specialized render");
+    let gen = render_to_film(&RenderOptions { general_kernel: true, ..o.clone() }).expect("general render");
+    let bits = |v: Vec<[f32; 3]>| v.into_iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<u32>>();
+    let name = o.scene.as_ref().map_or("<built-in>".into(), |p| p.display().to_string());
+    assert!(spec.film.mean().iter().flatten().any(|&v| v > 0.0), "{name}: black image proves nothing");
+    assert_eq!(bits(spec.film.mean()), bits(gen.film.mean()), "{name}: mean differs between kernels");
+    assert_eq!(bits(spec.film.variance_of_mean()), bits(gen.film.variance_of_mean()), "{name}: variance differs");
+    let k = |r: &strata::app::RenderOutput| stats_json(r)["kernel"].as_str().expect("kernel key").to_string();
+    (k(&spec), k(&gen))
+}
+
+#[test]
+fn own_scenes_specialized_equals_general_bit_for_bit() {
+    // Diffuse-only path tracing: every lobe compiled out.
+    let (s, g) = same_bits(&opts(own("cornell_diffuse_path.test"), 48, 48, 8));
+    assert_eq!((s.as_str(), g.as_str()), ("pathtracer<lobes=none>", "general"));
+    // The built-in box (direct lighting, one glossy Phong sphere).
+    let o = RenderOptions { size: Some((48, 48)), spp: Some(2), threads: 2, ..Default::default() };
+    assert_eq!(same_bits(&o).0, "direct<lobes=phong>");
+    // The built-in box path traced with BRDF sampling is a Phong kernel.
+    let o = RenderOptions { integrator: Some(strata::scene::desc::IntegratorKind::PathTracer), ..o };
+    assert_eq!(same_bits(&o).0, "pathtracer<lobes=phong>");
+}
+
+#[test]
+fn course_scenes_specialized_equals_general_bit_for_bit() {
+    let Some(root) = corpus() else { return };
+    for (scene, kernel) in [
+        ("hw3/cornellNEE.test", "pathtracer<lobes=phong>"),
+        ("hw3/cornellRR.test", "pathtracer<lobes=phong>"),
+        ("hw4/cornellBRDF.test", "pathtracer<lobes=phong>"),
+        ("hw4/cornellMIS.test", "pathtracer<lobes=phong>"),
+        ("hw4/ggx.test", "pathtracer<lobes=ggx>"),
+        ("hw2/cornell.test", "direct<lobes=phong>"),
+        ("hw2/direct9.test", "direct<lobes=none>"),
+    ] {
+        let (s, _) = same_bits(&opts(root.join(scene), 40, 40, 4));
+        assert_eq!(s, kernel, "{scene}");
+    }
+}
+
+#[test]
+fn stats_report_features() {
+    let out = render_to_film(&opts(own("cornell_diffuse_path.test"), 16, 16, 1)).expect("render");
+    let j = stats_json(&out);
+    let f = &j["features"];
+    assert_eq!(f["materials"], serde_json::json!(["diffuse"]));
+    assert_eq!(f["geometry"], serde_json::json!(["triangles", "spheres"]));
+    assert_eq!(f["quad_lights"], 1);
+    assert_eq!(f["nee"], "on");
+    assert_eq!(j["kernel"], "pathtracer<lobes=none>");
+}
