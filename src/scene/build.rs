@@ -261,6 +261,9 @@ impl Scene {
         }
         let device = accel::Device::new()?;
         let mut b = accel::SceneBuilder::new(&device)?;
+        if std::env::var("STRATA_BVH").as_deref() == Ok("high") {
+            b.high_quality();
+        }
         b.add_triangles(&vertices, &indices)?;
         b.add_spheres(&points)?;
         b.add_ellipsoids(&ell_user)?;
