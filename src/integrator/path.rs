@@ -7,7 +7,7 @@
 //! is gathered at vertices 1..N (N = 1 is direct lighting); without NEE, emission is counted at
 //! vertices 1..N+1. Emission of quad lights follows the NEE mode (off: always; on: vertex 1 only;
 //! MIS: vertex 1, then weighted against the light-sampling pdf); `emission` of materials is not
-//! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping.
+//! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping unless `--clamp` asks for it (biased, reported).
 //!
 //! Sampler dimensions of vertex v: `DIM_PATH_BASE + 4 (v-1) + {0: light point, 1: (light choice,
 //! lobe choice), 2: BSDF direction, 3: (Russian roulette, -)}`. Each is a stratified set over the
@@ -273,6 +273,16 @@ impl Integrator {
             }
             std::mem::swap(&mut sc.lanes, &mut sc.next);
             v += 1;
+        }
+        // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
+        // non-finite samples are left as they are, for the film to count and drop.
+        if let Some(m) = self.clamp {
+            for r in sc.radiance.iter_mut() {
+                let top = r.max_element();
+                if top > m {
+                    *r *= m / top;
+                }
+            }
         }
         out.clear();
         out.extend(sc.radiance.chunks_exact(8).map(|l| Vec3x8::from_lanes(std::array::from_fn(|i| l[i]))));
