@@ -71,6 +71,7 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         "materials": materials,
         "geometry": geometry,
         "quad_lights": scene.lights.len(),
+        "emissive_triangles": scene.emitters.n_triangles(),
         "point_lights": d.point_lights.len(),
         "directional_lights": d.directional_lights.len(),
         "integrator": crate::app::integrator_name(kind),

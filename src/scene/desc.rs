@@ -133,6 +133,16 @@ pub struct QuadLightDesc {
     pub radiance: Vec3,
 }
 
+/// An emissive triangle (an OBJ face whose MTL material has a non-zero `Ke`), world space: an area
+/// light emitting `radiance` one-sided towards (v1-v0)x(v2-v0), black otherwise (like a quad light).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissiveTriangleDesc {
+    /// vertices, world space
+    pub v: [Vec3; 3],
+    /// emitted radiance (the MTL `Ke`)
+    pub radiance: Vec3,
+}
+
 /// Point light (raytracer only).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointLightDesc {
@@ -192,6 +202,8 @@ pub struct SceneDesc {
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
     pub quad_lights: Vec<QuadLightDesc>,
+    /// emissive triangles (area lights from OBJ faces with `Ke`)
+    pub emissive_triangles: Vec<EmissiveTriangleDesc>,
     /// point lights
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
@@ -219,6 +231,7 @@ impl Default for SceneDesc {
             triangles: Vec::new(),
             spheres: Vec::new(),
             quad_lights: Vec::new(),
+            emissive_triangles: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
         }
