@@ -14,8 +14,9 @@
 //! The current material is the `.test` material state where the `obj` command appears, and
 //! [`whole_scene_material`] for a whole-scene OBJ.
 //!
-//! Errors name the file and the 1-based line. `tobj` reports only a kind of error, so on failure the
-//! file is scanned again by [`locate_obj_error`] / [`locate_mtl_error`] for the offending line.
+//! Errors name the file and the 1-based line. `tobj` reports only a kind of error (and skips some bad
+//! lines silently), so every file is first checked line by line by [`locate_obj_error`] /
+//! [`locate_mtl_error`], which give the line and the reason.
 //! Nothing here panics on bad input (a panic inside `tobj` would be caught and reported).
 
 use crate::scene::desc::{CameraDesc, ImportanceSampling, IntegratorKind, Material, Nee, SceneDesc};
@@ -93,6 +94,10 @@ pub fn load(path: &Path) -> Result<ObjMesh, SceneError> {
         let line = bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count() + 1;
         err(path, line, "the file is not valid UTF-8 text")
     })?;
+    // tobj skips some malformed lines silently (a face of two vertices, say): check every line first.
+    if let Some((line, msg)) = locate_obj_error(text) {
+        return Err(err(path, line, msg));
+    }
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     // MTL failures, with the library's path, captured from the loader callback.
     let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
