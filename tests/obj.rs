@@ -371,4 +371,5 @@ fn procedural_mesh_has_a_million_triangles_and_round_trips() {
     let s = strata::scene::obj::scene_from_obj(&d.join("t.obj"), &Limits::default()).unwrap();
     assert_eq!(s.emissive_triangles.len(), 2);
     assert_eq!(s.triangles.len(), small.faces.len() - 2);
+    assert_eq!(small.faces.len(), small.face_material.iter().filter(|&&i| i == 0).count() + 6);
 }

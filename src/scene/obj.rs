@@ -382,7 +382,8 @@ pub fn place(
 }
 
 /// A procedural test mesh of at least `min_triangles` triangles: a bumpy torus (2 n x n quads, no
-/// degenerate triangles) tilted towards +z, on a floor, under an emissive patch; material names
+/// degenerate triangles) tilted towards +z, on a floor before a wall, under an emissive patch
+/// (2 x 2 n^2 + 6 triangles); material names
 /// `torus`, `floor`, `light` (see [`write_obj`]).
 pub fn procedural_mesh(min_triangles: usize) -> ObjMesh {
     let n = ((min_triangles as f64 / 4.0).sqrt().ceil() as usize).max(3);
@@ -415,10 +416,10 @@ pub fn procedural_mesh(min_triangles: usize) -> ObjMesh {
         mesh.faces.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
         mesh.face_material.extend([material, material]);
     };
-    // Floor below the torus, wound to face +y; light above, wound to face -y.
-    let y0 = -1.2;
-    quad([Vec3::new(-3.0, y0, -3.0), Vec3::new(-3.0, y0, 3.0), Vec3::new(3.0, y0, 3.0), Vec3::new(3.0, y0, -3.0)], 1);
-    let y1 = 1.6;
+    // Floor below the torus (facing +y), a wall behind it (facing +z), a light above (facing -y).
+    let (y0, y1, e) = (-1.2, 1.6, 1.6);
+    quad([Vec3::new(-e, y0, -e), Vec3::new(-e, y0, e), Vec3::new(e, y0, e), Vec3::new(e, y0, -e)], 1);
+    quad([Vec3::new(-e, y0, -e), Vec3::new(e, y0, -e), Vec3::new(e, y1 + 0.2, -e), Vec3::new(-e, y1 + 0.2, -e)], 1);
     quad([Vec3::new(-0.5, y1, -0.5), Vec3::new(0.5, y1, -0.5), Vec3::new(0.5, y1, 0.5), Vec3::new(-0.5, y1, 0.5)], 2);
     mesh.materials = vec![
         MtlMaterial { name: "torus".into(), kd: Some(Vec3::new(0.7, 0.45, 0.3)), ks: Some(Vec3::splat(0.2)), ns: Some(40.0), ke: None },
