@@ -419,6 +419,29 @@ mod tests {
     }
 
     #[test]
+    fn uniform_choice_x8_matches_scalar_and_inv_pmf() {
+        let quads: Vec<Emitter> = (0..3).map(|i| Emitter::quad(Vec3::X * i as f32, Vec3::X, Vec3::Z, Vec3::ONE)).collect();
+        let e = Emitters::new(quads, []);
+        let cs = [0.0, 0.1, 0.34, 0.5, 0.66, 0.67, 0.999_99, 0.2];
+        let (u, v) = (F8::splat(0.3), F8::splat(0.6));
+        let active = mask_from_bools([true, true, true, true, true, true, true, false]);
+        let s8 = e.sample_x8(F8::new(cs), u, v, active);
+        let inv8 = e.inv_pmf_x8(s8.light, active).to_array();
+        for i in 0..7 {
+            let s = e.sample(cs[i], 0.3, 0.6);
+            assert_eq!((s8.light.to_array()[i], s8.inv_pmf.to_array()[i], inv8[i]), (s.light, 3.0, 3.0));
+            assert_eq!(s.light, (cs[i] * 3.0) as u32);
+            assert!((s8.y.lane(i) - s.y).length() < 1e-6);
+        }
+        for (ui, want) in [(0.2f32, 0.6f32), (0.5, 0.5), (0.9, 0.7)] {
+            let (i, _, r) = e.all.pick(ui);
+            let (i8, _, r8) = e.all.pick_x8(F8::splat(ui), mask_all());
+            assert_eq!(i8.to_array()[0], i);
+            assert!((r - want).abs() < 1e-5 && (r8.to_array()[0] - r).abs() < 1e-6, "{ui}: {r}");
+        }
+    }
+
+    #[test]
     fn folded_triangle_samples_are_uniform() {
         // Chi-square of a 4x4 stratified grid of square samples folded onto a triangle, counted in
         // the 4 congruent sub-triangles (midpoint subdivision): equal areas, equal expected counts.
