@@ -6,7 +6,9 @@
 //! Scenes: the built-in Cornell box, `scenes/cornell_diffuse_path.test` (diffuse, path traced with
 //! NEE); hw2 cornell, direct3x3, dragon (direct lighting) and hw3
 //! cornellNEE, hw4 cornellMIS, dragon (path tracing) from ../shared/cse168
-//! (skipped with a note when the corpus is absent).
+//! (skipped with a note when the corpus is absent); and `torus-1m`, the procedural mesh of
+//! `strata gen-mesh` (1,000,006 triangles, emissive patch; generated and written as OBJ at bench
+//! start, then loaded through tobj as a whole-scene OBJ: path tracer, NEE with MIS).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use std::path::PathBuf;
@@ -21,6 +23,11 @@ fn scenes() -> Vec<(String, RenderOptions)> {
         // The path tracer's target scene: diffuse Cornell box with NEE.
         ("cornell-diffuse-path".to_string(), RenderOptions { scene: Some(own), size: Some((256, 256)), spp: Some(4), ..Default::default() }),
     ];
+    // The million-triangle mesh, generated here (never committed).
+    let mesh_path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("torus1m.obj");
+    let mesh = strata::scene::obj::procedural_mesh(1_000_000);
+    strata::scene::obj::write_obj(&mesh_path, &mesh).expect("write the procedural mesh");
+    v.push(("torus-1m".to_string(), RenderOptions { scene: Some(mesh_path), size: Some((320, 240)), spp: Some(2), ..Default::default() }));
     let corpus = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168"));
     if corpus.is_dir() {
         for name in ["hw2/cornell", "hw2/direct3x3", "hw2/dragon", "hw3/cornellNEE", "hw4/cornellMIS", "hw4/dragon"] {

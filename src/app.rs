@@ -64,6 +64,8 @@ pub struct RenderOptions {
     pub time_budget: Option<f64>,
     /// set (e.g. by SIGINT/SIGTERM) to stop after the current pass, checkpoint and write the image
     pub stop: Option<Arc<AtomicBool>>,
+    /// camera override (`--camera`), for `.obj` and `.test` scenes alike
+    pub camera: Option<crate::scene::desc::CameraDesc>,
 }
 
 /// Default seconds between two checkpoints.
@@ -96,6 +98,7 @@ pub struct RenderOutput {
 pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
     let limits = Limits::default();
     let mut desc = match &opts.scene {
+        Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits).map_err(|e| e.to_string())?,
         Some(p) => parse::parse_file(p, &limits).map_err(|e| e.to_string())?,
         None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits).map_err(|e| e.to_string())?,
     };
@@ -109,7 +112,25 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
     if let Some(k) = opts.integrator {
         desc.integrator = k;
     }
+    if let Some(c) = opts.camera {
+        desc.camera = Some(c);
+    }
     Ok(desc)
+}
+
+/// A scene path naming a Wavefront OBJ (extension `.obj`, any case) rather than a `.test` file.
+pub fn is_obj(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+}
+
+/// `--camera "ex ey ez cx cy cz ux uy uz fovy"` (the format's `camera` arguments), checked as the
+/// `.test` parser checks them.
+pub fn parse_camera(s: &str) -> Result<crate::scene::desc::CameraDesc, String> {
+    let text = format!("camera {}", s.replace(',', " "));
+    parse::parse_str(&text, Path::new("--camera"), &Limits::default())
+        .map_err(|e| e.message)?
+        .camera
+        .ok_or_else(|| "--camera expects 10 numbers".to_string())
 }
 
 /// Integrator name as the format spells it.
@@ -180,7 +201,8 @@ pub fn identity(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<
     Ok(Header {
         strata_version: env!("CARGO_PKG_VERSION").to_string(),
         scene: d.source.display().to_string(),
-        scene_hash: scene_hash(opts)?,
+        // The file's bytes and the parsed content (which covers included OBJ and MTL files).
+        scene_hash: format!("{}-{:016x}", scene_hash(opts)?, d.content_hash()),
         options,
         width: d.width,
         height: d.height,

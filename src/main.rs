@@ -65,6 +65,15 @@ enum Cmd {
         #[arg(long, short = 'q')]
         quiet: bool,
     },
+    /// Write a procedural OBJ+MTL mesh (bumpy torus on a floor under an emissive patch) of at least
+    /// --triangles triangles, for throughput runs: OUT.obj and OUT.mtl.
+    GenMesh {
+        /// Output OBJ path (the MTL is written beside it).
+        out: PathBuf,
+        /// Minimum number of triangles of the torus.
+        #[arg(long, default_value_t = 1_000_000)]
+        triangles: usize,
+    },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
         #[command(flatten)]
@@ -77,8 +86,12 @@ enum Cmd {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// Scene file (.test); omitted: the built-in Cornell box.
+    /// Scene file (.test, or .obj for a whole-scene OBJ); omitted: the built-in Cornell box.
     scene: Option<PathBuf>,
+    /// Camera "ex ey ez cx cy cz ux uy uz fovy" (the format's camera arguments), replacing the
+    /// scene's (for an .obj, the default one framing its bounds).
+    #[arg(long, value_parser = app::parse_camera, allow_hyphen_values = true)]
+    camera: Option<strata::scene::desc::CameraDesc>,
     /// Samples per pixel (default: the scene's spp).
     #[arg(long)]
     spp: Option<u32>,
@@ -164,6 +177,7 @@ impl RenderArgs {
             samples: self.samples,
             time_budget: self.time_budget,
             stop: None,
+            camera: self.camera,
         }
     }
 }
@@ -242,6 +256,12 @@ fn main() -> ExitCode {
         }),
         Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
             run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
+        }
+        Cmd::GenMesh { out, triangles } => {
+            let mesh = strata::scene::obj::procedural_mesh(triangles);
+            strata::scene::obj::write_obj(&out, &mesh)
+                .map(|mtl| println!("{}: {} triangles, {} vertices (materials {})", out.display(), mesh.faces.len(), mesh.positions.len(), mtl.display()))
+                .map_err(|e| format!("{}: {e}", out.display()))
         }
         Cmd::Rays { args, json } => app::run_rays(&args.options()).map(|(rates, name)| {
             if json {

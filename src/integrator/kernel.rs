@@ -77,6 +77,7 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         "geometry": geometry,
         "quad_lights": scene.lights.len(),
         "light_selection": match scene.lights.len() { 0 => "none", 1 => "single", _ => "uniform" },
+        "emissive_triangles": scene.emitters.n_triangles(),
         "point_lights": d.point_lights.len(),
         "directional_lights": d.directional_lights.len(),
         "integrator": crate::app::integrator_name(kind),

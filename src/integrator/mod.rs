@@ -377,6 +377,72 @@ impl Integrator {
                 *o += acc.mul_elem(scale);
             }
         }
+        if scene.emitters.n_triangles() > 0 {
+            self.direct_triangles(scene, pks, s, out, sc, c, log, any_spec);
+        }
+    }
+
+    /// `direct` for the emissive triangles, treated as one more light after the quad lights (sampler
+    /// dimension `DIM_LIGHT_BASE + #quads`): each of the `lightsamples` samples picks a triangle by
+    /// power and a point on it (one 2D sample does both, see `light::emitters`), and adds
+    /// L f cos(th_i) cos(th_l) A / (d^2 pmf) over the number of samples where the shadow ray is clear.
+    #[allow(clippy::too_many_arguments)]
+    fn direct_triangles(
+        &self,
+        scene: &Scene,
+        pks: &[PixelPacket],
+        s: u32,
+        out: &mut [Vec3x8],
+        sc: &mut Scratch,
+        c: &mut Counters,
+        mut log: Option<&mut RayLog>,
+        any_spec: bool,
+    ) {
+        let n_light = self.light_set.n();
+        let inv_n = F8::splat(1.0 / n_light as f32);
+        let dim = DIM_LIGHT_BASE + scene.lights.len() as u32;
+        sc.streams.clear();
+        sc.streams.extend(pks.iter().map(|pk| self.light_set.stream_x8(pk.pixel, U8::splat(s), dim, self.seed)));
+        for k in 0..n_light {
+            sc.shadow.clear();
+            sc.contrib.clear();
+            sc.owner.clear();
+            for i in 0..pks.len() {
+                let (sh, shade) = (&sc.hits[i], sc.shade[i]);
+                if shade.none() {
+                    continue;
+                }
+                let (u, v) = sc.streams[i].point(k);
+                let ls = scene.emitters.sample_triangles_x8(u, v, shade);
+                let to = ls.y - sh.p;
+                let d2 = to.length_squared();
+                let inv_d = F8::ONE / d2.sqrt();
+                let wi = to.scale(inv_d);
+                let cos_i = sh.n.dot(wi);
+                let cos_l = -ls.normal.dot(wi);
+                let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                if lit.none() {
+                    continue;
+                }
+                let f = brdf_eval(sh, wi, lit, any_spec);
+                let w = cos_i * cos_l * inv_d * inv_d * ls.area * ls.inv_pmf * inv_n;
+                sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(w), lit));
+                let o = sh.n.mul_add(sc.eps[i], sh.p);
+                let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
+                let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
+                sc.shadow.push((ray, lit));
+                sc.owner.push(i as u32);
+            }
+            if let Some(l) = log.as_deref_mut() {
+                l.shadow.extend_from_slice(&sc.shadow);
+            }
+            for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
+                let occluded = scene.accel.occluded8(ray, *lit);
+                c.packet(RayKind::Shadow, *lit);
+                let visible = *lit & !occluded;
+                out[sc.owner[j] as usize] += masked(sc.contrib[j], visible);
+            }
+        }
     }
 }
 
@@ -396,11 +462,14 @@ pub struct Scratch {
     one: Vec<Vec3x8>,
 }
 
-/// `analyticdirect` without emission: kd/pi * sum over lights of L * max(0, Phi . n) (no visibility).
+/// `analyticdirect` without emission: kd/pi * sum over area lights of L * max(0, Phi . n) (no
+/// visibility; as for quads, the receiver must see the whole light in its upper hemisphere and on
+/// its emitting side for this to be exact).
 fn analytic_direct(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
     let mut l_out = Vec3x8::ZERO;
     let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into());
-    for light in &scene.lights {
+    // Quad lights, then emissive triangles (same polygon formula; `Emitter::corners` winds both alike).
+    for light in &scene.emitters.list {
         let phi = polygon_phi_x8(sh.p, &light.corners(), shade);
         let e = phi.dot(sh.n).max(F8::ZERO);
         l_out += sh.kd.mul_elem(Vec3x8::splat(light.radiance)).scale(e * F8::splat(1.0 / PI));

@@ -116,7 +116,7 @@ impl Integrator {
         mut log: Option<&mut RayLog>,
     ) {
         let nee = self.nee;
-        let n_lights = scene.lights.len() as u32;
+        let n_lights = scene.emitters.len() as u32;
         let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
         sc.radiance.clear();
         let n_samples = samples.len();
@@ -170,7 +170,7 @@ impl Integrator {
                 let s = U8::new(std::array::from_fn(|i| chunk[i].sample));
                 let prev_pdf = F8::new(std::array::from_fn(|i| chunk[i].pdf));
 
-                // Emission: materials always; quad lights by the NEE mode.
+                // Emission: materials always; area lights (quads, emissive triangles) by the NEE mode.
                 let mut le = masked(sh.emitted, hit);
                 let is_light = hit & F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
                 let light_w = match nee {
@@ -211,8 +211,10 @@ impl Integrator {
                 // Next event estimation: one light chosen uniformly, one point on it.
                 if nee_here {
                     let (u, w) = self.path_point(pixel, s, dims);
-                    let (la, lab, lac, ln, l_rad, area) = pick_lights(scene, u_choice);
-                    let y = lac.mul_add(w, lab.mul_add(u, la));
+                    // One light chosen by `scene.emitters.all` (uniform among quads, by power with
+                    // emissive triangles), one point on it, uniform in area.
+                    let ls = scene.emitters.sample_x8(u_choice, u, w, shade);
+                    let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
                     let to = y - sh.p;
                     let d2 = to.length_squared();
                     let inv_d = F8::ONE / d2.sqrt();
@@ -222,10 +224,10 @@ impl Integrator {
                     let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
                     if lit.any() {
                         let (f, pdf_b) = mat.eval_pdf_k::<PHONG, GGX>(self.strategy, wo, frame.to_local(wi), lit);
-                        // L f cos_i / p_light with p_light = d^2 / (A cos_l n_lights) (solid angle).
-                        let g = cos_i * cos_l * area * F8::splat(n_lights as f32) * inv_d * inv_d;
+                        // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
+                        let g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
                         let w_light = if nee == Nee::Mis {
-                            let p_light = d2 / (area * cos_l * F8::splat(n_lights as f32));
+                            let p_light = d2 / (area * cos_l * inv_pmf);
                             power_heuristic_x8(p_light, pdf_b, lit)
                         } else {
                             F8::ONE
@@ -327,39 +329,17 @@ fn add_lanes(radiance: &mut [Vec3], slots: &[u32; 8], v: Vec3x8) {
     }
 }
 
-/// The quad light each lane picks uniformly with `u_choice` in [0,1): corner, edges, unit normal,
-/// radiance and area, per lane (one light: splatted, no gather).
-#[inline]
-fn pick_lights(scene: &Scene, u_choice: F8) -> (Vec3x8, Vec3x8, Vec3x8, Vec3x8, Vec3x8, F8) {
-    let n = scene.lights.len() as u32;
-    if n == 1 {
-        let l = &scene.lights[0];
-        let v = Vec3x8::splat;
-        return (v(l.a), v(l.ab), v(l.ac), v(l.normal), v(l.radiance), F8::splat(l.area));
-    }
-    let pick = (u_choice * F8::splat(n as f32)).to_array().map(|x| (x as u32).min(n - 1));
-    let lights = pick.map(|l| &scene.lights[l as usize]);
-    (
-        Vec3x8::from_lanes(lights.map(|l| l.a)),
-        Vec3x8::from_lanes(lights.map(|l| l.ab)),
-        Vec3x8::from_lanes(lights.map(|l| l.ac)),
-        Vec3x8::from_lanes(lights.map(|l| l.normal)),
-        Vec3x8::from_lanes(lights.map(|l| l.radiance)),
-        F8::new(lights.map(|l| l.area)),
-    )
-}
-
-/// Solid-angle pdf with which NEE would have picked the point hit on a light: (1/#lights) d^2 /
-/// (A cos_l); zero where `is_light` is off.
+/// Solid-angle pdf with which NEE would have picked the point hit on a light: pmf d^2 / (A cos_l)
+/// (pmf = 1/#lights without emissive triangles); zero where `is_light` is off.
 #[inline]
 fn light_pdf_at_hit(scene: &Scene, sh: &crate::scene::build::SurfaceHit8, rh: &RayHit8, is_light: Mask8) -> F8 {
-    let n = scene.lights.len().max(1) as f32;
     let ids = sh.light.to_array();
-    let pick = |i: usize| scene.lights.get(ids[i] as usize);
+    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
     let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
     let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
+    let inv_pmf = scene.emitters.inv_pmf_x8(sh.light, is_light);
     let t = F8::new(rh.ray.tfar);
     let cos_l = ln.dot(sh.wo);
-    let p = t * t / (area * cos_l * F8::splat(n));
+    let p = t * t / (area * cos_l * inv_pmf);
     is_light.select(p, F8::ZERO)
 }

@@ -6,6 +6,7 @@
 //! (surfaces are shaded two-sided, so meshes of either winding render; lights stay one-sided).
 
 use crate::accel::{self, Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
+use crate::light::emitters::{Emitter, Emitters};
 use crate::scene::desc::{BrdfKind, CameraDesc, Material, SceneDesc};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
@@ -112,7 +113,8 @@ pub struct SurfaceHit8 {
     pub emitted: Vec3x8,
     /// ambient term of the material (`raytracer` only; zero on lights and misses)
     pub ambient: Vec3x8,
-    /// radiance emitted towards wo by a quad light (its radiance on its emitting side, else 0)
+    /// radiance emitted towards wo by an area light (quad or emissive triangle: its radiance on its
+    /// emitting side, else 0)
     pub le: Vec3x8,
     /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
     pub light: U8,
@@ -124,8 +126,10 @@ pub struct Scene {
     pub desc: SceneDesc,
     /// camera for the image size in `desc`
     pub camera: Camera,
-    /// area lights (quad lights)
+    /// quad lights (indices `0..lights.len()` of `emitters`)
     pub lights: Vec<QuadLight>,
+    /// every area light: the quad lights, then the emissive triangles; light selection
+    pub emitters: Emitters,
     /// materials (desc materials, then one black material per light)
     pub materials: Vec<Material>,
     /// per triangle: material index
@@ -176,7 +180,8 @@ impl From<accel::AccelError> for BuildError {
 }
 
 impl Scene {
-    /// Builds the scene. Quad lights become two triangles each, after the scene's triangles.
+    /// Builds the scene. Quad lights become two triangles each, after the scene's triangles, then
+    /// come the emissive triangles (zero-area ones are dropped: they can be neither hit nor sampled).
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
         let cam_desc = desc
             .camera
@@ -215,6 +220,20 @@ impl Scene {
             tri_light.extend([i as u32, i as u32]);
             lights.push(light);
         }
+        let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
+        for t in &desc.emissive_triangles {
+            let e = Emitter::triangle(t.v, t.radiance);
+            if !(e.area > 0.0 && e.area.is_finite()) {
+                continue;
+            }
+            let base = vertices.len() as u32;
+            vertices.extend_from_slice(&t.v);
+            indices.push([base, base + 1, base + 2]);
+            tri_material.push(black);
+            tri_light.push((lights.len() + tri_emitters.len()) as u32);
+            tri_emitters.push(e);
+        }
+        let emitters = Emitters::new(lights.iter().map(|q| Emitter::quad(q.a, q.ab, q.ac, q.radiance)), tri_emitters);
         let tri_normal: Vec<Vec3> = indices
             .iter()
             .map(|t| {
@@ -272,6 +291,7 @@ impl Scene {
             desc,
             camera,
             lights,
+            emitters,
             materials,
             tri_material,
             tri_normal,
@@ -314,7 +334,7 @@ impl Scene {
                     let l = self.tri_light[prim];
                     if l != INVALID_ID {
                         light[i] = l;
-                        let q = &self.lights[l as usize];
+                        let q = &self.emitters.list[l as usize];
                         if q.normal.dot(dirs[i]) < 0.0 {
                             le[i] = q.radiance;
                         }

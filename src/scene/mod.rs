@@ -2,3 +2,4 @@
 pub mod desc;
 pub mod parse;
 pub mod build;
+pub mod obj;

@@ -6,6 +6,7 @@
 //! nothing is allocated in proportion to a number written in the file.
 
 use crate::scene::desc::*;
+use crate::scene::obj;
 use glam::{DMat4, DVec3, Vec3};
 use std::collections::HashMap;
 use std::fmt;
@@ -97,12 +98,12 @@ pub fn parse_str(text: &str, source: &Path, limits: &Limits) -> Result<SceneDesc
 
 /// Every command the format knows (used only to suggest the right spelling).
 #[rustfmt::skip]
-const COMMANDS: [&str; 32] = [
+const COMMANDS: [&str; 33] = [
     "size", "output", "camera", "spp", "gamma", "maxdepth", "maxverts", "vertex", "tri", "sphere",
     "pushTransform", "popTransform", "translate", "rotate", "scale", "diffuse", "specular",
     "shininess", "emission", "ambient", "brdf", "roughness", "quadLight", "point", "directional",
     "attenuation", "integrator", "lightsamples", "lightstratify", "nexteventestimation",
-    "russianroulette", "importancesampling",
+    "russianroulette", "importancesampling", "obj",
 ];
 
 /// Most arguments any command takes (`quadLight`).
@@ -277,6 +278,10 @@ impl<'l> Parser<'l> {
                 self.vertices.push(Vec3::from_array(v));
             }
             "tri" => self.triangle(a.ints()?)?,
+            "obj" => {
+                a.expect(1, "file name")?;
+                self.obj(a.token(0))?
+            }
             "sphere" => self.sphere(a.floats()?)?,
             "pushTransform" => {
                 a.expect(0, "argument")?;
@@ -469,6 +474,23 @@ impl<'l> Parser<'l> {
         Ok(())
     }
 
+    /// `obj FILE`: the OBJ's faces (path relative to the `.test` file's directory) under the current
+    /// transform, with materials by the rule of `scene::obj` (MTL fields where given, the current
+    /// material elsewhere; faces with `Ke` become emissive triangles).
+    fn obj(&mut self, name: &str) -> Result<(), String> {
+        let path = self.desc.source.parent().unwrap_or(Path::new("")).join(name);
+        let mesh = obj::load(&path).map_err(|e| format!("obj '{}': {e}", show(name)))?;
+        let d = &self.desc;
+        let n = d.triangles.len() + d.emissive_triangles.len() + d.spheres.len() + d.quad_lights.len();
+        if n + mesh.faces.len() > self.limits.max_primitives {
+            let max = self.limits.max_primitives;
+            return Err(format!("obj '{}': more than {max} primitives and lights ({})", show(name), hint("max_primitives")));
+        }
+        let (matrix, current, lookup) = (self.matrix, self.material, &mut self.material_lookup);
+        obj::place(&mesh, &current, |p| to_world(&matrix, p), &mut self.desc, &mut |m, d| intern_material(lookup, d, &m))
+            .map_err(|e| format!("obj '{}': {e}", show(name)))
+    }
+
     /// Right-multiplies the current matrix: M <- M * x.
     fn transform(&mut self, x: DMat4) -> Result<(), String> {
         let m = self.matrix * x;
@@ -481,12 +503,7 @@ impl<'l> Parser<'l> {
 
     /// A point mapped by the current matrix, checked to stay finite in f32.
     fn to_world(&self, p: Vec3) -> Result<Vec3, String> {
-        let w = self.matrix.transform_point3(p.as_dvec3()).as_vec3();
-        if w.is_finite() {
-            Ok(w)
-        } else {
-            Err(format!("point {p} is out of range after the current transform"))
-        }
+        to_world(&self.matrix, p)
     }
 
     fn count_primitive(&self) -> Result<(), String> {
@@ -494,6 +511,7 @@ impl<'l> Parser<'l> {
         let n = d.triangles.len()
             + d.spheres.len()
             + d.quad_lights.len()
+            + d.emissive_triangles.len()
             + d.point_lights.len()
             + d.directional_lights.len();
         if n >= self.limits.max_primitives {
@@ -516,26 +534,40 @@ impl<'l> Parser<'l> {
         if let Some(i) = self.material_index {
             return Ok(i);
         }
-        let m = &self.material;
-        let vectors = [m.diffuse, m.specular, m.emission, m.ambient];
-        let values = vectors.iter().flat_map(|v| v.to_array()).chain([m.shininess, m.roughness]);
-        let mut key = [0u32; 15];
-        for (k, v) in key.iter_mut().zip(values) {
-            *k = (v + 0.0).to_bits(); // + 0.0 folds -0.0 into 0.0, as PartialEq does
-        }
-        key[14] = m.brdf as u32;
-        let index = match self.material_lookup.get(&key) {
-            Some(&i) => i,
-            None => {
-                let i = u32::try_from(self.desc.materials.len()).map_err(|_| "too many distinct materials")?;
-                self.desc.materials.push(*m);
-                self.material_lookup.insert(key, i);
-                i
-            }
-        };
+        let index = intern_material(&mut self.material_lookup, &mut self.desc, &self.material)?;
         self.material_index = Some(index);
         Ok(index)
     }
+}
+
+/// A point mapped by `matrix`, checked to stay finite in f32.
+fn to_world(matrix: &DMat4, p: Vec3) -> Result<Vec3, String> {
+    let w = matrix.transform_point3(p.as_dvec3()).as_vec3();
+    if w.is_finite() {
+        Ok(w)
+    } else {
+        Err(format!("point {p} is out of range after the current transform"))
+    }
+}
+
+/// Index of material `m` in `desc.materials` (`lookup` maps bit patterns to indices), adding it if new.
+fn intern_material(lookup: &mut HashMap<[u32; 15], u32>, desc: &mut SceneDesc, m: &Material) -> Result<u32, String> {
+    let vectors = [m.diffuse, m.specular, m.emission, m.ambient];
+    let values = vectors.iter().flat_map(|v| v.to_array()).chain([m.shininess, m.roughness]);
+    let mut key = [0u32; 15];
+    for (k, v) in key.iter_mut().zip(values) {
+        *k = (v + 0.0).to_bits(); // + 0.0 folds -0.0 into 0.0, as PartialEq does
+    }
+    key[14] = m.brdf as u32;
+    Ok(match lookup.get(&key) {
+        Some(&i) => i,
+        None => {
+            let i = u32::try_from(desc.materials.len()).map_err(|_| "too many distinct materials")?;
+            desc.materials.push(*m);
+            lookup.insert(key, i);
+            i
+        }
+    })
 }
 
 /// One number that must be >= 0.
