@@ -43,6 +43,8 @@ pub struct RenderOptions {
     pub progress: bool,
     /// run the general kernel instead of the one specialized for the scene's features
     pub general_kernel: bool,
+    /// path tracer: direction sampling override (default: the scene's `importancesampling`)
+    pub importance_sampling: Option<crate::scene::desc::ImportanceSampling>,
 }
 
 /// Everything a render produced.
@@ -76,6 +78,9 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
     if let Some(k) = opts.integrator {
         desc.integrator = k;
     }
+    if let Some(s) = opts.importance_sampling {
+        desc.importance_sampling = s;
+    }
     Ok(desc)
 }
 
@@ -96,6 +101,17 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
         "analyticdirect" => IntegratorKind::AnalyticDirect,
         "direct" => IntegratorKind::Direct,
         "pathtracer" => IntegratorKind::PathTracer,
+        _ => return None,
+    })
+}
+
+/// Parses a direction sampling strategy as the format spells it: hemisphere, cosine or brdf.
+pub fn parse_importance_sampling(s: &str) -> Option<crate::scene::desc::ImportanceSampling> {
+    use crate::scene::desc::ImportanceSampling as I;
+    Some(match s {
+        "hemisphere" => I::Hemisphere,
+        "cosine" => I::Cosine,
+        "brdf" => I::Brdf,
         _ => return None,
     })
 }

@@ -51,6 +51,31 @@ enum Cmd {
         #[arg(long, default_value = "compare")]
         out: PathBuf,
     },
+    /// Regenerate the seed experiments (direct lighting light samplers; path tracing pixel
+    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, contact sheets, plots.
+    Experiments {
+        /// Output folder.
+        #[arg(long, default_value = "docs/experiments")]
+        out: PathBuf,
+        /// The CSE168 corpus (default ../shared/cse168 beside the crate, or $STRATA_CSE168).
+        #[arg(long)]
+        corpus: Option<PathBuf>,
+        /// Independent runs per variant (K).
+        #[arg(long, default_value_t = 16)]
+        runs: usize,
+        /// Image width (heights keep each scene's aspect).
+        #[arg(long, default_value_t = 160)]
+        width: u32,
+        /// Light samples of each half of the direct-lighting reference.
+        #[arg(long, default_value_t = 4096)]
+        ref_light_samples: u32,
+        /// spp of the path-tracing references.
+        #[arg(long, default_value_t = 1024)]
+        ref_spp: u32,
+        /// Worker threads (0 = all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+    },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
         #[command(flatten)]
@@ -90,6 +115,9 @@ struct RenderArgs {
     /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
     #[arg(long, value_parser = parse_integrator)]
     integrator: Option<strata::scene::desc::IntegratorKind>,
+    /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
+    #[arg(long, value_parser = parse_importance_sampling)]
+    importance_sampling: Option<strata::scene::desc::ImportanceSampling>,
     /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
     #[arg(short = 'o', long = "out")]
     out: Option<PathBuf>,
@@ -121,6 +149,7 @@ impl RenderArgs {
             integrator: self.integrator,
             progress: !self.quiet,
             general_kernel: self.kernel == "general",
+            importance_sampling: self.importance_sampling,
         }
     }
 }
@@ -139,6 +168,10 @@ fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, Stri
     app::parse_integrator(s).ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
 }
 
+fn parse_importance_sampling(s: &str) -> Result<strata::scene::desc::ImportanceSampling, String> {
+    app::parse_importance_sampling(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.cmd {
@@ -152,6 +185,14 @@ fn main() -> ExitCode {
         }
         Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
             run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
+        }
+        Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads } => {
+            let corpus = corpus.unwrap_or_else(strata::experiments::default_corpus);
+            let cfg = strata::experiments::Config { corpus, out: out.clone(), runs, width, ref_light_samples, ref_spp, threads, verbose: true };
+            strata::experiments::run(&cfg).map(|md| {
+                println!("{md}");
+                println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
+            })
         }
         Cmd::Rays { args, json } => app::run_rays(&args.options()).map(|(rates, name)| {
             if json {
