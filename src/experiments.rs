@@ -43,13 +43,15 @@ pub struct Config {
     pub threads: usize,
     /// print progress on stderr
     pub verbose: bool,
+    /// contact-sheet tiles are the images box-downsampled by this factor (keeps the PNGs small)
+    pub sheet_factor: u32,
 }
 
 impl Config {
     /// The committed configuration: 160-pixel-wide images, K = 16, references of 2 x 4096 light
     /// samples and 1024 spp.
     pub fn full(corpus: PathBuf, out: PathBuf) -> Self {
-        Config { corpus, out, runs: 16, width: 160, ref_light_samples: 4096, ref_spp: 1024, threads: 0, verbose: true }
+        Config { corpus, out, runs: 16, width: 160, ref_light_samples: 4096, ref_spp: 1024, threads: 0, verbose: true, sheet_factor: 2 }
     }
 }
 
@@ -249,7 +251,7 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, String> {
         let (w, h) = reference.size;
         let mut tiles = Vec::new();
         for n in [9u32, 25] {
-            tiles.push(contact::tile_from_linear(w, h, &reference.rgb, reference.gamma, vec!["reference".into(), format!("2x{} strat", cfg.ref_light_samples)]));
+            tiles.push(contact::tile_from_linear(w, h, &reference.rgb, cfg.sheet_factor, reference.gamma, vec!["reference".into(), format!("2x{} str", cfg.ref_light_samples)]));
             for (label, kind) in kinds {
                 log(cfg, &format!("direct {name}: {label} x{n}, {} runs", cfg.runs));
                 let o = RenderOptions { light_sampler: Some(kind), light_samples: Some(n), ..base.clone() };
@@ -259,8 +261,9 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, String> {
                     w,
                     h,
                     &imgs[0],
+                    cfg.sheet_factor,
                     reference.gamma,
-                    vec![format!("{label} n={n}"), format!("var8 {}", g3(st.variance_8bit)), format!("rmsb {}", g3(st.rms_bias))],
+                    vec![format!("{} {n}", label.replace("grid-center", "grid-ctr")), format!("v8 {}", g3(st.variance_8bit)), format!("rb {}", g3(st.rms_bias))],
                 ));
                 let sname = format!("{name} {label}");
                 let p = (f64::from(n), st.mse.sqrt());
@@ -352,7 +355,7 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
         let reference = &refs[ri].1;
         let (w, h) = reference.size;
         let mut tiles =
-            vec![contact::tile_from_linear(w, h, &reference.rgb, reference.gamma, vec!["reference".into(), format!("{} spp", cfg.ref_spp)])];
+            vec![contact::tile_from_linear(w, h, &reference.rgb, cfg.sheet_factor, reference.gamma, vec!["reference".into(), format!("{} spp", cfg.ref_spp)])];
         let mut series = Vec::new();
         let mut main: Vec<Stats> = Vec::new();
         for (label, o) in &case.variants {
@@ -371,8 +374,9 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
                         w,
                         h,
                         &imgs[0],
+                        cfg.sheet_factor,
                         reference.gamma,
-                        vec![format!("{label} {s} spp"), format!("var {}", g3(st.variance)), format!("z {:.2}", st.z)],
+                        vec![format!("{label} {s}"), format!("var {}", g3(st.variance)), format!("z {:.2}", st.z)],
                     ));
                     main.push(st);
                 }
@@ -397,8 +401,9 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
                 w,
                 h,
                 &imgs[0],
+                cfg.sheet_factor,
                 reference.gamma,
-                vec![format!("{label} {eq_spp} spp"), "equal time".into(), format!("var {}", g3(st.variance))],
+                vec![format!("{label} {eq_spp}"), "equal time".into(), format!("var {}", g3(st.variance))],
             ));
         }
         let (sl, _) = &case.variants[slow];
@@ -421,7 +426,7 @@ pub fn markdown(rows: &[Row], cfg: &Config) -> String {
         md,
         "# Seed experiments (generated)\n\nRegenerate with `strata experiments` (see docs/experiments/README.md). K = {} runs per \
          variant, images {} pixels wide. `var` is the across-run variance of a pixel value (mean over pixels and channels) in \
-         linear radiance, `var8` the same on the 8-bit gamma-encoded values 0..255; `MSE` against the reference (linear); `bias` \
+         linear radiance, `var8` the same on the 8-bit gamma-encoded values 0..255; `MSE` against the reference (linear), `MSE8` the same in 8-bit units; `bias` \
          the mean signed error with its standard error `se` (runs' spread plus the reference's own noise) and `z = bias/se`; \
          `rms bias` the root mean squared per-pixel bias with the noise removed; `b-ratio = mean (m-r)^2 / mean (s^2/K + \
          var_ref)`, about 1 when unbiased; `eff = 1/(MSE x s)`; ratios are to the first row of each block. Seconds are wall \
@@ -444,17 +449,23 @@ pub fn markdown(rows: &[Row], cfg: &Config) -> String {
         };
         let _ = writeln!(md, "{head}\n");
         if !shown.contains(&sheet) {
-            let _ = writeln!(md, "![{sheet}]({sheet})\n");
+            let caption = if r0.table == "direct" {
+                "Tiles: the reference, then run 1 of random, stratified, grid-center, halton; top row 9, bottom row 25 light \
+                 samples (`v8` = var8, `rb` = rms bias)."
+            } else {
+                "Tiles: the reference, then run 1 of each technique at equal spp, then the faster one at equal time."
+            };
+            let _ = writeln!(md, "![{sheet}]({sheet})\n\n{caption} Images box-downsampled by {} for the sheet.\n", cfg.sheet_factor);
             shown.push(sheet);
         }
-        let _ = writeln!(md, "| variant | spp | s | var | var8 | var ratio | MSE | bias | se | z | rms bias | b-ratio | eff | eff ratio |");
-        let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(md, "| variant | spp | s | var | var8 | var ratio | MSE | MSE8 | bias | se | z | rms bias | b-ratio | eff | eff ratio |");
+        let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         let first = &rows[i].stats;
         for r in &rows[i..j] {
             let s = &r.stats;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} |",
                 r.variant,
                 s.spp,
                 g3(s.seconds),
@@ -462,6 +473,7 @@ pub fn markdown(rows: &[Row], cfg: &Config) -> String {
                 g3(s.variance_8bit),
                 g3(s.variance / first.variance),
                 g3(s.mse),
+                g3(s.mse_8bit),
                 g3(s.bias),
                 g3(s.bias_se),
                 s.z,

@@ -75,6 +75,9 @@ enum Cmd {
         /// Worker threads (0 = all cores).
         #[arg(long, default_value_t = 0)]
         threads: usize,
+        /// Contact-sheet tiles are the images box-downsampled by this factor.
+        #[arg(long, default_value_t = 2)]
+        sheet_factor: u32,
     },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
@@ -186,9 +189,9 @@ fn main() -> ExitCode {
         Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
             run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
         }
-        Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads } => {
+        Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
             let corpus = corpus.unwrap_or_else(strata::experiments::default_corpus);
-            let cfg = strata::experiments::Config { corpus, out: out.clone(), runs, width, ref_light_samples, ref_spp, threads, verbose: true };
+            let cfg = strata::experiments::Config { corpus, out: out.clone(), runs, width, ref_light_samples, ref_spp, threads, verbose: true, sheet_factor };
             strata::experiments::run(&cfg).map(|md| {
                 println!("{md}");
                 println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());

@@ -18,6 +18,7 @@ fn tiny_experiments_write_tables_sheets_and_plots() {
         ref_spp: 128,
         threads: 2,
         verbose: false,
+        sheet_factor: 1,
     };
     let md = strata::experiments::run(&cfg).expect("experiments run");
     for f in ["results.md", "results.json", "direct.svg", "direct-sphere.png", "direct-cornell.png", "direct-dragon.png"] {

@@ -146,10 +146,37 @@ pub fn layout(tiles: &[Tile], columns: usize, title: Option<&str>) -> Sheet {
     Sheet { width, height, rgb }
 }
 
-/// A tile from linear RGB, encoded with `gamma` (as the renderer's PNGs) and labelled.
-pub fn tile_from_linear(width: u32, height: u32, linear: &[[f32; 3]], gamma: f32, label: Vec<String>) -> Tile {
-    let rgb = linear.iter().map(|p| p.map(|v| crate::film::to_u8(v, gamma))).collect();
+/// A tile from linear RGB, box-downsampled by `factor` ([`box_downsample`]), encoded with `gamma`
+/// (as the renderer's PNGs) and labelled.
+pub fn tile_from_linear(width: u32, height: u32, linear: &[[f32; 3]], factor: u32, gamma: f32, label: Vec<String>) -> Tile {
+    let (width, height, small) = box_downsample(width, height, linear, factor);
+    let rgb = small.iter().map(|p| p.map(|v| crate::film::to_u8(v, gamma))).collect();
     Tile { width, height, rgb, label }
+}
+
+/// Box-filters linear RGB `rgb` (`width x height`) by an integer `factor` (at least 1): each output
+/// pixel is the mean of a `factor x factor` block; a partial block at the right or bottom edge is
+/// dropped. Returns the new width, height and pixels.
+pub fn box_downsample(width: u32, height: u32, rgb: &[[f32; 3]], factor: u32) -> (u32, u32, Vec<[f32; 3]>) {
+    let f = factor.max(1);
+    let (w, h) = (width / f, height / f);
+    let mut out = vec![[0.0f32; 3]; (w * h) as usize];
+    let norm = 1.0 / (f * f) as f32;
+    for y in 0..h {
+        for x in 0..w {
+            let mut acc = [0.0f32; 3];
+            for dy in 0..f {
+                for dx in 0..f {
+                    let p = rgb[((y * f + dy) * width + x * f + dx) as usize];
+                    for c in 0..3 {
+                        acc[c] += p[c];
+                    }
+                }
+            }
+            out[(y * w + x) as usize] = acc.map(|v| v * norm);
+        }
+    }
+    (w, h, out)
 }
 
 /// Encodes `sheet` as an 8-bit RGB PNG (best compression) and writes it atomically.
@@ -224,6 +251,16 @@ mod tests {
                 assert_ne!(s.rgb[(y * s.width + x) as usize], [255, 255, 255], "({x}, {y})");
             }
         }
+    }
+
+    #[test]
+    fn box_downsample_averages_blocks_and_drops_partial_edges() {
+        let rgb: Vec<[f32; 3]> = (0..5 * 3).map(|i| [i as f32, 2.0 * i as f32, 1.0]).collect();
+        let (w, h, d) = box_downsample(5, 3, &rgb, 2);
+        assert_eq!((w, h), (2, 1));
+        // block (0,0): pixels 0, 1, 5, 6 -> mean 3; block (1,0): 2, 3, 7, 8 -> mean 5
+        assert_eq!(d, vec![[3.0, 6.0, 1.0], [5.0, 10.0, 1.0]]);
+        assert_eq!(box_downsample(5, 3, &rgb, 1), (5, 3, rgb.clone()));
     }
 
     #[test]
