@@ -138,8 +138,11 @@ pub fn stats(runs: &[Vec<[f32; 3]>], reference: &[[f32; 3]], ref_var: &[[f32; 3]
     }
 }
 
+/// Linear RGB images, one per run.
+pub type Images = Vec<Vec<[f32; 3]>>;
+
 /// K renders of `opts` (seeds derived from 1..=K as `strata compare` does) at `spp`: the mean images and the mean seconds.
-pub fn runs(opts: &RenderOptions, spp: u32, k: usize) -> Result<(Vec<Vec<[f32; 3]>>, f64), String> {
+pub fn runs(opts: &RenderOptions, spp: u32, k: usize) -> Result<(Images, f64), String> {
     let (scene, integ) = app::prepare(opts)?;
     let pool = render::thread_pool(opts.threads).map_err(|e| e.to_string())?;
     let integ = integ.resampled(Some(spp));
@@ -513,4 +516,43 @@ pub fn run(cfg: &Config) -> Result<String, String> {
 /// `Path` of the corpus beside the crate or in `$STRATA_CSE168`.
 pub fn default_corpus() -> PathBuf {
     std::env::var_os("STRATA_CSE168").map(PathBuf::from).unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/cse168"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_of_synthetic_runs_have_the_known_answers() {
+        let r = vec![[0.25f32, 0.5, 0.75]; 6];
+        let zero = vec![[0.0f32; 3]; 6];
+        // Two runs at r - d and r + d: no bias, per-value variance 2 d^2, MSE d^2.
+        let d = 0.125f32;
+        let runs: Images = vec![r.iter().map(|p| p.map(|v| v - d)).collect(), r.iter().map(|p| p.map(|v| v + d)).collect()];
+        let s = stats(&runs, &r, &zero, 1.0, 2.0, 4);
+        assert_eq!((s.runs, s.spp), (2, 4));
+        assert!((s.variance - 2.0 * f64::from(d * d)).abs() < 1e-12, "{}", s.variance);
+        assert!((s.mse - f64::from(d * d)).abs() < 1e-12);
+        assert_eq!((s.bias, s.z, s.rms_bias), (0.0, 0.0, 0.0));
+        assert!((s.efficiency - 1.0 / (2.0 * f64::from(d * d))).abs() < 1e-9);
+        // 8-bit (gamma 1, x 255, rounded): 0.125/0.375 -> 32/96, 0.375/0.625 -> 96/159,
+        // 0.625/0.875 -> 159/223; variance (a - b)^2 / 2 per channel.
+        let want = (64.0f64.powi(2) + 63.0f64.powi(2) + 64.0f64.powi(2)) / 2.0 / 3.0;
+        assert!((s.variance_8bit - want).abs() < 1e-9, "{} vs {want}", s.variance_8bit);
+        // Identical runs offset by b: zero variance, all error is bias, z infinite.
+        let b = 0.0625f32;
+        let off: Vec<[f32; 3]> = r.iter().map(|p| p.map(|v| v + b)).collect();
+        let s = stats(&[off.clone(), off.clone(), off], &r, &zero, 1.0, 1.0, 1);
+        assert_eq!(s.variance, 0.0);
+        assert!((s.bias - f64::from(b)).abs() < 1e-12 && (s.rms_bias - f64::from(b)).abs() < 1e-9);
+        assert_eq!(s.z, f64::INFINITY);
+        // The reference's own variance enters the standard error: M = 18 values of variance v
+        // give a mean with variance v / 18.
+        let v = 0.02f32;
+        let noisy = vec![[v; 3]; 6];
+        let runs: Images = vec![r.clone(), r.clone()];
+        let s = stats(&runs, &r, &noisy, 1.0, 1.0, 1);
+        assert!((s.bias_se - (f64::from(v) / 18.0).sqrt()).abs() < 1e-9, "{}", s.bias_se);
+        assert!(s.bias_ratio < 1e-12, "no error at all: ratio 0");
+    }
 }

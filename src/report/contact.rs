@@ -97,6 +97,7 @@ pub fn glyph(c: char) -> [u8; 7] {
 
 /// Draws `text` with its top-left corner at (x, y) in `color`, clipped to the `w x h` image and to
 /// x < `clip_x`.
+#[allow(clippy::too_many_arguments)]
 fn draw_text(rgb: &mut [[u8; 3]], w: u32, h: u32, x: u32, y: u32, clip_x: u32, text: &str, color: [u8; 3]) {
     for (i, c) in text.chars().enumerate() {
         let gx = x + i as u32 * GLYPH_W;
