@@ -66,6 +66,8 @@ pub struct RenderOptions {
     pub stop: Option<Arc<AtomicBool>>,
     /// camera override (`--camera`), for `.obj` and `.test` scenes alike
     pub camera: Option<crate::scene::desc::CameraDesc>,
+    /// path tracer: direction sampling override (default: the scene's `importancesampling`)
+    pub importance_sampling: Option<crate::scene::desc::ImportanceSampling>,
 }
 
 /// Default seconds between two checkpoints.
@@ -115,6 +117,9 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
     if let Some(c) = opts.camera {
         desc.camera = Some(c);
     }
+    if let Some(s) = opts.importance_sampling {
+        desc.importance_sampling = s;
+    }
     Ok(desc)
 }
 
@@ -150,6 +155,17 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
         "analyticdirect" => IntegratorKind::AnalyticDirect,
         "direct" => IntegratorKind::Direct,
         "pathtracer" => IntegratorKind::PathTracer,
+        _ => return None,
+    })
+}
+
+/// Parses a direction sampling strategy as the format spells it: hemisphere, cosine or brdf.
+pub fn parse_importance_sampling(s: &str) -> Option<crate::scene::desc::ImportanceSampling> {
+    use crate::scene::desc::ImportanceSampling as I;
+    Some(match s {
+        "hemisphere" => I::Hemisphere,
+        "cosine" => I::Cosine,
+        "brdf" => I::Brdf,
         _ => return None,
     })
 }
