@@ -62,7 +62,9 @@ fn agreement(a: &Est, b: &Est) -> (f64, usize) {
 /// Every estimator of the same transport (maxdepth 3, no roulette) agrees with a MIS + BRDF
 /// reference rendered with another seed: aggregate |z| < 4.5 over 1728 pixel channels (false alarm
 /// ~7e-6 each for a Gaussian aggregate; 8 comparisons) and under 1% of channels beyond |z| = 5
-/// (heavy-tailed estimators make per-pixel variance estimates rough). A different light transport
+/// (heavy-tailed estimators make per-pixel variance estimates rough: hemisphere and cosine sampling
+/// without NEE find the glossy sphere's reflection of the light rarely, so they get 4096 spp, at
+/// 1024 a seed left 10 pixels with the light unfound). A different light transport
 /// (maxdepth 1) must fail the same test, so the test has power.
 #[test]
 fn estimators_agree_with_each_other() {
@@ -70,8 +72,8 @@ fn estimators_agree_with_each_other() {
     let with = |extra: &[&'static str]| depth.iter().copied().chain(extra.iter().copied()).collect::<Vec<_>>();
     let reference = estimate("ref", &with(&["importancesampling brdf", "nexteventestimation mis"]), 512, 1);
     let cases: [(&str, Vec<&str>, u32); 8] = [
-        ("hemi-off", with(&["importancesampling hemisphere", "nexteventestimation off"]), 1024),
-        ("cos-off", with(&["importancesampling cosine", "nexteventestimation off"]), 1024),
+        ("hemi-off", with(&["importancesampling hemisphere", "nexteventestimation off"]), 4096),
+        ("cos-off", with(&["importancesampling cosine", "nexteventestimation off"]), 4096),
         ("brdf-off", with(&["importancesampling brdf", "nexteventestimation off"]), 1024),
         ("hemi-on", with(&["importancesampling hemisphere", "nexteventestimation on"]), 256),
         ("cos-on", with(&["importancesampling cosine", "nexteventestimation on"]), 256),
