@@ -103,6 +103,10 @@ struct RenderArgs {
     /// `kernel` in --stats), `general` the one with every feature compiled in. Same image either way.
     #[arg(long, default_value = "auto", value_parser = ["auto", "general"])]
     kernel: String,
+    /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
+    /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth.
+    #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_limit)]
+    limits: Vec<String>,
 }
 
 impl RenderArgs {
@@ -121,8 +125,23 @@ impl RenderArgs {
             integrator: self.integrator,
             progress: !self.quiet,
             general_kernel: self.kernel == "general",
+            limits: limits_of(&self.limits),
         }
     }
+}
+
+/// Checks one `--limit NAME=VALUE` (the assignment is applied again in [`limits_of`]).
+fn parse_limit(s: &str) -> Result<String, String> {
+    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string())
+}
+
+/// The default limits with every (already checked) `--limit` applied in order.
+fn limits_of(assignments: &[String]) -> strata::scene::parse::Limits {
+    let mut limits = strata::scene::parse::Limits::default();
+    for a in assignments {
+        let _ = limits.set(a); // validated by `parse_limit`
+    }
+    limits
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
