@@ -382,7 +382,7 @@ fn a_write_cut_short_never_truncates_the_final_files() {
     assert!(exr.len() > 8 * 1024, "the EXR must exceed the 4 KiB limit below ({} bytes)", exr.len());
     // 4 KiB file-size limit (ulimit -f counts 1024-byte blocks in sh/dash), SIGXFSZ ignored so
     // that write() fails with EFBIG instead of killing the process.
-    let script = format!("trap '' XFSZ; ulimit -f 4 && exec \"$0\" \"$@\"");
+    let script = "trap '' XFSZ; ulimit -f 4 && exec \"$0\" \"$@\"";
     let cut = std::process::Command::new("/bin/sh").arg("-c").arg(script).arg(bin).args(args("2")).output().unwrap();
     let stderr = String::from_utf8_lossy(&cut.stderr);
     assert!(!cut.status.success(), "the write under a 4 KiB limit must fail");
