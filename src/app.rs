@@ -68,6 +68,8 @@ pub struct RenderOptions {
     pub camera: Option<crate::scene::desc::CameraDesc>,
     /// path tracer: direction sampling override (default: the scene's `importancesampling`)
     pub importance_sampling: Option<crate::scene::desc::ImportanceSampling>,
+    /// resource caps (`--limit NAME=VALUE`), applied to the scene file and to the overrides
+    pub limits: Limits,
 }
 
 /// Default seconds between two checkpoints.
@@ -98,15 +100,23 @@ pub struct RenderOutput {
 
 /// Parses the scene named in `opts` (or the built-in one) and applies the size override.
 pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
-    let limits = Limits::default();
+    let limits = opts.limits;
     let mut desc = match &opts.scene {
         Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits).map_err(|e| e.to_string())?,
         Some(p) => parse::parse_file(p, &limits).map_err(|e| e.to_string())?,
         None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits).map_err(|e| e.to_string())?,
     };
     if let Some((w, h)) = opts.size {
-        if w == 0 || h == 0 || u64::from(w) * u64::from(h) > limits.max_pixels || w > limits.max_side || h > limits.max_side {
-            return Err(format!("--size {w}x{h} is outside 1..={} per side and {} pixels", limits.max_side, limits.max_pixels));
+        if w == 0 || h == 0 {
+            return Err(format!("--size {w}x{h}: width and height must be positive"));
+        }
+        if w.max(h) > limits.max_side {
+            let (max, hint) = (limits.max_side, parse::limit_hint("max_side"));
+            return Err(format!("--size {w}x{h} exceeds the limit of {max} pixels per side ({hint})"));
+        }
+        if u64::from(w) * u64::from(h) > limits.max_pixels {
+            let (max, hint) = (limits.max_pixels, parse::limit_hint("max_pixels"));
+            return Err(format!("--size {w}x{h} exceeds the limit of {max} pixels ({hint})"));
         }
         desc.width = w;
         desc.height = h;
@@ -179,6 +189,14 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
         IntegratorKind::RayTracer | IntegratorKind::AnalyticDirect | IntegratorKind::Direct | IntegratorKind::PathTracer => {}
     }
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
+    if spp > opts.limits.max_spp {
+        let (max, hint) = (opts.limits.max_spp, parse::limit_hint("max_spp"));
+        return Err(format!("--spp {spp} exceeds the limit of {max} ({hint})"));
+    }
+    if let Some(n) = opts.light_samples.filter(|&n| n > opts.limits.max_light_samples) {
+        let (max, hint) = (opts.limits.max_light_samples, parse::limit_hint("max_light_samples"));
+        return Err(format!("--light-samples {n} exceeds the limit of {max} ({hint})"));
+    }
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
     let mut integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
     if opts.general_kernel {

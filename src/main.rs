@@ -183,6 +183,10 @@ struct RenderArgs {
     /// (independent pixel and path layouts; --spp, if given, caps the samples).
     #[arg(long)]
     time_budget: Option<f64>,
+    /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
+    /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth.
+    #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_limit)]
+    limits: Vec<String>,
 }
 
 impl RenderArgs {
@@ -210,8 +214,23 @@ impl RenderArgs {
             stop: None,
             camera: self.camera,
             importance_sampling: self.importance_sampling,
+            limits: limits_of(&self.limits),
         }
     }
+}
+
+/// Checks one `--limit NAME=VALUE` (the assignment is applied again in [`limits_of`]).
+fn parse_limit(s: &str) -> Result<String, String> {
+    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string())
+}
+
+/// The default limits with every (already checked) `--limit` applied in order.
+fn limits_of(assignments: &[String]) -> strata::scene::parse::Limits {
+    let mut limits = strata::scene::parse::Limits::default();
+    for a in assignments {
+        let _ = limits.set(a); // validated by `parse_limit`
+    }
+    limits
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {

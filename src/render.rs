@@ -258,3 +258,29 @@ pub fn tile_packets(x0: u32, y0: u32, tw: u32, th: u32, w: u32, h: u32) -> Vec<P
         .map(|(px, py)| PixelPacket::new(x0 + px * PACKET_W, y0 + py * PACKET_H, w, h))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::{Vec3x8, F8};
+
+    /// A NaN or infinite lane is counted in `nonfinite` and accumulated as zero; finite lanes and
+    /// inactive lanes are untouched. (Without the check the NaN would reach the film's sums.)
+    #[test]
+    fn nonfinite_samples_are_counted_and_never_reach_the_film() {
+        let pk = PixelPacket::new(0, 0, 3, 2); // a 4x2 packet clipped to 3 columns: lanes 3, 7 inactive
+        let bad = [f32::NAN, f32::INFINITY, -f32::INFINITY, 1.0, 2.0, f32::NAN, 0.5, f32::NAN];
+        let l = Vec3x8::new(F8::new(bad), F8::splat(1.0), F8::splat(1.0));
+        // One leaf per pixel of the 3x2 tile, at stack depth 0 (no carries).
+        let mut data = vec![[0.0f64; 6]; 6];
+        let mut c = Counters::default();
+        accumulate(&mut data, 6, 0, 0, &pk, 0, 0, 3, &l, &mut c);
+        assert_eq!(c.nonfinite, 4, "lanes 0, 1, 2 and 5 (lane 3 and 7 are outside the image)");
+        assert!(data.iter().flatten().all(|v: &f64| v.is_finite()));
+        let sum: Vec<[f64; 3]> = data.iter().map(|m| [m[0], m[1], m[2]]).collect();
+        // Pixels (row-major in the 3-wide tile) of lanes 0, 1, 2, 4, 5, 6.
+        assert_eq!(sum.iter().map(|p| p[0]).collect::<Vec<_>>(), [0.0, 0.0, 0.0, 2.0, 0.0, 0.5]);
+        assert_eq!(sum[0], [0.0; 3], "a rejected sample is zero in every channel");
+        assert_eq!(sum[3], [2.0, 1.0, 1.0]);
+    }
+}

@@ -15,6 +15,8 @@
 //! - geometries from [`GEOM_FIRST_INSTANCE`] on: instances (hits report `inst_id`).
 //! Geometry kinds must be added in this order; a kind may be skipped.
 
+pub mod alloc;
+
 use crate::simd::{mask_to_valid, Mask8, Vec3x8, F8, U8};
 use embree4_sys as sys;
 use glam::{Mat4, Vec3, Vec4};

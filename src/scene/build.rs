@@ -248,9 +248,17 @@ impl Scene {
 
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for v in &vertices {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
+        // Zero-area triangles are never hit; a stray one far away must not inflate the extent
+        // (and with it every ray offset). Each vertex belongs to one triangle.
+        for (t, n) in indices.iter().zip(&tri_normal) {
+            if *n == Vec3::ZERO {
+                continue;
+            }
+            for &i in t {
+                let v = vertices[i as usize];
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
         }
         for m in &ell_o2w {
             let c = m.w_axis.truncate();

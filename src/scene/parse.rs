@@ -71,6 +71,56 @@ impl Default for Limits {
     }
 }
 
+impl Limits {
+    /// Names of the limits, as `--limit NAME=VALUE` spells them (the field names).
+    pub const NAMES: [&'static str; 8] = [
+        "max_pixels",
+        "max_side",
+        "max_vertices",
+        "max_primitives",
+        "max_spp",
+        "max_depth",
+        "max_light_samples",
+        "max_transform_depth",
+    ];
+
+    /// Sets one limit from `NAME=VALUE` (the `--limit` flag); VALUE is a non-negative integer that
+    /// must fit the field. Errors name the known limits.
+    pub fn set(&mut self, assignment: &str) -> Result<(), String> {
+        let (name, value) = assignment
+            .split_once('=')
+            .ok_or_else(|| format!("--limit `{assignment}`: expected NAME=VALUE, NAME one of {}", Self::NAMES.join(", ")))?;
+        let (name, value) = (name.trim(), value.trim());
+        let v: u64 = value
+            .parse()
+            .map_err(|_| format!("--limit {name}: expected a non-negative integer, got `{value}`"))?;
+        let range = |max: u64| {
+            if v <= max {
+                Ok(v)
+            } else {
+                Err(format!("--limit {name}={v}: at most {max}"))
+            }
+        };
+        match name {
+            "max_pixels" => self.max_pixels = v,
+            "max_side" => self.max_side = range(u32::MAX.into())? as u32,
+            "max_vertices" => self.max_vertices = range(usize::MAX as u64)? as usize,
+            "max_primitives" => self.max_primitives = range(usize::MAX as u64)? as usize,
+            "max_spp" => self.max_spp = range(u32::MAX.into())? as u32,
+            "max_depth" => self.max_depth = range(i32::MAX as u64)? as i32,
+            "max_light_samples" => self.max_light_samples = range(u32::MAX.into())? as u32,
+            "max_transform_depth" => self.max_transform_depth = range(usize::MAX as u64)? as usize,
+            _ => return Err(format!("--limit: unknown limit `{name}` (one of {})", Self::NAMES.join(", "))),
+        }
+        Ok(())
+    }
+}
+
+/// How to raise a limit: the `--limit` flag with the field's name (`Limits::set`).
+pub fn limit_hint(field: &str) -> String {
+    format!("raise it with --limit {field}=N")
+}
+
 /// Reads and parses a `.test` file. An unreadable file is an error on line 0.
 pub fn parse_file(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneError> {
     let error = |line, message| SceneError { file: path.to_path_buf(), line, message };
@@ -117,9 +167,9 @@ fn show(token: &str) -> String {
     }
 }
 
-/// How to raise a limit: the `Limits` field and the matching command-line flag.
+/// How to raise a limit (see [`limit_hint`]).
 fn hint(field: &str) -> String {
-    format!("Limits::{field} / --{}", field.replace('_', "-"))
+    limit_hint(field)
 }
 
 /// One command line split into its command and arguments.
@@ -811,7 +861,7 @@ mod tests {
         expect_err("vertex 0 0 0\ntri 0 0 -1", 2, &["tri index -1", "1 vertices"]);
         expect_err("tri 0 1 2.5", 1, &["tri", "expected an integer", "'2.5'"]);
         expect_err("pushTransform\npopTransform\npopTransform", 3, &["popTransform", "empty"]);
-        expect_err("size 1000000 1000000", 1, &["1000000x1000000", "268435456 pixels", "max_pixels", "--max-pixels"]);
+        expect_err("size 1000000 1000000", 1, &["1000000x1000000", "268435456 pixels", "--limit max_pixels=N"]);
         expect_err("size 100000 2", 1, &["65536", "max_side"]);
         expect_err("size 0 10", 1, &["size", "positive"]);
         expect_err("scale 1 1 1\nscale 1 0 1", 2, &["scale", "non-zero"]);
