@@ -189,6 +189,11 @@ impl Film {
         self.refresh();
     }
 
+    /// Frees the block moments before [`Film::set_state`] replaces them (the totals stay).
+    pub(crate) fn drop_block_data(&mut self) {
+        self.data = Vec::new();
+    }
+
     /// Adds sample index `s` for every pixel (`rgb[p]` for pixel p); `s` must be the next sample
     /// of the film's range (any index for an empty film). The scalar reference of the renderer's
     /// accumulation. Panics on a wrong index or length.

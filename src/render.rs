@@ -123,6 +123,7 @@ pub fn render(
         push_block(&mut blocks, Block::leaf(s));
     });
     let n = film.pixels();
+    film.drop_block_data(); // the tiles hold the continued blocks: peak memory 2x the state, not 3x
     let mut data = vec![[0.0; 6]; blocks.len() * n];
     for (tile, c, busy) in &results {
         stats.counters.merge(c);

@@ -252,11 +252,17 @@ fn time_budget_renders_whole_passes_and_records_spp() {
     run_ok(c);
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     let spp = j["spp"].as_u64().unwrap();
-    assert!(spp >= 1 && spp < 4000, "spp reached {spp}");
+    assert!((1..=4000).contains(&spp), "spp reached {spp}");
     assert_eq!(j["layout"], "time-budget");
     let (_, _, meta) = image(&d.join("b"));
     assert_eq!(meta["strata.spp"], spp.to_string());
     assert_eq!(meta["strata.pixel_sampler"], "independent", "budget renders use spp-free layouts");
-    assert_eq!(j["rays"]["camera"].as_u64().unwrap(), 64 * 48 * spp);
+    assert_eq!(j["rays"]["camera"].as_u64().unwrap(), 64 * 48 * spp, "whole passes: every pixel got spp samples");
+    // --spp caps a budgeted render (a budget far larger than the 24 samples need).
+    let mut c = render_cmd(24, &d.join("c"), &["--time-budget", "300"]);
+    c.arg("--stats").arg(&stats);
+    run_ok(c);
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(j["spp"], 24);
     std::fs::remove_dir_all(&d).ok();
 }
