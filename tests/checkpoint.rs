@@ -185,6 +185,12 @@ fn shards_from_parallel_processes_merge_bit_identically() {
     run_ok(c);
     let e = merge_err(&[parts[3].clone(), d.join("other.ckpt"), parts[2].clone(), parts[0].clone()]);
     assert!(e.contains("does not belong") && e.contains("pixel_sampler"), "{e}");
+    // A part that did not finish its range (as a killed shard leaves it) is refused.
+    let (mut h, f) = strata::checkpoint::read(&parts[0]).unwrap();
+    h.target = [65, 120];
+    strata::checkpoint::write(&d.join("unfinished.ckpt"), &h, &f).unwrap();
+    let e = merge_err(&[parts[3].clone(), parts[2].clone(), parts[1].clone(), d.join("unfinished.ckpt")]);
+    assert!(e.contains("unfinished part") && e.contains("samples 65..100 of its range 65..120"), "{e}");
     assert!(!d.join("bad.exr").exists());
     std::fs::remove_dir_all(&d).ok();
 }
