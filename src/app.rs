@@ -48,6 +48,8 @@ pub struct RenderOptions {
     pub progress: bool,
     /// run the general kernel instead of the one specialized for the scene's features
     pub general_kernel: bool,
+    /// path tracer: clamp each pixel sample's largest channel to this value (biased; None = off)
+    pub clamp: Option<f32>,
     /// checkpoint file: the accumulated state is written there every `checkpoint_every` seconds
     /// and at the end (default with `--samples` or on interruption: OUT.ckpt)
     pub checkpoint: Option<PathBuf>,
@@ -145,6 +147,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
+    integrator.clamp = opts.clamp;
     Ok((scene, integrator))
 }
 
@@ -169,6 +172,7 @@ pub fn identity(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<
         ("light_samples", json!(it.light_set.n())),
         ("layout", json!(if opts.time_budget.is_some() { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
+        ("clamp", json!(it.clamp)),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
@@ -458,6 +462,8 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "russian_roulette": out.integrator.russian_roulette,
         "importance_sampling": format!("{:?}", out.integrator.strategy).to_lowercase(),
         "nonfinite_samples": c.nonfinite,
+        "clamp": out.integrator.clamp,
+        "biased": out.integrator.clamp.is_some(),
         "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
@@ -478,7 +484,7 @@ pub fn summary(out: &RenderOutput) -> String {
             format!("{:?}", it.strategy).to_lowercase(),
             if it.russian_roulette { "on" } else { "off" },
             it.max_depth
-        ),
+        ) + &it.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default(),
         _ => String::new(),
     };
     format!(
