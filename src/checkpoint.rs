@@ -40,7 +40,7 @@ pub struct Header {
     pub samples: [u32; 2],
     /// the dyadic blocks of `samples`, as (k, j)
     pub blocks: Vec<[u32; 2]>,
-    /// thread-seconds spent rendering (summed over sessions and parts)
+    /// CPU seconds of the worker threads rendering tiles (summed over sessions and parts)
     pub cpu_seconds: f64,
     /// wall-clock seconds of rendering (summed over sessions)
     pub render_seconds: f64,
