@@ -40,7 +40,7 @@ pub struct Header {
     pub samples: [u32; 2],
     /// the dyadic blocks of `samples`, as (k, j)
     pub blocks: Vec<[u32; 2]>,
-    /// thread-seconds spent rendering (summed over sessions and parts)
+    /// CPU seconds of the worker threads rendering tiles (summed over sessions and parts)
     pub cpu_seconds: f64,
     /// wall-clock seconds of rendering (summed over sessions)
     pub render_seconds: f64,
@@ -163,6 +163,10 @@ pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), String> {
     let hend = 20 + hlen as usize;
     let header: Header = serde_json::from_slice(&bytes[20..hend]).map_err(|e| bad(format!("corrupt header: {e}")))?;
     let pixels = header.width as u64 * header.height as u64;
+    let max = crate::scene::parse::Limits::default().max_pixels;
+    if pixels == 0 || pixels > max {
+        return Err(bad(format!("image size {}x{} outside 1..={max} pixels", header.width, header.height)));
+    }
     let expected = (hend as u64).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
     if expected != bytes.len() as u64 {
         return Err(bad(format!(

@@ -76,11 +76,19 @@ pub fn push_block(blocks: &mut Vec<Block>, mut b: Block) -> usize {
     carries
 }
 
-/// The canonical (minimal, aligned) dyadic blocks of the sample range `r`, in increasing order.
+/// The canonical (minimal, aligned) dyadic blocks of the sample range `r`, in increasing order:
+/// from the left, the largest aligned block that fits (what [`push_block`] builds sample by
+/// sample), in O(log) steps.
 pub fn canonical_blocks(r: Range<u32>) -> Vec<Block> {
+    let (mut x, hi) = (u64::from(r.start), u64::from(r.end));
     let mut blocks = Vec::new();
-    for s in r {
-        push_block(&mut blocks, Block::leaf(s));
+    while x < hi {
+        let mut k = x.trailing_zeros().min(32);
+        while (1u64 << k) > hi - x {
+            k -= 1;
+        }
+        blocks.push(Block { k: k as u8, j: (x >> k) as u32 });
+        x += 1 << k;
     }
     blocks
 }
@@ -187,6 +195,11 @@ impl Film {
         self.blocks = blocks;
         self.data = data;
         self.refresh();
+    }
+
+    /// Frees the block moments before [`Film::set_state`] replaces them (the totals stay).
+    pub(crate) fn drop_block_data(&mut self) {
+        self.data = Vec::new();
     }
 
     /// Adds sample index `s` for every pixel (`rgb[p]` for pixel p); `s` must be the next sample
@@ -533,6 +546,8 @@ mod tests {
         assert_eq!(canonical_blocks(3..13), vec![b(0, 3), b(2, 1), b(2, 2), b(0, 12)]);
         assert_eq!(canonical_blocks(0..64), vec![b(6, 0)]);
         assert_eq!(canonical_blocks(5..5), vec![]);
+        assert_eq!(canonical_blocks(0..u32::MAX).len(), 32);
+        assert_eq!(canonical_blocks(1 << 31..(1 << 31) + 1), vec![b(0, 1 << 31)]);
         for lo in 0..40u32 {
             for hi in lo..80 {
                 let bl = canonical_blocks(lo..hi);
@@ -546,6 +561,11 @@ mod tests {
                     at = x.end();
                 }
                 assert_eq!(at, u64::from(hi));
+                let mut counter = Vec::new();
+                (lo..hi).for_each(|s| {
+                    push_block(&mut counter, Block::leaf(s));
+                });
+                assert_eq!(counter, bl, "{lo}..{hi}: the binary counter builds the canonical blocks");
                 assert!(bl.len() <= 2 * (32 - (hi - lo).max(1).leading_zeros()) as usize, "{lo}..{hi}: {} blocks", bl.len());
             }
         }

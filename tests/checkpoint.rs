@@ -185,6 +185,12 @@ fn shards_from_parallel_processes_merge_bit_identically() {
     run_ok(c);
     let e = merge_err(&[parts[3].clone(), d.join("other.ckpt"), parts[2].clone(), parts[0].clone()]);
     assert!(e.contains("does not belong") && e.contains("pixel_sampler"), "{e}");
+    // A part that did not finish its range (as a killed shard leaves it) is refused.
+    let (mut h, f) = strata::checkpoint::read(&parts[0]).unwrap();
+    h.target = [65, 120];
+    strata::checkpoint::write(&d.join("unfinished.ckpt"), &h, &f).unwrap();
+    let e = merge_err(&[parts[3].clone(), parts[2].clone(), parts[1].clone(), d.join("unfinished.ckpt")]);
+    assert!(e.contains("unfinished part") && e.contains("samples 65..100 of its range 65..120"), "{e}");
     assert!(!d.join("bad.exr").exists());
     std::fs::remove_dir_all(&d).ok();
 }
@@ -252,12 +258,18 @@ fn time_budget_renders_whole_passes_and_records_spp() {
     run_ok(c);
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     let spp = j["spp"].as_u64().unwrap();
-    assert!(spp >= 1 && spp < 4000, "spp reached {spp}");
+    assert!((1..=4000).contains(&spp), "spp reached {spp}");
     assert_eq!(j["layout"], "time-budget");
     let (_, _, meta) = image(&d.join("b"));
     assert_eq!(meta["strata.spp"], spp.to_string());
     assert_eq!(meta["strata.pixel_sampler"], "independent", "budget renders use spp-free layouts");
-    assert_eq!(j["rays"]["camera"].as_u64().unwrap(), 64 * 48 * spp);
+    assert_eq!(j["rays"]["camera"].as_u64().unwrap(), 64 * 48 * spp, "whole passes: every pixel got spp samples");
+    // --spp caps a budgeted render (a budget far larger than the 24 samples need).
+    let mut c = render_cmd(24, &d.join("c"), &["--time-budget", "300"]);
+    c.arg("--stats").arg(&stats);
+    run_ok(c);
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(j["spp"], 24);
     std::fs::remove_dir_all(&d).ok();
 }
 
