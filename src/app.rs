@@ -45,6 +45,8 @@ pub struct RenderOptions {
     pub general_kernel: bool,
     /// camera override (`--camera`), for `.obj` and `.test` scenes alike
     pub camera: Option<crate::scene::desc::CameraDesc>,
+    /// path tracer: clamp each pixel sample's largest channel to this value (biased; None = off)
+    pub clamp: Option<f32>,
 }
 
 /// Everything a render produced.
@@ -135,6 +137,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
+    integrator.clamp = opts.clamp;
     Ok((scene, integrator))
 }
 
@@ -259,6 +262,8 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "russian_roulette": out.integrator.russian_roulette,
         "importance_sampling": format!("{:?}", out.integrator.strategy).to_lowercase(),
         "nonfinite_samples": c.nonfinite,
+        "clamp": out.integrator.clamp,
+        "biased": out.integrator.clamp.is_some(),
         "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
@@ -279,7 +284,7 @@ pub fn summary(out: &RenderOutput) -> String {
             format!("{:?}", it.strategy).to_lowercase(),
             if it.russian_roulette { "on" } else { "off" },
             it.max_depth
-        ),
+        ) + &it.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default(),
         _ => String::new(),
     };
     format!(

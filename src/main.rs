@@ -116,6 +116,10 @@ struct RenderArgs {
     /// `kernel` in --stats), `general` the one with every feature compiled in. Same image either way.
     #[arg(long, default_value = "auto", value_parser = ["auto", "general"])]
     kernel: String,
+    /// Path tracer only, opt-in and BIASED: scale each pixel sample down so its largest RGB channel is
+    /// at most MAX (trades fireflies for a darker, inconsistent estimate; off by default).
+    #[arg(long, value_name = "MAX", value_parser = parse_clamp)]
+    clamp: Option<f32>,
 }
 
 impl RenderArgs {
@@ -135,6 +139,7 @@ impl RenderArgs {
             progress: !self.quiet,
             general_kernel: self.kernel == "general",
             camera: self.camera,
+            clamp: self.clamp,
         }
     }
 }
@@ -143,6 +148,13 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got `{s}`"))?;
     let p = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected WxH with positive integers, got `{s}`"));
     Ok((p(w)?, p(h)?))
+}
+
+fn parse_clamp(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("--clamp expects a positive finite radiance, got `{s}`")),
+    }
 }
 
 fn parse_sampler(s: &str) -> Result<SamplerKind, String> {

@@ -63,6 +63,7 @@ fn stats_report_features() {
     assert_eq!(f["materials"], serde_json::json!(["diffuse"]));
     assert_eq!(f["geometry"], serde_json::json!(["triangles", "spheres"]));
     assert_eq!(f["quad_lights"], 1);
+    assert_eq!(f["light_selection"], "single");
     assert_eq!(f["nee"], "on");
     assert_eq!(j["kernel"], "pathtracer<lobes=none>");
 }

@@ -144,3 +144,23 @@ fn path_tracing_is_bit_identical_across_thread_counts() {
     assert_eq!(a.sum.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>(), b.sum.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>());
     assert_eq!(a.sum_sq, b.sum_sq);
 }
+
+/// `--clamp MAX` (opt-in, biased): every sample's largest channel is at most MAX, so every pixel
+/// mean is too; it darkens a scene whose unclamped samples exceed MAX, and the stats say biased.
+#[test]
+fn clamp_bounds_every_sample_and_reports_bias() {
+    let scene = variant("clamp", &["integrator pathtracer", "nexteventestimation on", "maxdepth 3"]);
+    let free = strata::app::render_to_film(&opts(scene.clone(), 24, 24, 8)).unwrap();
+    let clamped = strata::app::render_to_film(&RenderOptions { clamp: Some(0.5), ..opts(scene, 24, 24, 8) }).unwrap();
+    let (mf, mc) = (means(&free.film), means(&clamped.film));
+    let top = |m: &[[f64; 3]]| m.iter().flatten().fold(0f64, |a, &v| a.max(v));
+    assert!(top(&mf) > 0.5, "the unclamped image must exceed the clamp for the test to mean anything");
+    assert!(top(&mc) <= 0.5 + 1e-6, "clamped pixel mean {} above 0.5", top(&mc));
+    let sum = |m: &[[f64; 3]]| m.iter().flatten().sum::<f64>();
+    assert!(sum(&mc) < sum(&mf), "clamping must darken");
+    let j = strata::app::stats_json(&clamped);
+    assert_eq!(j["biased"], serde_json::json!(true));
+    assert_eq!(j["clamp"], serde_json::json!(0.5));
+    assert!(strata::app::summary(&clamped).contains("biased"));
+    assert_eq!(strata::app::stats_json(&free)["biased"], serde_json::json!(false));
+}

@@ -5,7 +5,12 @@
 //! Specialization changes speed, never results: a specialized kernel differs from the general one
 //! only by code that, under the scene's [`Lobes`] promise, adds exact zeros (tested bit for bit
 //! in `tests/kernels.rs`). Settings that are uniform over a render (NEE mode, Russian roulette,
-//! strategy) are branched on once per packet and are not worth a monomorphized copy.
+//! strategy) are branched on once per packet and are not worth a monomorphized copy. What else a
+//! scene does not use costs nothing either: with one light the path tracer splats it instead of
+//! gathering a per-lane choice (and skips drawing the choice dimension unless BRDF sampling needs
+//! its lobe pick); MIS weights are computed only under `nexteventestimation mis`; a scene without
+//! spheres has no Embree user geometry, so no callback ever runs; primary packets carry Embree's
+//! coherent flag, later ones not.
 
 use crate::bsdf::Lobes;
 use crate::scene::build::Scene;
@@ -72,6 +77,12 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         "geometry": geometry,
         "quad_lights": scene.lights.len(),
         "emissive_triangles": scene.emitters.n_triangles(),
+        "light_selection": match (scene.emitters.len(), scene.emitters.n_triangles()) {
+            (0, _) => "none",
+            (1, _) => "single",
+            (_, 0) => "uniform",
+            _ => "power",
+        },
         "point_lights": d.point_lights.len(),
         "directional_lights": d.directional_lights.len(),
         "integrator": crate::app::integrator_name(kind),

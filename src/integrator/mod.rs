@@ -148,6 +148,9 @@ pub struct Integrator {
     pub max_depth: i32,
     /// the kernel that runs (specialized for the scene's features, or [`Kernel::GENERAL`])
     pub kernel: Kernel,
+    /// path tracer, opt-in and biased: each pixel sample is scaled so its largest channel is at
+    /// most this radiance (None: no clamping, the unbiased default)
+    pub clamp: Option<f32>,
 }
 
 impl Integrator {
@@ -175,6 +178,7 @@ impl Integrator {
             strategy: d.importance_sampling,
             max_depth: d.max_depth,
             kernel: Kernel::for_scene(scene),
+            clamp: None,
         }
     }
 

@@ -5,9 +5,9 @@
 //!
 //! Vertex numbering: vertex 1 is the camera hit. `maxdepth N` (FORMAT.md): with NEE, direct light
 //! is gathered at vertices 1..N (N = 1 is direct lighting); without NEE, emission is counted at
-//! vertices 1..N+1. Emission of quad lights follows the NEE mode (off: always; on: vertex 1 only;
+//! vertices 1..N+1. Emission of area lights (quads, emissive triangles) follows the NEE mode (off: always; on: vertex 1 only;
 //! MIS: vertex 1, then weighted against the light-sampling pdf); `emission` of materials is not
-//! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping.
+//! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping unless `--clamp` asks for it (biased, reported).
 //!
 //! Sampler dimensions of vertex v: `DIM_PATH_BASE + 4 (v-1) + {0: light point, 1: (light choice,
 //! lobe choice), 2: BSDF direction, 3: (Russian roulette, -)}`. Each is a stratified set over the
@@ -21,7 +21,7 @@ use crate::render::PixelPacket;
 use crate::sampler::permute_x8;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
-use crate::scene::desc::Nee;
+use crate::scene::desc::{ImportanceSampling, Nee};
 use crate::simd::{mask_from_bools, mask_to_bools, Frame8, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 
@@ -30,7 +30,8 @@ pub const DIM_PATH_BASE: u32 = 64;
 /// Hard cap on path vertices when `maxdepth -1` (Russian roulette normally ends paths far sooner).
 pub const MAX_VERTICES_UNBOUNDED: u32 = 4096;
 
-/// One live path between bounces (AoS, so that compaction is a plain copy).
+/// One live path between bounces (AoS, so that compaction is a plain copy). The wavefront is kept
+/// padded to a multiple of 8 with [`PathLane::DEAD`] lanes, so packets are read without bounds checks.
 #[derive(Clone, Copy, Debug)]
 struct PathLane {
     /// index of (tile packet, lane) whose pixel this path belongs to: packet * 8 + lane
@@ -46,6 +47,24 @@ struct PathLane {
     beta: Vec3,
     /// solid-angle pdf with which `d` was sampled (for the MIS weight of emission found along it)
     pdf: f32,
+}
+
+impl PathLane {
+    /// Padding lane: traced inactive, contributes nothing, never continues.
+    const DEAD: Self = Self { slot: u32::MAX, pixel: 0, sample: 0, o: Vec3::ZERO, d: Vec3::Z, beta: Vec3::ZERO, pdf: 0.0 };
+}
+
+impl ShadowLane {
+    /// Padding lane of a shadow packet: inactive, adds nothing.
+    const DEAD: Self = Self { slot: u32::MAX, o: Vec3::ZERO, d: Vec3::Z, tfar: 0.0, contrib: Vec3::ZERO };
+}
+
+/// Pads `v` with `dead` up to a multiple of 8 lanes.
+#[inline]
+fn pad8<T: Copy>(v: &mut Vec<T>, dead: T) {
+    while v.len() % 8 != 0 {
+        v.push(dead);
+    }
 }
 
 /// One shadow ray waiting to be packed: origin, unnormalized direction to the light sample,
@@ -121,7 +140,7 @@ impl Integrator {
             let dims = DIM_PATH_BASE + 4 * (v - 1);
             // Trace: full packets of 8 live paths (the first bounce keeps the camera packets).
             sc.rh.clear();
-            for chunk in sc.lanes.chunks(8) {
+            for chunk in sc.lanes.chunks_exact(8) {
                 let (org, dir, active) = soa_rays(chunk);
                 let mut rh = RayHit8::default();
                 let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
@@ -140,16 +159,16 @@ impl Integrator {
             sc.shadow.clear();
             sc.shadow_contrib.clear();
             sc.shadow_slots.clear();
-            for (ci, chunk) in sc.lanes.chunks(8).enumerate() {
+            for (ci, chunk) in sc.lanes.chunks_exact(8).enumerate() {
                 let (rh, traced) = &sc.rh[ci];
                 let (org, dir) = (rh.ray.org(), rh.ray.dir());
                 let sh = scene.gather(org, dir, &Hits8::from_rayhit(rh, *traced));
                 let hit = sh.valid;
-                let beta = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::ZERO, |l| l.beta)));
-                let slots: [u32; 8] = std::array::from_fn(|i| chunk.get(i).map_or(u32::MAX, |l| l.slot));
-                let pixel = U8::new(std::array::from_fn(|i| chunk.get(i).map_or(0, |l| l.pixel)));
-                let s = U8::new(std::array::from_fn(|i| chunk.get(i).map_or(0, |l| l.sample)));
-                let prev_pdf = F8::new(std::array::from_fn(|i| chunk.get(i).map_or(0.0, |l| l.pdf)));
+                let beta = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].beta));
+                let slots: [u32; 8] = std::array::from_fn(|i| chunk[i].slot);
+                let pixel = U8::new(std::array::from_fn(|i| chunk[i].pixel));
+                let s = U8::new(std::array::from_fn(|i| chunk[i].sample));
+                let prev_pdf = F8::new(std::array::from_fn(|i| chunk[i].pdf));
 
                 // Emission: materials always; area lights (quads, emissive triangles) by the NEE mode.
                 let mut le = masked(sh.emitted, hit);
@@ -181,9 +200,14 @@ impl Integrator {
                 let mat = Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx };
                 let eps = scene.offset_eps(sh.p);
                 let o = sh.n.mul_add(eps, sh.p);
-                let (u_choice, u_lobe) = self.path_point(pixel, s, dims + 1);
+                // (light choice, lobe choice): drawn only where one of them is used (several
+                // lights, or BRDF sampling's lobe pick); skipping it changes no other dimension.
+                let (u_choice, u_lobe) = if n_lights > 1 || self.strategy == ImportanceSampling::Brdf {
+                    self.path_point(pixel, s, dims + 1)
+                } else {
+                    (F8::ZERO, F8::ZERO)
+                };
 
-                // Next event estimation: one light chosen uniformly, one point on it.
                 if nee_here {
                     let (u, w) = self.path_point(pixel, s, dims);
                     // One light chosen by `scene.emitters.all` (uniform among quads, by power with
@@ -246,16 +270,16 @@ impl Integrator {
                 }
             }
             // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
-            for chunk in sc.shadow_lanes.chunks(8) {
-                let get = |i: usize| chunk.get(i);
-                let o = Vec3x8::from_lanes(std::array::from_fn(|i| get(i).map_or(Vec3::ZERO, |l| l.o)));
-                let d = Vec3x8::from_lanes(std::array::from_fn(|i| get(i).map_or(Vec3::Z, |l| l.d)));
-                let tfar = F8::new(std::array::from_fn(|i| get(i).map_or(0.0, |l| l.tfar)));
-                let active = mask_from_bools(std::array::from_fn(|i| i < chunk.len()));
+            pad8(&mut sc.shadow_lanes, ShadowLane::DEAD);
+            for chunk in sc.shadow_lanes.chunks_exact(8) {
+                let o = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].o));
+                let d = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].d));
+                let tfar = F8::new(std::array::from_fn(|i| chunk[i].tfar));
+                let active = mask_from_bools(std::array::from_fn(|i| chunk[i].slot != u32::MAX));
                 let (ray, lit) = Ray8::new(o, d, F8::ZERO, tfar, active);
                 sc.shadow.push((ray, lit));
-                sc.shadow_contrib.push(Vec3x8::from_lanes(std::array::from_fn(|i| get(i).map_or(Vec3::ZERO, |l| l.contrib))));
-                sc.shadow_slots.push(std::array::from_fn(|i| get(i).map_or(u32::MAX, |l| l.slot)));
+                sc.shadow_contrib.push(Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].contrib)));
+                sc.shadow_slots.push(std::array::from_fn(|i| chunk[i].slot));
             }
             if let Some(l) = log.as_deref_mut() {
                 l.shadow.extend_from_slice(&sc.shadow);
@@ -266,21 +290,31 @@ impl Integrator {
                 let visible = *lit & !occluded;
                 add_lanes(&mut sc.radiance, &sc.shadow_slots[j], masked(sc.shadow_contrib[j], visible));
             }
+            pad8(&mut sc.next, PathLane::DEAD);
             std::mem::swap(&mut sc.lanes, &mut sc.next);
             v += 1;
+        }
+        // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
+        // non-finite samples are left as they are, for the film to count and drop.
+        if let Some(m) = self.clamp {
+            for r in sc.radiance.iter_mut() {
+                let top = r.max_element();
+                if top > m {
+                    *r *= m / top;
+                }
+            }
         }
         out.clear();
         out.extend(sc.radiance.chunks_exact(8).map(|l| Vec3x8::from_lanes(std::array::from_fn(|i| l[i]))));
     }
 }
 
-/// SoA rays of up to 8 lanes; missing lanes and placeholders (slot u32::MAX) are inactive.
+/// SoA rays of a packet of 8 lanes; placeholders (slot u32::MAX) are inactive.
 #[inline]
 fn soa_rays(chunk: &[PathLane]) -> (Vec3x8, Vec3x8, Mask8) {
-    let get = |i: usize| chunk.get(i).filter(|l| l.slot != u32::MAX);
-    let o = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::ZERO, |l| l.o)));
-    let d = Vec3x8::from_lanes(std::array::from_fn(|i| chunk.get(i).map_or(Vec3::Z, |l| l.d)));
-    (o, d, mask_from_bools(std::array::from_fn(|i| get(i).is_some())))
+    let o = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].o));
+    let d = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].d));
+    (o, d, mask_from_bools(std::array::from_fn(|i| chunk[i].slot != u32::MAX)))
 }
 
 /// Adds lane i of `v` to `radiance[slots[i]]` for every lane with a slot.

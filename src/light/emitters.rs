@@ -311,6 +311,20 @@ impl Emitters {
     }
 
     fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
+        if let [e] = self.list.as_slice() {
+            // One light: splatted, no gather.
+            let fold = if e.triangle { (u + v).simd_gt(F8::ONE) } else { F8::ZERO.simd_gt(F8::ONE) };
+            let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
+            let s = Vec3x8::splat;
+            return LightSample8 {
+                y: s(e.ac).mul_add(v, s(e.ab).mul_add(u, s(e.a))),
+                normal: s(e.normal),
+                radiance: s(e.radiance),
+                area: F8::splat(e.area),
+                inv_pmf,
+                light: idx,
+            };
+        }
         let ids = idx.to_array();
         let es = ids.map(|i| &self.list[i as usize]);
         let la = Vec3x8::from_lanes(es.map(|e| e.a));
