@@ -373,3 +373,42 @@ fn procedural_mesh_has_a_million_triangles_and_round_trips() {
     assert_eq!(s.triangles.len(), small.faces.len() - 2);
     assert_eq!(small.faces.len(), small.face_material.iter().filter(|&&i| i == 0).count() + 6);
 }
+
+/// The command line: `gen-mesh`, then `render model.obj --camera`, and a malformed OBJ reported with
+/// its file and line (exit status 1, no panic).
+#[test]
+fn cli_gen_mesh_render_obj_with_camera_and_errors() {
+    let d = tmpdir("cli");
+    let strata = || std::process::Command::new(env!("CARGO_BIN_EXE_strata"));
+    let mesh = d.join("m.obj");
+    let r = strata().args(["gen-mesh", "--triangles", "400"]).arg(&mesh).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(String::from_utf8_lossy(&r.stdout).contains("406 triangles"));
+    assert!(d.join("m.mtl").is_file());
+    let out = d.join("img");
+    let stats = d.join("s.json");
+    let r = strata()
+        .arg("render")
+        .arg(&mesh)
+        .args(["--camera", "0 0.5 6 0 0 0 0 1 0 40", "--size", "24x16", "--spp", "2", "--threads", "2", "-q"])
+        .arg("-o")
+        .arg(&out)
+        .arg("--stats")
+        .arg(&stats)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(d.join("img.exr").is_file() && d.join("img.png").is_file());
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!((j["integrator"].as_str(), j["width"].as_u64()), (Some("pathtracer"), Some(24)));
+    assert_eq!(j["features"]["emissive_triangles"], 2);
+    assert_eq!(j["features"]["light_selection"], "power");
+    assert_eq!(j["nonfinite_samples"], 0);
+    let bad = write(&d, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    let r = strata().arg("render").arg(&bad).args(["--size", "8x8", "-q"]).output().unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("{}:4: ", bad.display())) && err.contains("out of range"), "{err}");
+    let r = strata().arg("render").arg(&mesh).args(["--camera", "0 0 1 0 0 1 0 1 0 40"]).output().unwrap();
+    assert!(!r.status.success() && String::from_utf8_lossy(&r.stderr).contains("coincide"));
+}
