@@ -8,8 +8,13 @@ use crate::sampler::SamplerKind;
 use crate::scene::build::Scene;
 use crate::scene::desc::{IntegratorKind, SceneDesc};
 use crate::scene::parse::{self, Limits};
+use crate::checkpoint::{self, Header};
 use serde_json::json;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
 
 /// The built-in default scene (a Cornell box written for strata).
 pub const DEFAULT_SCENE: &str = include_str!("../scenes/cornell.test");
@@ -47,7 +52,27 @@ pub struct RenderOptions {
     pub camera: Option<crate::scene::desc::CameraDesc>,
     /// path tracer: clamp each pixel sample's largest channel to this value (biased; None = off)
     pub clamp: Option<f32>,
+    /// checkpoint file: the accumulated state is written there every `checkpoint_every` seconds
+    /// and at the end (default with `--samples` or on interruption: OUT.ckpt)
+    pub checkpoint: Option<PathBuf>,
+    /// seconds between checkpoints (default [`DEFAULT_CHECKPOINT_EVERY`]; 0 = after every pass)
+    pub checkpoint_every: Option<f64>,
+    /// continue the render held in this checkpoint (same scene and options, else refused)
+    pub resume: Option<PathBuf>,
+    /// render only sample indices A..B of the spp (a shard for `strata merge`)
+    pub samples: Option<(u32, u32)>,
+    /// render whole passes until this many seconds are spent (independent pixel and path layouts;
+    /// `--spp`, if given, caps the samples)
+    pub time_budget: Option<f64>,
+    /// set (e.g. by SIGINT/SIGTERM) to stop after the current pass, checkpoint and write the image
+    pub stop: Option<Arc<AtomicBool>>,
 }
+
+/// Default seconds between two checkpoints.
+pub const DEFAULT_CHECKPOINT_EVERY: f64 = 300.0;
+/// Aimed wall-clock seconds of one pass (passes only schedule the work: the image is the same
+/// whatever their sizes; shorter passes make checkpoints and Ctrl-C more timely).
+const PASS_SECONDS: f64 = 2.0;
 
 /// Everything a render produced.
 pub struct RenderOutput {
@@ -61,6 +86,12 @@ pub struct RenderOutput {
     pub stats: RenderStats,
     /// the output stem written to, if any
     pub out: Option<PathBuf>,
+    /// identity and totals over every session of this render (as in its checkpoint)
+    pub header: Header,
+    /// the checkpoint written last, if any
+    pub checkpoint: Option<PathBuf>,
+    /// stopped by the `stop` flag (a signal) before the sample range was done
+    pub interrupted: bool,
 }
 
 /// Parses the scene named in `opts` (or the built-in one) and applies the size override.
@@ -141,74 +172,242 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     Ok((scene, integrator))
 }
 
-/// Renders without writing anything: scene build, integrator set-up, all samples.
-pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
-    let (scene, integrator) = prepare(opts)?;
-    let spp = integrator.spp;
-    let pool = render::thread_pool(opts.threads).map_err(|e| e.to_string())?;
-    let mut film = Film::new(scene.desc.width, scene.desc.height);
-    let stats = render_passes(&scene, &integrator, &mut film, 0..spp, &pool, opts.progress);
-    Ok(RenderOutput { scene, integrator, film, stats, out: None })
+/// Hash of the scene's bytes (the file as read, or the built-in scene's text).
+pub fn scene_hash(opts: &RenderOptions) -> Result<String, String> {
+    Ok(match &opts.scene {
+        Some(p) => checkpoint::hash_bytes(&std::fs::read(p).map_err(|e| format!("{}: cannot read scene file: {e}", p.display()))?),
+        None => checkpoint::hash_bytes(DEFAULT_SCENE.as_bytes()),
+    })
 }
 
-/// Renders `samples` in passes (about 1% of the samples each, at least one), so that progress can
-/// be shown; the image is bit-identical to one pass (running sums continue across passes).
-pub fn render_passes(
-    scene: &Scene,
-    integ: &Integrator,
-    film: &mut Film,
-    samples: std::ops::Range<u32>,
-    pool: &rayon::ThreadPool,
-    progress: bool,
-) -> RenderStats {
-    let total = samples.len() as u32;
-    let pass = (total / 100).max(render::SAMPLE_BATCH).max(1);
+/// The identity of a render (scene hash, version, size and every option that affects the image)
+/// with empty ranges and totals.
+pub fn identity(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<Header, String> {
+    let d = &scene.desc;
+    let options: BTreeMap<String, serde_json::Value> = [
+        ("integrator", json!(integrator_name(d.integrator))),
+        ("spp", json!(it.spp)),
+        ("seed", json!(it.seed)),
+        ("pixel_sampler", json!(it.pixel_set.kind().name())),
+        ("light_sampler", json!(it.light_set.kind().name())),
+        ("light_samples", json!(it.light_set.n())),
+        ("layout", json!(if opts.time_budget.is_some() { "time-budget" } else { "spp" })),
+        ("gamma", json!(d.gamma)),
+        ("clamp", json!(it.clamp)),
+    ]
+    .into_iter()
+    // `--camera` (present only when given, so other renders' identities are unchanged).
+    .chain(opts.camera.map(|c| ("camera", json!([c.eye.to_array(), c.center.to_array(), c.up.to_array(), [c.fovy_deg]]))))
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    Ok(Header {
+        strata_version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: d.source.display().to_string(),
+        scene_hash: scene_hash(opts)?,
+        options,
+        width: d.width,
+        height: d.height,
+        target: [0, 0],
+        samples: [0, 0],
+        blocks: Vec::new(),
+        cpu_seconds: 0.0,
+        render_seconds: 0.0,
+        rays: 0,
+        parts: Vec::new(),
+    })
+}
+
+/// Renders without writing images: scene build, integrator set-up, the sample range in passes
+/// (resuming `opts.resume`, writing `opts.checkpoint` periodically and at the end, stopping
+/// early on `opts.stop` or when `opts.time_budget` is spent).
+pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, String> {
+    let (scene, mut integrator) = prepare(opts)?;
+    if let Some(b) = opts.time_budget {
+        if !(b > 0.0 && b.is_finite()) {
+            return Err(format!("--time-budget {b}: expected a positive number of seconds"));
+        }
+        // The number of samples is not known in advance: layouts that need it become independent.
+        integrator = integrator.resampled(None);
+    }
+    let every = opts.checkpoint_every.unwrap_or(DEFAULT_CHECKPOINT_EVERY);
+    if !(every >= 0.0 && every.is_finite()) {
+        return Err(format!("--checkpoint-every {every}: expected a number of seconds >= 0"));
+    }
+    let cap = if opts.time_budget.is_some() { opts.spp.unwrap_or(u32::MAX) } else { integrator.spp };
+    let target = match opts.samples {
+        Some((a, b)) if a < b && b <= cap => a..b,
+        Some((a, b)) => return Err(format!("--samples {a}..{b}: expected A < B <= spp ({cap})")),
+        None => 0..cap,
+    };
+    let mut header = identity(opts, &scene, &integrator)?;
+    header.target = [target.start, target.end];
+    let mut film = Film::new(scene.desc.width, scene.desc.height);
+    if let Some(path) = &opts.resume {
+        let (h, f) = checkpoint::read(path)?;
+        if let Some(why) = h.mismatch(&header, "this render") {
+            return Err(format!("{}: cannot resume: {why}", path.display()));
+        }
+        let have = f.samples();
+        if !have.is_empty() && (have.start != target.start || have.end > target.end) {
+            return Err(format!(
+                "{}: cannot resume: it holds samples {}..{}, which do not start the requested range {}..{}",
+                path.display(),
+                have.start,
+                have.end,
+                target.start,
+                target.end
+            ));
+        }
+        (header.cpu_seconds, header.render_seconds, header.rays) = (h.cpu_seconds, h.render_seconds, h.rays);
+        film = f;
+    }
+    let ckpt_path = opts.checkpoint.clone().or_else(|| opts.resume.clone());
+    let pool = render::thread_pool(opts.threads).map_err(|e| e.to_string())?;
+    let mut progress = Progress::new(opts.progress, &target, film.samples().len() as u32, opts.time_budget);
     let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
-    let is_tty = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let mut last_line = std::time::Instant::now();
-    let mut s = samples.start;
-    while s < samples.end {
-        let e = samples.end.min(s + pass);
-        let st = render::render(scene, integ, film, s..e, pool);
+    let started = Instant::now();
+    let mut last_ckpt = Instant::now();
+    let mut s = if film.samples().is_empty() { target.start } else { film.samples().end };
+    let mut pass = render::SAMPLE_BATCH;
+    let mut interrupted = false;
+    while s < target.end {
+        if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
+            interrupted = true;
+            break;
+        }
+        let mut n = pass.min(target.end - s);
+        if let Some(b) = opts.time_budget {
+            let left = b - started.elapsed().as_secs_f64();
+            if left <= 0.0 {
+                break;
+            }
+            // Whole passes that fit in what is left of the budget (at least one sample).
+            if let Some(per) = progress.secs_per_spp() {
+                n = n.min(((left / per) as u32).max(1));
+            }
+        }
+        let st = render::render(&scene, &integrator, &mut film, s..s + n, &pool);
+        s += n;
         stats.seconds += st.seconds;
+        stats.cpu_seconds += st.cpu_seconds;
         stats.counters.merge(&st.counters);
-        s = e;
-        if progress {
-            let done = s - samples.start;
-            let eta = stats.seconds / f64::from(done) * f64::from(total - done);
-            let line = format!("{done}/{total} spp, {:.2} Mrays/s, ETA {eta:.1} s", stats.mrays_per_sec());
-            if is_tty {
-                let bar = (40 * done / total.max(1)) as usize;
-                eprint!("\r[{}{}] {line}   ", "#".repeat(bar), ".".repeat(40 - bar));
-            } else if last_line.elapsed().as_secs_f64() > 5.0 || done == total {
-                eprintln!("strata: {line}");
-                last_line = std::time::Instant::now();
+        header.cpu_seconds += st.cpu_seconds;
+        header.render_seconds += st.seconds;
+        header.rays += st.counters.total_rays();
+        progress.pass(n, &st, started.elapsed().as_secs_f64());
+        // Next pass: about PASS_SECONDS, growing at most 4x, whole wavefront batches when large.
+        let per = st.seconds / f64::from(n);
+        let want = ((PASS_SECONDS / per.max(1e-9)) as u32).clamp(1, pass.saturating_mul(4));
+        pass = if want >= render::SAMPLE_BATCH { want / render::SAMPLE_BATCH * render::SAMPLE_BATCH } else { want };
+        if let Some(p) = &ckpt_path {
+            if s < target.end && last_ckpt.elapsed().as_secs_f64() >= every {
+                checkpoint::write(p, &header, &film)?;
+                last_ckpt = Instant::now();
             }
         }
     }
-    if progress && is_tty {
-        eprintln!();
+    progress.finish();
+    let stem = output_stem(opts, &scene.desc);
+    let final_ckpt = match ckpt_path {
+        Some(p) => Some(p),
+        None if interrupted || opts.samples.is_some() => Some(with_ext(&stem, "ckpt")),
+        None => None,
+    };
+    if let Some(p) = &final_ckpt {
+        checkpoint::write(p, &header, &film)?;
     }
-    stats
+    header = checkpoint::header_for(header, &film);
+    Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted })
+}
+
+/// Progress on stderr: a bar with spp done, Mrays/s and ETA on a terminal, a plain line every
+/// few seconds otherwise, nothing when disabled.
+struct Progress {
+    on: bool,
+    tty: bool,
+    total: u64,
+    done: u64,
+    session: u64,
+    budget: Option<f64>,
+    seconds: f64,
+    rays: u64,
+    last_line: Instant,
+}
+
+impl Progress {
+    fn new(on: bool, target: &std::ops::Range<u32>, done: u32, budget: Option<f64>) -> Self {
+        Self {
+            on,
+            tty: std::io::IsTerminal::is_terminal(&std::io::stderr()),
+            total: target.len() as u64,
+            done: u64::from(done),
+            session: 0,
+            budget,
+            seconds: 0.0,
+            rays: 0,
+            last_line: Instant::now(),
+        }
+    }
+
+    /// Seconds per sample per pixel measured so far in this session.
+    fn secs_per_spp(&self) -> Option<f64> {
+        (self.session > 0).then(|| self.seconds / self.session as f64)
+    }
+
+    fn pass(&mut self, n: u32, st: &RenderStats, elapsed: f64) {
+        self.done += u64::from(n);
+        self.session += u64::from(n);
+        self.seconds += st.seconds;
+        self.rays += st.counters.total_rays();
+        if !self.on {
+            return;
+        }
+        let mrays = self.rays as f64 / self.seconds.max(1e-12) / 1e6;
+        let (line, frac) = match self.budget {
+            Some(b) => (format!("{} spp, {mrays:.2} Mrays/s, {:.1} s of {b} s budget left", self.done, (b - elapsed).max(0.0)), (elapsed / b).min(1.0)),
+            None => {
+                let eta = self.secs_per_spp().unwrap_or(0.0) * (self.total - self.done) as f64;
+                (format!("{}/{} spp, {mrays:.2} Mrays/s, ETA {eta:.1} s", self.done, self.total), self.done as f64 / self.total.max(1) as f64)
+            }
+        };
+        if self.tty {
+            let bar = (40.0 * frac) as usize;
+            eprint!("\r[{}{}] {line}   ", "#".repeat(bar), ".".repeat(40 - bar));
+        } else if self.last_line.elapsed().as_secs_f64() > 5.0 || self.done == self.total {
+            eprintln!("strata: {line}");
+            self.last_line = Instant::now();
+        }
+    }
+
+    fn finish(&self) {
+        if self.on && self.tty {
+            eprintln!();
+        }
+    }
 }
 
 /// Output stem: `-o OUT`, else the scene's `output` file name without extension (directories
 /// stripped: a scene file never chooses where we write), else "strata".
 pub fn output_stem(opts: &RenderOptions, desc: &SceneDesc) -> PathBuf {
     if let Some(o) = &opts.out {
-        let s = o.to_string_lossy();
-        for ext in [".exr", ".png"] {
-            if let Some(stripped) = s.strip_suffix(ext) {
-                return PathBuf::from(stripped);
-            }
-        }
-        return o.clone();
+        return stem_of(o);
     }
     desc.output
         .as_deref()
         .and_then(|n| Path::new(n).file_stem())
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from("strata"))
+}
+
+/// `o` without a trailing `.exr` or `.png`.
+fn stem_of(o: &Path) -> PathBuf {
+    let s = o.to_string_lossy();
+    for ext in [".exr", ".png"] {
+        if let Some(stripped) = s.strip_suffix(ext) {
+            return PathBuf::from(stripped);
+        }
+    }
+    o.to_path_buf()
 }
 
 fn with_ext(stem: &Path, ext: &str) -> PathBuf {
@@ -218,21 +417,38 @@ fn with_ext(stem: &Path, ext: &str) -> PathBuf {
     PathBuf::from(s)
 }
 
-/// Metadata written into the EXR header.
+/// EXR metadata of a render or merge state: version, scene and its hash, integrator, samplers,
+/// seed, spp held, sample range, total render and CPU seconds, rays, and the parts it came from.
+pub fn header_metadata(h: &Header) -> Metadata {
+    let opt = |k: &str| h.options.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
+    let mut m: Metadata = vec![
+        ("strata.version".into(), h.strata_version.clone()),
+        ("strata.scene".into(), h.scene.clone()),
+        ("strata.scene_hash".into(), h.scene_hash.clone()),
+        ("strata.integrator".into(), opt("integrator")),
+        ("strata.spp".into(), (h.samples[1] - h.samples[0]).to_string()),
+        ("strata.samples".into(), format!("{}..{}", h.samples[0], h.samples[1])),
+        ("strata.seed".into(), opt("seed")),
+        ("strata.pixel_sampler".into(), opt("pixel_sampler")),
+        ("strata.light_sampler".into(), opt("light_sampler")),
+        ("strata.light_samples".into(), opt("light_samples")),
+        ("strata.layout".into(), opt("layout")),
+        ("strata.render_seconds".into(), format!("{:.6}", h.render_seconds)),
+        ("strata.cpu_seconds".into(), format!("{:.6}", h.cpu_seconds)),
+        ("strata.rays".into(), h.rays.to_string()),
+    ];
+    if !h.parts.is_empty() {
+        m.push(("strata.parts".into(), h.parts.join("; ")));
+        m.push(("strata.part_count".into(), h.parts.len().to_string()));
+    }
+    m
+}
+
+/// Metadata written into the EXR header of a render ([`header_metadata`] and the thread count).
 pub fn metadata(out: &RenderOutput) -> Metadata {
-    let d = &out.scene.desc;
-    vec![
-        ("strata.version".into(), env!("CARGO_PKG_VERSION").into()),
-        ("strata.scene".into(), d.source.display().to_string()),
-        ("strata.integrator".into(), integrator_name(d.integrator).into()),
-        ("strata.spp".into(), out.integrator.spp.to_string()),
-        ("strata.seed".into(), out.integrator.seed.to_string()),
-        ("strata.pixel_sampler".into(), out.integrator.pixel_set.kind().name().into()),
-        ("strata.light_sampler".into(), out.integrator.light_set.kind().name().into()),
-        ("strata.light_samples".into(), out.integrator.light_set.n().to_string()),
-        ("strata.render_seconds".into(), format!("{:.6}", out.stats.seconds)),
-        ("strata.threads".into(), out.stats.threads.to_string()),
-    ]
+    let mut m = header_metadata(&out.header);
+    m.push(("strata.threads".into(), out.stats.threads.to_string()));
+    m
 }
 
 /// The `--stats` JSON.
@@ -243,7 +459,14 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "scene": d.source.display().to_string(),
         "integrator": integrator_name(d.integrator),
         "seconds": out.stats.seconds,
-        "spp": out.integrator.spp,
+        "spp": out.film.samples().len(),
+        "samples": [out.header.samples[0], out.header.samples[1]],
+        "cpu_seconds": out.stats.cpu_seconds,
+        "total_render_seconds": out.header.render_seconds,
+        "total_cpu_seconds": out.header.cpu_seconds,
+        "interrupted": out.interrupted,
+        "checkpoint": out.checkpoint.as_ref().map(|p| p.display().to_string()),
+        "layout": out.header.options.get("layout"),
         "width": d.width,
         "height": d.height,
         "seed": out.integrator.seed,
@@ -292,7 +515,7 @@ pub fn summary(out: &RenderOutput) -> String {
         d.source.display(),
         d.width,
         d.height,
-        it.spp,
+        out.film.samples().len(),
         integrator_name(d.integrator),
         technique,
         it.kernel.name(d.integrator),
@@ -325,6 +548,108 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, String> {
         film::write_atomic(p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
     }
     Ok(out)
+}
+
+/// Sets the returned flag on SIGINT or SIGTERM (a render checks it between passes, then writes a
+/// checkpoint and the image); a second signal while the flag is set exits at once.
+pub fn stop_on_signals() -> Result<Arc<AtomicBool>, String> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&flag)).map_err(|e| format!("signal handler: {e}"))?;
+        signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(|e| format!("signal handler: {e}"))?;
+    }
+    Ok(flag)
+}
+
+/// What `strata merge` produced.
+pub struct MergeOutput {
+    /// the merged state (identity, totals, parts)
+    pub header: Header,
+    /// the merged film
+    pub film: Film,
+    /// output stem written (OUT.exr, OUT.png)
+    pub out: PathBuf,
+}
+
+/// `strata merge PARTS... -o OUT`: checks that the parts (checkpoint files of finished `--samples`
+/// shards) belong to one render (scene hash, version, size, options) and cover its sample range
+/// without overlap or gap, merges their dyadic blocks (bit-identical to one render of the whole
+/// range) and writes OUT.exr (metadata: total spp, CPU seconds, the parts) and OUT.png.
+pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, String> {
+    if parts.is_empty() {
+        return Err("merge: give the part files to merge".into());
+    }
+    let mut loaded = Vec::new();
+    for p in parts {
+        let (h, f) = checkpoint::read(p)?;
+        if h.samples != h.target {
+            return Err(format!(
+                "{}: unfinished part: it holds samples {}..{} of its range {}..{} (finish it with --resume)",
+                p.display(),
+                h.samples[0],
+                h.samples[1],
+                h.target[0],
+                h.target[1]
+            ));
+        }
+        if let Some((p0, h0, _)) = loaded.first() {
+            let p0: &PathBuf = p0;
+            if let Some(why) = h.mismatch(h0, &p0.display().to_string()) {
+                return Err(format!("{}: does not belong with {}: {why}", p.display(), p0.display()));
+            }
+        }
+        loaded.push((p.clone(), h, f));
+    }
+    loaded.sort_by_key(|(_, h, _)| h.samples);
+    let want_end = match loaded[0].1.options.get("layout").and_then(|v| v.as_str()) {
+        Some("spp") => loaded[0].1.options.get("spp").and_then(|v| v.as_u64()),
+        _ => None,
+    };
+    let name = |p: &PathBuf, h: &Header| format!("{} ({}..{})", p.display(), h.samples[0], h.samples[1]);
+    if loaded[0].1.samples[0] != 0 {
+        return Err(format!("samples 0..{} are missing (no part starts at 0)", loaded[0].1.samples[0]));
+    }
+    for w in loaded.windows(2) {
+        let ((pa, ha, _), (pb, hb, _)) = (&w[0], &w[1]);
+        if hb.samples[0] < ha.samples[1] {
+            return Err(format!("{} and {} overlap", name(pa, ha), name(pb, hb)));
+        }
+        if hb.samples[0] > ha.samples[1] {
+            return Err(format!("samples {}..{} are missing (between {} and {})", ha.samples[1], hb.samples[0], name(pa, ha), name(pb, hb)));
+        }
+    }
+    let last = loaded.last().map(|(_, h, _)| h.samples[1]).unwrap_or(0);
+    if let Some(end) = want_end {
+        if u64::from(last) != end {
+            return Err(format!("samples {last}..{end} of the {end} spp are missing (the last part ends at {last})"));
+        }
+    }
+    let mut header = loaded[0].1.clone();
+    let (w, h) = (header.width, header.height);
+    let mut film = Film::new(w, h);
+    (header.cpu_seconds, header.render_seconds, header.rays, header.parts) = (0.0, 0.0, 0, Vec::new());
+    for (p, ph, f) in &loaded {
+        film.merge(f).map_err(|e| format!("{}: {e}", p.display()))?;
+        header.cpu_seconds += ph.cpu_seconds;
+        header.render_seconds += ph.render_seconds;
+        header.rays += ph.rays;
+        if ph.parts.is_empty() {
+            header.parts.push(name(p, ph));
+        } else {
+            header.parts.extend(ph.parts.iter().cloned());
+        }
+    }
+    header.target = [0, last];
+    header = checkpoint::header_for(header, &film);
+    let stem = stem_of(out);
+    let (mean, var) = (film.mean(), film.variance_of_mean());
+    let exr = with_ext(&stem, "exr");
+    film::write_exr(&exr, w, h, &mean, Some(&var), &header_metadata(&header)).map_err(|e| format!("{}: {e}", exr.display()))?;
+    let gamma = header.options.get("gamma").and_then(|v| v.as_f64()).unwrap_or(1.0) as f32;
+    let png = with_ext(&stem, "png");
+    film::write_png(&png, w, h, &mean, gamma).map_err(|e| format!("{}: {e}", png.display()))?;
+    Ok(MergeOutput { header, film, out: stem })
 }
 
 /// `strata rays`: renderer rays/s next to Embree's raw rate on the same packets.

@@ -4,66 +4,280 @@
 //! Pixels are row-major, top row first, index `y * width + x`. Every writer goes through
 //! [`write_atomic`]: the bytes are built in memory, written to `<path>.tmp-<pid>`, fsynced and renamed
 //! over `path`, so a reader never sees a partial file and a failed write leaves the old file intact.
+//!
+//! ## Order-independent accumulation (dyadic blocks)
+//! f64 addition is not associative, so "sum of shard totals" differs in the last bits from one
+//! sequential sum. A film therefore defines the value of the sample range `[lo, hi)` of a pixel
+//! canonically: `[lo, hi)` is cut into its minimal set of aligned dyadic [`Block`]s (block (k, j)
+//! holds samples `[j 2^k, (j+1) 2^k)`, as in a segment tree); a block's moments are the sum of its
+//! two children's (a leaf is the sample's f64 value and its square); the range total is the fold of
+//! its blocks in increasing sample order. Samples are inserted like a binary counter (a leaf, then
+//! combine with the left sibling while it is present), and two films of adjacent ranges merge by
+//! combining siblings bottom-up, which rebuilds exactly the blocks of one render of the union. So
+//! passes, checkpoints and shards are bit-identical to one uninterrupted render. The block list is
+//! the same for every pixel (it depends only on the range), so it is stored once; each live block
+//! costs 48 bytes per pixel, and at most about 2 log2(hi - lo) blocks are live.
 
 use std::fs::{self, File};
 use std::io::{self, Cursor, Write};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// Per-pixel f64 accumulation: per-channel sum, per-channel sum of squares (second moment) and
-/// sample count.
+/// An aligned dyadic block of sample indices: samples `[j * 2^k, (j + 1) * 2^k)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Block {
+    /// log2 of the number of samples
+    pub k: u8,
+    /// index of the block among the blocks of size 2^k
+    pub j: u32,
+}
+
+impl Block {
+    /// The leaf block of sample `s`.
+    pub fn leaf(s: u32) -> Self {
+        Self { k: 0, j: s }
+    }
+
+    /// First sample index.
+    pub fn start(self) -> u64 {
+        u64::from(self.j) << self.k
+    }
+
+    /// One past the last sample index.
+    pub fn end(self) -> u64 {
+        (u64::from(self.j) + 1) << self.k
+    }
+
+    /// Whether `self` is the left sibling of `right` (same size, `right` the odd one right after).
+    pub fn is_left_sibling_of(self, right: Block) -> bool {
+        self.k == right.k && right.j % 2 == 1 && self.j + 1 == right.j
+    }
+
+    /// The block made of this block and its sibling.
+    pub fn parent(self) -> Block {
+        Block { k: self.k + 1, j: self.j / 2 }
+    }
+}
+
+/// Pushes `b` (which starts where the last block ends) onto a block list kept in increasing sample
+/// order, combining it with its left sibling while that is the last block; returns how many
+/// combinations were made (the caller combines the per-pixel moments the same way).
+pub fn push_block(blocks: &mut Vec<Block>, mut b: Block) -> usize {
+    let mut carries = 0;
+    while let Some(&top) = blocks.last() {
+        if !top.is_left_sibling_of(b) {
+            break;
+        }
+        blocks.pop();
+        b = b.parent();
+        carries += 1;
+    }
+    blocks.push(b);
+    carries
+}
+
+/// The canonical (minimal, aligned) dyadic blocks of the sample range `r`, in increasing order.
+pub fn canonical_blocks(r: Range<u32>) -> Vec<Block> {
+    let mut blocks = Vec::new();
+    for s in r {
+        push_block(&mut blocks, Block::leaf(s));
+    }
+    blocks
+}
+
+/// Moments of one block of one pixel: sum of R, G, B, then sum of squares of R, G, B.
+pub type Moments = [f64; 6];
+
+/// Turns `right` into the moments of the block `left` + `right` (IEEE addition commutes, so the
+/// order of the two operands inside one addition does not matter; the tree shape does).
+#[inline(always)]
+pub fn combine(left: &Moments, right: &mut Moments) {
+    for q in 0..6 {
+        right[q] += left[q];
+    }
+}
+
+/// The leaf moments of one sample value.
+#[inline(always)]
+pub fn leaf_moments(rgb: [f32; 3]) -> Moments {
+    let [r, g, b] = rgb.map(f64::from);
+    [r, g, b, r * r, g * g, b * b]
+}
+
+/// Per-pixel f64 accumulation of a contiguous range of sample indices, kept as dyadic blocks (see
+/// the module doc), with the per-pixel totals: per-channel sum, per-channel sum of squares (second
+/// moment) and sample count.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     /// Width in pixels.
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// Per-pixel sum of the RGB samples.
+    /// Per-pixel sum of the RGB samples (the fold of the blocks; read-only view).
     pub sum: Vec<[f64; 3]>,
-    /// Per-pixel sum of the squared RGB samples, per channel.
+    /// Per-pixel sum of the squared RGB samples, per channel (read-only view).
     pub sum_sq: Vec<[f64; 3]>,
-    /// Per-pixel number of samples.
+    /// Per-pixel number of samples (read-only view).
     pub count: Vec<u32>,
+    /// sample indices held
+    samples: Range<u32>,
+    /// live blocks of `samples`, increasing
+    blocks: Vec<Block>,
+    /// block-major moments: `data[b * pixels + p]`
+    data: Vec<Moments>,
 }
 
 impl Film {
     /// An empty film of `width * height` pixels.
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        Self { width, height, sum: vec![[0.0; 3]; n], sum_sq: vec![[0.0; 3]; n], count: vec![0; n] }
-    }
-
-    /// Adds one sample value for pixel (x, y). Panics if the pixel is outside the film.
-    pub fn add(&mut self, x: u32, y: u32, rgb: [f32; 3]) {
-        assert!(
-            x < self.width && y < self.height,
-            "pixel ({x}, {y}) outside {}x{} film",
-            self.width,
-            self.height
-        );
-        let i = y as usize * self.width as usize + x as usize;
-        for (c, &v) in rgb.iter().enumerate() {
-            let v = f64::from(v);
-            self.sum[i][c] += v;
-            self.sum_sq[i][c] += v * v;
+        Self {
+            width,
+            height,
+            sum: vec![[0.0; 3]; n],
+            sum_sq: vec![[0.0; 3]; n],
+            count: vec![0; n],
+            samples: 0..0,
+            blocks: Vec::new(),
+            data: Vec::new(),
         }
-        self.count[i] += 1;
     }
 
-    /// Adds another film of the same size (pixelwise sums), e.g. merging tiles or passes.
-    /// Panics if the sizes differ.
-    pub fn merge(&mut self, other: &Film) {
-        assert_eq!(
-            (self.width, self.height),
-            (other.width, other.height),
-            "merging films of different sizes"
-        );
-        let pixels = self.sum.iter_mut().zip(&mut self.sum_sq).zip(&mut self.count);
-        for (i, ((s, q), n)) in pixels.enumerate() {
-            for c in 0..3 {
-                s[c] += other.sum[i][c];
-                q[c] += other.sum_sq[i][c];
+    /// Number of pixels.
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// The sample indices accumulated (every pixel holds the same ones; empty for a new film).
+    pub fn samples(&self) -> Range<u32> {
+        self.samples.clone()
+    }
+
+    /// The live dyadic blocks, in increasing sample order.
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+
+    /// Moments of every live block, block-major: `block_data()[b * pixels() + p]`.
+    pub fn block_data(&self) -> &[Moments] {
+        &self.data
+    }
+
+    /// A film from its stored parts (a checkpoint): `blocks` must be the canonical blocks of
+    /// `samples` and `data` hold `blocks.len() * width * height` moments.
+    pub fn from_parts(width: u32, height: u32, samples: Range<u32>, blocks: Vec<Block>, data: Vec<Moments>) -> Result<Self, String> {
+        if canonical_blocks(samples.clone()) != blocks {
+            return Err(format!("the block list is not the dyadic decomposition of samples {}..{}", samples.start, samples.end));
+        }
+        let mut f = Film::new(width, height);
+        if data.len() != blocks.len() * f.pixels() {
+            return Err(format!("{} block values, expected {} blocks x {}x{} pixels", data.len(), blocks.len(), width, height));
+        }
+        f.samples = samples;
+        f.blocks = blocks;
+        f.data = data;
+        f.refresh();
+        Ok(f)
+    }
+
+    /// Replaces the block state (after a render) and recomputes the totals.
+    pub(crate) fn set_state(&mut self, samples: Range<u32>, blocks: Vec<Block>, data: Vec<Moments>) {
+        debug_assert_eq!(data.len(), blocks.len() * self.pixels());
+        self.samples = samples;
+        self.blocks = blocks;
+        self.data = data;
+        self.refresh();
+    }
+
+    /// Adds sample index `s` for every pixel (`rgb[p]` for pixel p); `s` must be the next sample
+    /// of the film's range (any index for an empty film). The scalar reference of the renderer's
+    /// accumulation. Panics on a wrong index or length.
+    pub fn add_sample(&mut self, s: u32, rgb: &[[f32; 3]]) {
+        let n = self.pixels();
+        assert_eq!(rgb.len(), n, "add_sample: {} values for {n} pixels", rgb.len());
+        if self.samples.is_empty() {
+            self.samples = s..s;
+        }
+        assert_eq!(s, self.samples.end, "add_sample: sample {s} does not continue {:?}", self.samples);
+        let d = self.blocks.len();
+        let c = push_block(&mut self.blocks, Block::leaf(s));
+        self.data.resize((d + 1) * n, [0.0; 6]);
+        for (p, v) in rgb.iter().enumerate() {
+            let mut acc = leaf_moments(*v);
+            for t in 0..c {
+                combine(&self.data[(d - 1 - t) * n + p], &mut acc);
             }
-            *n += other.count[i];
+            self.data[(d - c) * n + p] = acc;
+        }
+        self.data.truncate((d - c + 1) * n);
+        self.samples.end = s + 1;
+        self.refresh();
+    }
+
+    /// Merges a film of the same size holding the adjacent sample range (right after or right
+    /// before this one): combines sibling blocks bottom-up, so the result has exactly the bits of
+    /// one film that took all the samples. Errors if the sizes differ or the ranges do not touch.
+    pub fn merge(&mut self, other: &Film) -> Result<(), String> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(format!("merging a {}x{} film into a {}x{} one", other.width, other.height, self.width, self.height));
+        }
+        if other.samples.is_empty() {
+            return Ok(());
+        }
+        if self.samples.is_empty() {
+            *self = other.clone();
+            return Ok(());
+        }
+        let (left, right) = if self.samples.end == other.samples.start {
+            (&*self, other)
+        } else if other.samples.end == self.samples.start {
+            (other, &*self)
+        } else {
+            return Err(format!(
+                "sample ranges {}..{} and {}..{} are not adjacent",
+                self.samples.start, self.samples.end, other.samples.start, other.samples.end
+            ));
+        };
+        let n = self.pixels();
+        let mut blocks = left.blocks.clone();
+        let mut data = left.data.clone();
+        for (b, &blk) in right.blocks.iter().enumerate() {
+            let d = blocks.len();
+            let c = push_block(&mut blocks, blk);
+            data.resize((d + 1) * n, [0.0; 6]);
+            for p in 0..n {
+                let mut acc = right.data[b * n + p];
+                for t in 0..c {
+                    combine(&data[(d - 1 - t) * n + p], &mut acc);
+                }
+                data[(d - c) * n + p] = acc;
+            }
+            data.truncate((d - c + 1) * n);
+        }
+        let samples = left.samples.start..right.samples.end;
+        self.set_state(samples, blocks, data);
+        Ok(())
+    }
+
+    /// Recomputes the per-pixel totals: the fold of the blocks in increasing sample order.
+    fn refresh(&mut self) {
+        let n = self.pixels();
+        let count = self.samples.len() as u32;
+        for p in 0..n {
+            let mut t = [0.0f64; 6];
+            for b in 0..self.blocks.len() {
+                let m = &self.data[b * n + p];
+                if b == 0 {
+                    t = *m;
+                } else {
+                    for q in 0..6 {
+                        t[q] += m[q];
+                    }
+                }
+            }
+            self.sum[p] = [t[0], t[1], t[2]];
+            self.sum_sq[p] = [t[3], t[4], t[5]];
+            self.count[p] = count;
         }
     }
 
@@ -273,42 +487,109 @@ mod tests {
     fn mean_and_variance_of_known_samples() {
         let mut f = Film::new(3, 2);
         for v in [1.0, 2.0, 3.0] {
-            f.add(2, 1, [v, 2.0 * v, -v]);
+            let mut px = [[0.0f32; 3]; 6];
+            px[5] = [v, 2.0 * v, -v];
+            px[0] = [5.0; 3];
+            f.add_sample(10 + v as u32, &px);
         }
-        f.add(0, 0, [5.0, 5.0, 5.0]);
         let (m, var) = (f.mean(), f.variance_of_mean());
+        assert_eq!(f.samples(), 11..14);
         assert_eq!(m[5], [2.0, 4.0, -2.0]);
         let third = 1.0f32 / 3.0;
         assert!((var[5][0] - third).abs() < 1e-7 && (var[5][1] - 4.0 * third).abs() < 1e-6);
         assert!((var[5][2] - third).abs() < 1e-7);
-        assert_eq!((m[0], var[0]), ([5.0; 3], [0.0; 3]), "one sample: mean, no variance");
-        assert_eq!((m[1], var[1]), ([0.0; 3], [0.0; 3]), "no samples");
-        assert_eq!(f.count, vec![1, 0, 0, 0, 0, 3]);
+        assert_eq!((m[0], var[0]), ([5.0; 3], [0.0; 3]), "constant samples: mean, no variance");
+        assert_eq!((m[1], var[1]), ([0.0; 3], [0.0; 3]), "zero samples");
+        assert_eq!(f.count, vec![3; 6]);
+        assert_eq!((Film::new(2, 1).mean(), Film::new(2, 1).count), (vec![[0.0; 3]; 2], vec![0, 0]), "no samples");
         let mut g = Film::new(1, 1);
-        (0..4).for_each(|_| g.add(0, 0, [0.1; 3]));
+        (0..4).for_each(|s| g.add_sample(s, &[[0.1; 3]]));
         assert_eq!(g.variance_of_mean()[0], [0.0; 3], "constant samples: no negative round-off");
     }
 
+    /// A value with many significant bits, different per (sample, pixel, channel).
+    fn value(s: u32, p: usize) -> [f32; 3] {
+        let x = (s as f32 + 1.0) * 0.7310586 + p as f32 * 0.1234567;
+        [x.sin() * 3.1 + 3.2, 1.0 / (1.0 + x), (x * 1.618034).fract() * 1e3]
+    }
+
+    fn film_of(r: Range<u32>, w: u32, h: u32) -> Film {
+        let mut f = Film::new(w, h);
+        for s in r {
+            let px: Vec<[f32; 3]> = (0..(w * h) as usize).map(|p| value(s, p)).collect();
+            f.add_sample(s, &px);
+        }
+        f
+    }
+
+    fn bits(f: &Film) -> Vec<u64> {
+        f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect()
+    }
+
     #[test]
-    fn merge_equals_adding_all_samples_to_one_film() {
-        let (mut a, mut b, mut all) = (Film::new(4, 3), Film::new(4, 3), Film::new(4, 3));
-        for i in 0..40u32 {
-            let (x, y, v) = (i % 4, (i / 4) % 3, [i as f32 * 0.37, (i * i) as f32, 1.0 / (1 + i) as f32]);
-            if i % 3 == 0 {
-                a.add(x, y, v)
-            } else {
-                b.add(x, y, v)
+    fn canonical_blocks_are_the_minimal_aligned_cover() {
+        let b = |k, j| Block { k, j };
+        assert_eq!(canonical_blocks(0..7), vec![b(2, 0), b(1, 2), b(0, 6)]);
+        assert_eq!(canonical_blocks(3..13), vec![b(0, 3), b(2, 1), b(2, 2), b(0, 12)]);
+        assert_eq!(canonical_blocks(0..64), vec![b(6, 0)]);
+        assert_eq!(canonical_blocks(5..5), vec![]);
+        for lo in 0..40u32 {
+            for hi in lo..80 {
+                let bl = canonical_blocks(lo..hi);
+                // Contiguous cover, and no two neighbours are siblings (else it is not minimal).
+                let mut at = u64::from(lo);
+                for w in bl.windows(2) {
+                    assert!(!w[0].is_left_sibling_of(w[1]), "{lo}..{hi}: {bl:?}");
+                }
+                for x in &bl {
+                    assert_eq!(x.start(), at);
+                    at = x.end();
+                }
+                assert_eq!(at, u64::from(hi));
+                assert!(bl.len() <= 2 * (32 - (hi - lo).max(1).leading_zeros()) as usize, "{lo}..{hi}: {} blocks", bl.len());
             }
-            all.add(x, y, v);
         }
-        a.merge(&b);
-        assert_eq!(a.count, all.count);
-        assert_eq!(a.mean(), all.mean());
-        for (p, q) in a.variance_of_mean().iter().zip(all.variance_of_mean()) {
-            for c in 0..3 {
-                assert!((p[c] - q[c]).abs() <= 1e-6 * q[c].abs().max(1e-6), "{p:?} vs {q:?}");
+    }
+
+    #[test]
+    fn merge_of_any_split_is_bit_identical_to_one_film() {
+        let (w, h) = (3, 2);
+        let all = film_of(0..45, w, h);
+        for cuts in [vec![1u32], vec![20], vec![7, 8, 9], vec![3, 16, 17, 31, 44], vec![32], (1..45).collect()] {
+            let mut edges = vec![0];
+            edges.extend(&cuts);
+            edges.push(45);
+            let parts: Vec<Film> = edges.windows(2).map(|e| film_of(e[0]..e[1], w, h)).collect();
+            // Merge left to right, and also right to left: same bits, same blocks.
+            let mut l = Film::new(w, h);
+            parts.iter().for_each(|p| l.merge(p).unwrap());
+            let mut r = Film::new(w, h);
+            parts.iter().rev().for_each(|p| r.merge(p).unwrap());
+            for m in [&l, &r] {
+                assert_eq!(m.samples(), 0..45);
+                assert_eq!(m.blocks(), all.blocks(), "cuts {cuts:?}");
+                assert_eq!(bits(m), bits(&all), "cuts {cuts:?}");
+                assert_eq!(m.count, all.count);
             }
         }
+        // Not adjacent, or another size: refused.
+        let mut a = film_of(0..4, w, h);
+        assert!(a.merge(&film_of(5..9, w, h)).unwrap_err().contains("not adjacent"));
+        assert!(a.merge(&film_of(4..9, 2, 2)).is_err());
+        assert_eq!(a.samples(), 0..4, "a refused merge leaves the film as it was");
+    }
+
+    #[test]
+    fn dyadic_sum_is_close_to_the_plain_sum_and_from_parts_checks_blocks() {
+        let f = film_of(0..100, 2, 1);
+        for p in 0..2 {
+            let plain = (0..100).map(|s| f64::from(value(s, p)[1])).sum::<f64>();
+            assert!((f.sum[p][1] - plain).abs() <= 1e-12 * plain.abs(), "{} vs {plain}", f.sum[p][1]);
+        }
+        let g = Film::from_parts(2, 1, 0..100, f.blocks().to_vec(), f.block_data().to_vec()).unwrap();
+        assert_eq!(bits(&g), bits(&f));
+        assert!(Film::from_parts(2, 1, 0..99, f.blocks().to_vec(), f.block_data().to_vec()).is_err());
+        assert!(Film::from_parts(2, 1, 0..100, f.blocks().to_vec(), f.block_data()[1..].to_vec()).is_err());
     }
 
     #[test]

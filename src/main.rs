@@ -60,6 +60,20 @@ enum Cmd {
         #[arg(long, default_value_t = 1_000_000)]
         triangles: usize,
     },
+    /// Merge the part files of `render --samples A..B` shards (checkpoints) into OUT.exr and
+    /// OUT.png, bit-identical to one render of the whole range; refuses parts of another render,
+    /// unfinished parts, overlaps and gaps.
+    Merge {
+        /// Part files (.ckpt), any order.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output stem: writes OUT.exr and OUT.png.
+        #[arg(short = 'o', long = "out")]
+        out: PathBuf,
+        /// Print nothing on success.
+        #[arg(long, short = 'q')]
+        quiet: bool,
+    },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
         #[command(flatten)]
@@ -120,6 +134,24 @@ struct RenderArgs {
     /// at most MAX (trades fireflies for a darker, inconsistent estimate; off by default).
     #[arg(long, value_name = "MAX", value_parser = parse_clamp)]
     clamp: Option<f32>,
+    /// Write the accumulated state here (atomically) every --checkpoint-every seconds and at the
+    /// end; resume it with --resume. Default with --samples or on Ctrl-C: OUT.ckpt.
+    #[arg(long)]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (0: after every pass).
+    #[arg(long, default_value_t = app::DEFAULT_CHECKPOINT_EVERY)]
+    checkpoint_every: f64,
+    /// Continue the render held in this checkpoint (refused if the scene or an option differs);
+    /// it keeps being checkpointed there unless --checkpoint says otherwise.
+    #[arg(long)]
+    resume: Option<PathBuf>,
+    /// Render only sample indices A..B (0 <= A < B <= spp) of every pixel: a part for `strata merge`.
+    #[arg(long, value_parser = parse_range)]
+    samples: Option<(u32, u32)>,
+    /// Render whole passes until this many seconds are spent and record the spp reached
+    /// (independent pixel and path layouts; --spp, if given, caps the samples).
+    #[arg(long)]
+    time_budget: Option<f64>,
 }
 
 impl RenderArgs {
@@ -140,6 +172,12 @@ impl RenderArgs {
             general_kernel: self.kernel == "general",
             camera: self.camera,
             clamp: self.clamp,
+            checkpoint: self.checkpoint,
+            checkpoint_every: Some(self.checkpoint_every),
+            resume: self.resume,
+            samples: self.samples,
+            time_budget: self.time_budget,
+            stop: None,
         }
     }
 }
@@ -157,6 +195,16 @@ fn parse_clamp(s: &str) -> Result<f32, String> {
     }
 }
 
+fn parse_range(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B, got `{s}`"))?;
+    let p = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected A..B with non-negative integers, got `{s}`"));
+    let (a, b) = (p(a)?, p(b)?);
+    if a >= b {
+        return Err(format!("expected A..B with A < B, got `{s}`"));
+    }
+    Ok((a, b))
+}
+
 fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
     SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton, sobol, pmj02)"))
 }
@@ -170,12 +218,42 @@ fn main() -> ExitCode {
     let result = match cli.cmd {
         Cmd::Render(args) | Cmd::Reference(args) => {
             let quiet = args.quiet;
-            app::run_render(&args.options()).map(|o| {
-                if !quiet {
-                    println!("{}", app::summary(&o));
+            let mut opts = args.options();
+            match app::stop_on_signals() {
+                Ok(flag) => opts.stop = Some(flag),
+                Err(e) => eprintln!("strata: {e}; Ctrl-C will not checkpoint"),
+            }
+            match app::run_render(&opts) {
+                Ok(o) if o.interrupted => {
+                    let ck = o.checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+                    eprintln!(
+                        "strata: interrupted after {} spp; image written, checkpoint {ck}: continue with the same flags and --resume {ck}",
+                        o.film.samples().len()
+                    );
+                    return ExitCode::from(130);
                 }
-            })
+                Ok(o) => {
+                    if !quiet {
+                        println!("{}", app::summary(&o));
+                    }
+                    Ok(())
+                }
+                Err(e) => Err(e),
+            }
         }
+        Cmd::Merge { parts, out, quiet } => app::run_merge(&parts, &out).map(|m| {
+            if !quiet {
+                println!(
+                    "merged {} parts: {} spp ({}..{}), {:.3} CPU seconds -> {}.exr/.png",
+                    m.header.parts.len(),
+                    m.header.samples[1] - m.header.samples[0],
+                    m.header.samples[0],
+                    m.header.samples[1],
+                    m.header.cpu_seconds,
+                    m.out.display()
+                );
+            }
+        }),
         Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
             run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
         }

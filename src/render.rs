@@ -1,11 +1,12 @@
 //! Tiles, threads and accumulation: the only place with threads.
 //!
 //! The image is cut into 16x16-pixel tiles; a tile is cut into 4x2-pixel packets. Tiles run in
-//! parallel under rayon; each pixel's samples are accumulated in f64 in increasing sample order,
+//! parallel under rayon; each pixel's samples are accumulated in f64 dyadic blocks (see `film`) in increasing sample
+//! order,
 //! and every sample value is a pure function of (pixel, sample, dimension, seed), so the image is
 //! bit-identical whatever the thread count or tile schedule.
 
-use crate::film::Film;
+use crate::film::{combine, leaf_moments, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
@@ -63,6 +64,8 @@ pub struct RenderStats {
     pub counters: Counters,
     /// worker threads used
     pub threads: usize,
+    /// thread-seconds spent rendering tiles, summed over the workers (CPU time of the sampling)
+    pub cpu_seconds: f64,
 }
 
 impl RenderStats {
@@ -77,7 +80,9 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, rayon::ThreadPoo
     rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()
 }
 
-/// Renders samples `samples.start..samples.end` of every pixel into `film` (which accumulates).
+/// Renders samples `samples.start..samples.end` of every pixel into `film`, which accumulates:
+/// `samples` must continue the film's range (start where it ends; any start for an empty film).
+/// Panics otherwise (callers check ranges before rendering).
 pub fn render(
     scene: &Scene,
     integrator: &Integrator,
@@ -85,69 +90,86 @@ pub fn render(
     samples: std::ops::Range<u32>,
     pool: &rayon::ThreadPool,
 ) -> RenderStats {
+    let have = film.samples();
+    assert!(
+        have.is_empty() || have.end == samples.start,
+        "render: samples {samples:?} do not continue the film's {have:?}"
+    );
     let (w, h) = (film.width, film.height);
+    let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
+    if samples.is_empty() {
+        return stats;
+    }
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     let start = Instant::now();
     let film_in: &Film = film;
-    let results: Vec<(TileResult, Counters)> = pool.install(|| {
+    let results: Vec<(TileResult, Counters, f64)> = pool.install(|| {
         tiles
             .par_iter()
             .map_init(Scratch::default, |scratch, &(tx, ty)| {
+                let t0 = Instant::now();
                 let mut counters = Counters::default();
                 let mut r = TileResult::from_film(film_in, tx * TILE, ty * TILE);
                 render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
-                (r, counters)
+                (r, counters, t0.elapsed().as_secs_f64())
             })
             .collect()
     });
-    let seconds = start.elapsed().as_secs_f64();
-    let mut counters = Counters::default();
-    for (tile, c) in &results {
-        counters.merge(c);
-        tile.store(film);
+    stats.seconds = start.elapsed().as_secs_f64();
+    let first = if have.is_empty() { samples.start } else { have.start };
+    let mut blocks = film.blocks().to_vec();
+    samples.clone().for_each(|s| {
+        push_block(&mut blocks, Block::leaf(s));
+    });
+    let n = film.pixels();
+    let mut data = vec![[0.0; 6]; blocks.len() * n];
+    for (tile, c, busy) in &results {
+        stats.counters.merge(c);
+        stats.cpu_seconds += busy;
+        debug_assert_eq!(tile.blocks, blocks);
+        tile.store(&mut data, w, n);
     }
-    RenderStats { seconds, counters, threads: pool.current_num_threads() }
+    film.set_state(first..samples.end, blocks, data);
+    stats
 }
 
-/// Accumulated samples of one tile (f64 sums, row-major inside the tile).
+/// Accumulated samples of one tile: the film's dyadic blocks continued (moments level-major,
+/// `data[level * tw * th + pixel in the tile]`).
 struct TileResult {
     x0: u32,
     y0: u32,
     tw: u32,
     th: u32,
-    sum: Vec<[f64; 3]>,
-    sum_sq: Vec<[f64; 3]>,
-    count: u32,
+    blocks: Vec<Block>,
+    data: Vec<Moments>,
 }
 
 impl TileResult {
-    /// The film's current sums for the tile at (x0, y0): samples continue the same running sums,
-    /// so an image is bit-identical however its samples are split into passes.
+    /// The film's current blocks for the tile at (x0, y0): samples continue the same binary
+    /// counter, so an image is bit-identical however its samples are split into passes.
     fn from_film(film: &Film, x0: u32, y0: u32) -> Self {
         let (tw, th) = (TILE.min(film.width - x0), TILE.min(film.height - y0));
-        let idx = |tx: u32, ty: u32| ((y0 + ty) * film.width + x0 + tx) as usize;
-        let cells = || (0..th).flat_map(move |ty| (0..tw).map(move |tx| (tx, ty)));
-        Self {
-            x0,
-            y0,
-            tw,
-            th,
-            sum: cells().map(|(x, y)| film.sum[idx(x, y)]).collect(),
-            sum_sq: cells().map(|(x, y)| film.sum_sq[idx(x, y)]).collect(),
-            count: 0,
+        let n = film.pixels();
+        let src = film.block_data();
+        let mut data = Vec::with_capacity((film.blocks().len() + 8) * (tw * th) as usize);
+        for b in 0..film.blocks().len() {
+            for ty in 0..th {
+                let row = b * n + ((y0 + ty) * film.width + x0) as usize;
+                data.extend_from_slice(&src[row..row + tw as usize]);
+            }
         }
+        Self { x0, y0, tw, th, blocks: film.blocks().to_vec(), data }
     }
 
-    /// Writes the running sums back and adds the samples taken.
-    fn store(&self, film: &mut Film) {
-        for ty in 0..self.th {
-            for tx in 0..self.tw {
-                let i = (ty * self.tw + tx) as usize;
-                let j = ((self.y0 + ty) * film.width + self.x0 + tx) as usize;
-                film.sum[j] = self.sum[i];
-                film.sum_sq[j] = self.sum_sq[i];
-                film.count[j] += self.count;
+    /// Writes the tile's blocks into the film-wide block-major array (`n` pixels, width `w`).
+    fn store(&self, data: &mut [Moments], w: u32, n: usize) {
+        let tn = (self.tw * self.th) as usize;
+        for b in 0..self.blocks.len() {
+            for ty in 0..self.th {
+                let i = b * tn + (ty * self.tw) as usize;
+                let j = b * n + ((self.y0 + ty) * w + self.x0) as usize;
+                data[j..j + self.tw as usize].copy_from_slice(&self.data[i..i + self.tw as usize]);
             }
         }
     }
@@ -165,6 +187,7 @@ fn render_tile(
     let (x0, y0, tw, th) = (tile.x0, tile.y0, tile.tw, tile.th);
     let (w, h) = (scene.desc.width, scene.desc.height);
     let packets = tile_packets(x0, y0, tw, th, w, h);
+    let tn = (tw * th) as usize;
     let mut radiance = Vec::with_capacity(packets.len() * SAMPLE_BATCH as usize);
     let mut start = samples.start;
     while start < samples.end {
@@ -172,22 +195,32 @@ fn render_tile(
         // still accumulated in increasing order.
         let batch = start..samples.end.min(start + SAMPLE_BATCH);
         integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None);
-        for per_sample in radiance.chunks_exact(packets.len()) {
+        for (s, per_sample) in batch.clone().zip(radiance.chunks_exact(packets.len())) {
+            // The block structure is the same for every pixel: one binary-counter step.
+            let depth = tile.blocks.len();
+            let carries = push_block(&mut tile.blocks, Block::leaf(s));
+            if tile.data.len() < (depth + 1) * tn {
+                tile.data.resize((depth + 1) * tn, [0.0; 6]);
+            }
             for (pk, l) in packets.iter().zip(per_sample) {
-                accumulate(&mut tile.sum, &mut tile.sum_sq, pk, x0, y0, tw, l, counters);
+                accumulate(&mut tile.data, tn, depth, carries, pk, x0, y0, tw, l, counters);
             }
         }
         start = batch.end;
     }
-    tile.count += samples.len() as u32;
+    tile.data.truncate(tile.blocks.len() * tn);
 }
 
-/// Adds one sample per active lane; a non-finite lane value is counted and replaced by zero so
-/// no NaN or Inf ever reaches the image.
+/// Adds one sample per active lane as a leaf of the dyadic stack (`depth` live levels of `tn`
+/// pixels each before the sample; the leaf combines with the top `carries` levels). A non-finite
+/// lane value is counted and replaced by zero so no NaN or Inf ever reaches the image.
 #[allow(clippy::too_many_arguments)]
+#[inline]
 fn accumulate(
-    sum: &mut [[f64; 3]],
-    sum_sq: &mut [[f64; 3]],
+    data: &mut [Moments],
+    tn: usize,
+    depth: usize,
+    carries: usize,
     pk: &PixelPacket,
     x0: u32,
     y0: u32,
@@ -210,11 +243,11 @@ fn accumulate(
             glam::Vec3::ZERO
         };
         let j = ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize;
-        for c in 0..3 {
-            let x = v[c] as f64;
-            sum[j][c] += x;
-            sum_sq[j][c] += x * x;
+        let mut acc = leaf_moments([v.x, v.y, v.z]);
+        for t in 0..carries {
+            combine(&data[(depth - 1 - t) * tn + j], &mut acc);
         }
+        data[(depth - carries) * tn + j] = acc;
     }
 }
 

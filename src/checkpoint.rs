@@ -1,0 +1,292 @@
+//! Checkpoint and part files: the accumulated state of a render (its dyadic blocks, see `film`),
+//! with what identifies the render (scene hash, every option that affects the image), so that a
+//! run can be resumed and shards of one render merged bit-identically.
+//!
+//! Layout (version 1), all integers little-endian:
+//! `b"STRATACK"`, u32 version, u64 header length, the header as UTF-8 JSON ([`Header`]), then
+//! `blocks * width * height * 6` f64 (block-major; per pixel sum R, G, B, sum of squares R, G, B),
+//! then a u64 checksum of every byte before it. Written atomically ([`crate::film::write_atomic`]).
+
+use crate::film::{self, Block, Film, Moments};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// File magic.
+pub const MAGIC: &[u8; 8] = b"STRATACK";
+/// Format version written and read.
+pub const VERSION: u32 = 1;
+/// Refuse headers larger than this (a corrupt length must not allocate gigabytes).
+const MAX_HEADER: u64 = 64 << 20;
+
+/// What a checkpoint records besides the moments.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// strata version that wrote it (part of the identity: sample values may change across versions)
+    pub strata_version: String,
+    /// scene file as named on the command line (informative)
+    pub scene: String,
+    /// hash of the scene file's bytes ([`hash_bytes`], hex)
+    pub scene_hash: String,
+    /// every option that affects the image, resolved (spp, seed, samplers, integrator, ...)
+    pub options: BTreeMap<String, serde_json::Value>,
+    /// image width
+    pub width: u32,
+    /// image height
+    pub height: u32,
+    /// the sample range this run was asked for (`--samples`, else 0..spp)
+    pub target: [u32; 2],
+    /// the sample range held
+    pub samples: [u32; 2],
+    /// the dyadic blocks of `samples`, as (k, j)
+    pub blocks: Vec<[u32; 2]>,
+    /// thread-seconds spent rendering (summed over sessions and parts)
+    pub cpu_seconds: f64,
+    /// wall-clock seconds of rendering (summed over sessions)
+    pub render_seconds: f64,
+    /// rays traced
+    pub rays: u64,
+    /// the files a merged state came from, with their ranges (empty for a render)
+    pub parts: Vec<String>,
+}
+
+impl Header {
+    /// Why a checkpoint with header `self` cannot continue or join a render with header `want`
+    /// (other scene, version, size or options), or None if it can; `label` names `want` in the
+    /// message (e.g. "this render").
+    pub fn mismatch(&self, want: &Header, label: &str) -> Option<String> {
+        if self.scene_hash != want.scene_hash {
+            return Some(format!(
+                "it is of another scene ({} hash {}; {label}: {} hash {})",
+                self.scene, self.scene_hash, want.scene, want.scene_hash
+            ));
+        }
+        if self.strata_version != want.strata_version {
+            return Some(format!("it was written by strata {} ({label}: {})", self.strata_version, want.strata_version));
+        }
+        if (self.width, self.height) != (want.width, want.height) {
+            return Some(format!("it is {}x{} ({label}: {}x{})", self.width, self.height, want.width, want.height));
+        }
+        let keys: std::collections::BTreeSet<&String> = self.options.keys().chain(want.options.keys()).collect();
+        let diffs: Vec<String> = keys
+            .into_iter()
+            .filter(|k| self.options.get(*k) != want.options.get(*k))
+            .map(|k| {
+                let show = |v: Option<&serde_json::Value>| v.map_or("(unset)".to_string(), |v| v.to_string());
+                format!("{k} {} ({label}: {})", show(self.options.get(k)), show(want.options.get(k)))
+            })
+            .collect();
+        (!diffs.is_empty()).then(|| format!("it was rendered with other options: {}", diffs.join(", ")))
+    }
+}
+
+/// FNV-1a, 64 bit, of `bytes`, as 16 hex digits: the scene hash.
+pub fn hash_bytes(bytes: &[u8]) -> String {
+    format!("{:016x}", fnv1a(0xcbf2_9ce4_8422_2325, bytes))
+}
+
+fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// Checksum of a file body: FNV-1a over 8-byte words (fast enough for GB-sized states), then over
+/// the tail bytes.
+fn checksum(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let words = bytes.chunks_exact(8);
+    let tail = words.remainder();
+    for w in words {
+        h ^= u64::from_le_bytes(w.try_into().expect("8 bytes"));
+        h = h.wrapping_mul(0x0000_0100_0000_01b3).rotate_left(29);
+    }
+    fnv1a(h, tail)
+}
+
+/// The header for `film` (its samples and blocks filled in from the film).
+pub fn header_for(mut base: Header, film: &Film) -> Header {
+    let s = film.samples();
+    base.width = film.width;
+    base.height = film.height;
+    base.samples = [s.start, s.end];
+    base.blocks = film.blocks().iter().map(|b| [u32::from(b.k), b.j]).collect();
+    base
+}
+
+/// Serializes `film` with `header` (whose samples and blocks are overwritten from the film).
+pub fn to_bytes(header: &Header, film: &Film) -> Vec<u8> {
+    let header = header_for(header.clone(), film);
+    let json = serde_json::to_vec(&header).expect("a header serializes");
+    let data = film.block_data();
+    let mut out = Vec::with_capacity(28 + json.len() + data.len() * 48);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&(json.len() as u64).to_le_bytes());
+    out.extend_from_slice(&json);
+    for m in data {
+        for v in m {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let sum = checksum(&out);
+    out.extend_from_slice(&sum.to_le_bytes());
+    out
+}
+
+/// Writes a checkpoint atomically (temporary file, fsync, rename).
+pub fn write(path: &Path, header: &Header, film: &Film) -> Result<(), String> {
+    film::write_atomic(path, &to_bytes(header, film)).map_err(|e| format!("{}: cannot write checkpoint: {e}", path.display()))
+}
+
+/// Parses checkpoint bytes; `name` labels errors.
+pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), String> {
+    let bad = |msg: String| format!("{name}: not a usable strata checkpoint: {msg}");
+    if bytes.len() < 8 || &bytes[..8] != MAGIC {
+        return Err(bad("wrong magic (not a strata checkpoint file)".into()));
+    }
+    if bytes.len() < 28 {
+        return Err(bad(format!("truncated ({} bytes)", bytes.len())));
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if version != VERSION {
+        return Err(bad(format!("format version {version}, this strata reads version {VERSION}")));
+    }
+    let hlen = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
+    if hlen > MAX_HEADER || 20 + hlen + 8 > bytes.len() as u64 {
+        return Err(bad(format!("truncated or corrupt (header of {hlen} bytes in a file of {})", bytes.len())));
+    }
+    let body_end = bytes.len() - 8;
+    let stored = u64::from_le_bytes(bytes[body_end..].try_into().expect("8 bytes"));
+    let hend = 20 + hlen as usize;
+    let header: Header = serde_json::from_slice(&bytes[20..hend]).map_err(|e| bad(format!("corrupt header: {e}")))?;
+    let pixels = header.width as u64 * header.height as u64;
+    let expected = (hend as u64).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
+    if expected != bytes.len() as u64 {
+        return Err(bad(format!(
+            "truncated or corrupt: {} bytes, expected {expected} for {} blocks of {}x{} pixels",
+            bytes.len(),
+            header.blocks.len(),
+            header.width,
+            header.height
+        )));
+    }
+    if checksum(&bytes[..body_end]) != stored {
+        return Err(bad("checksum mismatch (the file is corrupt)".into()));
+    }
+    let mut blocks = Vec::with_capacity(header.blocks.len());
+    for &[k, j] in &header.blocks {
+        let k = u8::try_from(k).ok().filter(|&k| k <= 32).ok_or_else(|| bad(format!("bad block size 2^{k}")))?;
+        blocks.push(Block { k, j });
+    }
+    let data: Vec<Moments> = bytes[hend..body_end]
+        .chunks_exact(48)
+        .map(|c| std::array::from_fn(|q| f64::from_le_bytes(c[8 * q..8 * q + 8].try_into().expect("8 bytes"))))
+        .collect();
+    let [lo, hi] = header.samples;
+    if lo > hi {
+        return Err(bad(format!("bad sample range {lo}..{hi}")));
+    }
+    let film = Film::from_parts(header.width, header.height, lo..hi, blocks, data).map_err(bad)?;
+    Ok((header, film))
+}
+
+/// Reads a checkpoint written by [`write`], checking magic, version, size and checksum.
+pub fn read(path: &Path) -> Result<(Header, Film), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read checkpoint: {e}", path.display()))?;
+    from_bytes(&bytes, &path.display().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn film(r: std::ops::Range<u32>) -> Film {
+        let mut f = Film::new(3, 2);
+        for s in r {
+            let px: Vec<[f32; 3]> = (0..6).map(|p| [s as f32 * 0.3 + p as f32, 1.0 / (1.0 + s as f32), -(p as f32)]).collect();
+            f.add_sample(s, &px);
+        }
+        f
+    }
+
+    fn header() -> Header {
+        let options = [("spp", serde_json::json!(64)), ("seed", serde_json::json!(3)), ("pixel_sampler", serde_json::json!("sobol"))]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        Header {
+            strata_version: "0.1.0".into(),
+            scene: "a.test".into(),
+            scene_hash: hash_bytes(b"size 8 8\n"),
+            options,
+            width: 3,
+            height: 2,
+            target: [0, 64],
+            samples: [0, 0],
+            blocks: vec![],
+            cpu_seconds: 1.5,
+            render_seconds: 0.75,
+            rays: 1000,
+            parts: vec![],
+        }
+    }
+
+    #[test]
+    fn round_trip_is_bit_exact() {
+        let f = film(5..27);
+        let bytes = to_bytes(&header(), &f);
+        let (h, g) = from_bytes(&bytes, "x").unwrap();
+        assert_eq!(g, f);
+        assert_eq!((h.samples, h.blocks.len(), h.cpu_seconds), ([5, 27], f.blocks().len(), 1.5));
+        assert_eq!(header_for(header(), &f), h);
+        // An empty film round-trips too.
+        let (_, e) = from_bytes(&to_bytes(&header(), &Film::new(3, 2)), "e").unwrap();
+        assert_eq!(e.samples(), 0..0);
+    }
+
+    #[test]
+    fn truncated_or_corrupt_files_are_clear_errors() {
+        let bytes = to_bytes(&header(), &film(0..9));
+        for cut in [0, 5, 12, 27, 40, bytes.len() / 2, bytes.len() - 9, bytes.len() - 1] {
+            let e = from_bytes(&bytes[..cut], "t.ckpt").unwrap_err();
+            assert!(e.starts_with("t.ckpt: "), "{e}");
+            assert!(e.contains("truncated") || e.contains("magic") || e.contains("corrupt"), "cut {cut}: {e}");
+        }
+        // A flipped bit anywhere is caught (header or data).
+        for at in [25, bytes.len() / 2, bytes.len() - 12] {
+            let mut b = bytes.clone();
+            b[at] ^= 0x10;
+            assert!(from_bytes(&b, "c").is_err(), "flip at {at}");
+        }
+        let mut b = bytes.clone();
+        b[8] = 9;
+        assert!(from_bytes(&b, "v").unwrap_err().contains("version 9"));
+        assert!(from_bytes(b"PNG....", "p").unwrap_err().contains("magic"));
+    }
+
+    #[test]
+    fn mismatches_name_what_differs() {
+        let a = header();
+        assert_eq!(a.mismatch(&a.clone(), "this render"), None);
+        let mut b = a.clone();
+        b.scene_hash = hash_bytes(b"size 8 9\n");
+        assert!(a.mismatch(&b, "this render").unwrap().contains("another scene"));
+        let mut b = a.clone();
+        b.options.insert("seed".into(), serde_json::json!(4));
+        let m = a.mismatch(&b, "this render").unwrap();
+        assert!(m.contains("seed 3 (this render: 4)"), "{m}");
+        let mut b = a.clone();
+        b.width = 4;
+        assert!(a.mismatch(&b, "this render").unwrap().contains("3x2"));
+        let mut b = a.clone();
+        b.strata_version = "9.9.9".into();
+        assert!(a.mismatch(&b, "this render").unwrap().contains("9.9.9"));
+        // Timing, ranges and parts are not identity.
+        let mut b = a.clone();
+        (b.cpu_seconds, b.target, b.parts) = (9.0, [0, 8], vec!["p".into()]);
+        assert_eq!(a.mismatch(&b, "this render"), None);
+    }
+}
