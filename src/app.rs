@@ -48,8 +48,6 @@ pub struct RenderOptions {
     pub progress: bool,
     /// run the general kernel instead of the one specialized for the scene's features
     pub general_kernel: bool,
-    /// camera override (`--camera`), for `.obj` and `.test` scenes alike
-    pub camera: Option<crate::scene::desc::CameraDesc>,
     /// path tracer: clamp each pixel sample's largest channel to this value (biased; None = off)
     pub clamp: Option<f32>,
     /// checkpoint file: the accumulated state is written there every `checkpoint_every` seconds
@@ -66,6 +64,10 @@ pub struct RenderOptions {
     pub time_budget: Option<f64>,
     /// set (e.g. by SIGINT/SIGTERM) to stop after the current pass, checkpoint and write the image
     pub stop: Option<Arc<AtomicBool>>,
+    /// camera override (`--camera`), for `.obj` and `.test` scenes alike
+    pub camera: Option<crate::scene::desc::CameraDesc>,
+    /// path tracer: direction sampling override (default: the scene's `importancesampling`)
+    pub importance_sampling: Option<crate::scene::desc::ImportanceSampling>,
 }
 
 /// Default seconds between two checkpoints.
@@ -115,6 +117,9 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
     if let Some(c) = opts.camera {
         desc.camera = Some(c);
     }
+    if let Some(s) = opts.importance_sampling {
+        desc.importance_sampling = s;
+    }
     Ok(desc)
 }
 
@@ -150,6 +155,17 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
         "analyticdirect" => IntegratorKind::AnalyticDirect,
         "direct" => IntegratorKind::Direct,
         "pathtracer" => IntegratorKind::PathTracer,
+        _ => return None,
+    })
+}
+
+/// Parses a direction sampling strategy as the format spells it: hemisphere, cosine or brdf.
+pub fn parse_importance_sampling(s: &str) -> Option<crate::scene::desc::ImportanceSampling> {
+    use crate::scene::desc::ImportanceSampling as I;
+    Some(match s {
+        "hemisphere" => I::Hemisphere,
+        "cosine" => I::Cosine,
+        "brdf" => I::Brdf,
         _ => return None,
     })
 }
@@ -196,14 +212,13 @@ pub fn identity(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<
         ("clamp", json!(it.clamp)),
     ]
     .into_iter()
-    // `--camera` (present only when given, so other renders' identities are unchanged).
-    .chain(opts.camera.map(|c| ("camera", json!([c.eye.to_array(), c.center.to_array(), c.up.to_array(), [c.fovy_deg]]))))
     .map(|(k, v)| (k.to_string(), v))
     .collect();
     Ok(Header {
         strata_version: env!("CARGO_PKG_VERSION").to_string(),
         scene: d.source.display().to_string(),
-        scene_hash: scene_hash(opts)?,
+        // The file's bytes and the parsed content (which covers included OBJ and MTL files).
+        scene_hash: format!("{}-{:016x}", scene_hash(opts)?, d.content_hash()),
         options,
         width: d.width,
         height: d.height,

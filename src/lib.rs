@@ -3,6 +3,7 @@ pub mod accel;
 pub mod app;
 pub mod bsdf;
 pub mod checkpoint;
+pub mod experiments;
 pub mod film;
 pub mod integrator;
 pub mod lab;

@@ -51,15 +51,6 @@ enum Cmd {
         #[arg(long, default_value = "compare")]
         out: PathBuf,
     },
-    /// Write a procedural OBJ+MTL mesh (bumpy torus on a floor under an emissive patch) of at least
-    /// --triangles triangles, for throughput runs: OUT.obj and OUT.mtl.
-    GenMesh {
-        /// Output OBJ path (the MTL is written beside it).
-        out: PathBuf,
-        /// Minimum number of triangles of the torus.
-        #[arg(long, default_value_t = 1_000_000)]
-        triangles: usize,
-    },
     /// Merge the part files of `render --samples A..B` shards (checkpoints) into OUT.exr and
     /// OUT.png, bit-identical to one render of the whole range; refuses parts of another render,
     /// unfinished parts, overlaps and gaps.
@@ -73,6 +64,43 @@ enum Cmd {
         /// Print nothing on success.
         #[arg(long, short = 'q')]
         quiet: bool,
+    },
+    /// Write a procedural OBJ+MTL mesh (bumpy torus on a floor under an emissive patch) of at least
+    /// --triangles triangles, for throughput runs: OUT.obj and OUT.mtl.
+    GenMesh {
+        /// Output OBJ path (the MTL is written beside it).
+        out: PathBuf,
+        /// Minimum number of triangles of the torus.
+        #[arg(long, default_value_t = 1_000_000)]
+        triangles: usize,
+    },
+    /// Regenerate the seed experiments (direct lighting light samplers; path tracing pixel
+    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, contact sheets, plots.
+    Experiments {
+        /// Output folder.
+        #[arg(long, default_value = "docs/experiments")]
+        out: PathBuf,
+        /// The CSE168 corpus (default ../shared/cse168 beside the crate, or $STRATA_CSE168).
+        #[arg(long)]
+        corpus: Option<PathBuf>,
+        /// Independent runs per variant (K).
+        #[arg(long, default_value_t = 16)]
+        runs: usize,
+        /// Image width (heights keep each scene's aspect).
+        #[arg(long, default_value_t = 160)]
+        width: u32,
+        /// Light samples of each half of the direct-lighting reference.
+        #[arg(long, default_value_t = 4096)]
+        ref_light_samples: u32,
+        /// spp of the path-tracing references.
+        #[arg(long, default_value_t = 1024)]
+        ref_spp: u32,
+        /// Worker threads (0 = all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Contact-sheet tiles are the images box-downsampled by this factor.
+        #[arg(long, default_value_t = 2)]
+        sheet_factor: u32,
     },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
@@ -117,6 +145,9 @@ struct RenderArgs {
     /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
     #[arg(long, value_parser = parse_integrator)]
     integrator: Option<strata::scene::desc::IntegratorKind>,
+    /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
+    #[arg(long, value_parser = parse_importance_sampling)]
+    importance_sampling: Option<strata::scene::desc::ImportanceSampling>,
     /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
     #[arg(short = 'o', long = "out")]
     out: Option<PathBuf>,
@@ -170,7 +201,6 @@ impl RenderArgs {
             integrator: self.integrator,
             progress: !self.quiet,
             general_kernel: self.kernel == "general",
-            camera: self.camera,
             clamp: self.clamp,
             checkpoint: self.checkpoint,
             checkpoint_every: Some(self.checkpoint_every),
@@ -178,6 +208,8 @@ impl RenderArgs {
             samples: self.samples,
             time_budget: self.time_budget,
             stop: None,
+            camera: self.camera,
+            importance_sampling: self.importance_sampling,
         }
     }
 }
@@ -211,6 +243,10 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
 
 fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, String> {
     app::parse_integrator(s).ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
+}
+
+fn parse_importance_sampling(s: &str) -> Result<strata::scene::desc::ImportanceSampling, String> {
+    app::parse_importance_sampling(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
 }
 
 fn main() -> ExitCode {
@@ -262,6 +298,14 @@ fn main() -> ExitCode {
             strata::scene::obj::write_obj(&out, &mesh)
                 .map(|mtl| println!("{}: {} triangles, {} vertices (materials {})", out.display(), mesh.faces.len(), mesh.positions.len(), mtl.display()))
                 .map_err(|e| format!("{}: {e}", out.display()))
+        }
+        Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
+            let corpus = corpus.unwrap_or_else(strata::experiments::default_corpus);
+            let cfg = strata::experiments::Config { corpus, out: out.clone(), runs, width, ref_light_samples, ref_spp, threads, verbose: true, sheet_factor };
+            strata::experiments::run(&cfg).map(|md| {
+                println!("{md}");
+                println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
+            })
         }
         Cmd::Rays { args, json } => app::run_rays(&args.options()).map(|(rates, name)| {
             if json {

@@ -260,3 +260,34 @@ fn time_budget_renders_whole_passes_and_records_spp() {
     assert_eq!(j["rays"]["camera"].as_u64().unwrap(), 64 * 48 * spp);
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// A checkpoint covers every input file: a change to an OBJ included by the `.test` file (which
+/// itself is unchanged) makes another scene; so does another `--clamp`.
+#[test]
+fn resume_refuses_a_changed_included_obj_and_another_clamp() {
+    let d = tmpdir("included");
+    let obj = "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 3 2\nf 1 4 3\n";
+    std::fs::write(d.join("floor.obj"), obj).unwrap();
+    let test = "size 16 16\ncamera 0 2 3 0 0 0 0 1 0 45\nintegrator pathtracer\nnexteventestimation on\n\
+                quadLight -0.2 1.5 -0.2 0 0 0.4 0.4 0 0 10 10 10\ndiffuse 0.5 0.5 0.5\nobj floor.obj\n";
+    let scene = d.join("s.test");
+    std::fs::write(&scene, test).unwrap();
+    let ck = d.join("s.ckpt");
+    let cmd = |extra: &[&str]| {
+        let mut c = strata();
+        c.arg("render").arg(&scene).args(["-q", "--spp", "8", "-o"]).arg(d.join("out")).args(extra);
+        c
+    };
+    let mut c = cmd(&["--samples", "0..4"]);
+    c.arg("--checkpoint").arg(&ck);
+    run_ok(c);
+    let mut c = cmd(&["--clamp", "2"]);
+    c.arg("--resume").arg(&ck);
+    let e = run_err(c);
+    assert!(e.contains("clamp"), "{e}");
+    std::fs::write(d.join("floor.obj"), obj.replace("v 1 0 1", "v 1 0 1.001")).unwrap();
+    let mut c = cmd(&[]);
+    c.arg("--resume").arg(&ck);
+    let e = run_err(c);
+    assert!(e.contains("another scene"), "{e}");
+}

@@ -119,3 +119,24 @@ fn reference_then_compare_writes_tables_and_plot() {
     assert!(String::from_utf8_lossy(&r.stderr).contains("--variant x"));
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn importance_sampling_flag_overrides_the_scene_and_rejects_unknown_names() {
+    let d = tmpdir("is");
+    let stats = d.join("stats.json");
+    let r = strata()
+        .args(["render", "--integrator", "pathtracer", "--spp", "1", "--size", "16x16", "--threads", "2", "-q"])
+        .args(["--importance-sampling", "cosine", "-o"])
+        .arg(d.join("img"))
+        .arg("--stats")
+        .arg(&stats)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(j["importance_sampling"], "cosine");
+    let bad = strata().args(["render", "--importance-sampling", "phong"]).output().unwrap();
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("unknown importance sampling `phong`"), "{err}");
+}

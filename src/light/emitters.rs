@@ -282,6 +282,10 @@ impl Emitters {
     /// Path-tracer light sample: `u_choice` picks a light from [`Emitters::all`], `(u, v)` places
     /// the point. Needs at least one light; inactive lanes sample light 0 and stay finite.
     pub fn sample_x8(&self, u_choice: F8, u: F8, v: F8, active: Mask8) -> LightSample8 {
+        if let [e] = self.list.as_slice() {
+            // One light: nothing to choose (1/pmf = 1 either way) and nothing to gather.
+            return Self::place_one_x8(e, u, v);
+        }
         let (idx, inv_pmf, _) = self.all.pick_x8(u_choice, active);
         self.place_x8(idx, inv_pmf, u, v)
     }
@@ -310,21 +314,22 @@ impl Emitters {
         LightSample { y: e.point(u, v), normal: e.normal, radiance: e.radiance, area: e.area, inv_pmf, light: i }
     }
 
-    fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
-        if let [e] = self.list.as_slice() {
-            // One light: splatted, no gather.
-            let fold = if e.triangle { (u + v).simd_gt(F8::ONE) } else { F8::ZERO.simd_gt(F8::ONE) };
-            let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
-            let s = Vec3x8::splat;
-            return LightSample8 {
-                y: s(e.ac).mul_add(v, s(e.ab).mul_add(u, s(e.a))),
-                normal: s(e.normal),
-                radiance: s(e.radiance),
-                area: F8::splat(e.area),
-                inv_pmf,
-                light: idx,
-            };
+    /// [`Emitters::place_x8`] for a scene whose only light is `e`, splatted (bit-identical).
+    fn place_one_x8(e: &Emitter, u: F8, v: F8) -> LightSample8 {
+        let fold = if e.triangle { (u + v).simd_gt(F8::ONE) } else { Mask8::splat(0.0) };
+        let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
+        let s = Vec3x8::splat;
+        LightSample8 {
+            y: s(e.ac).mul_add(v, s(e.ab).mul_add(u, s(e.a))),
+            normal: s(e.normal),
+            radiance: s(e.radiance),
+            area: F8::splat(e.area),
+            inv_pmf: F8::ONE,
+            light: U8::splat(0),
         }
+    }
+
+    fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let ids = idx.to_array();
         let es = ids.map(|i| &self.list[i as usize]);
         let la = Vec3x8::from_lanes(es.map(|e| e.a));
@@ -430,6 +435,28 @@ mod tests {
             }
         }
         assert!(s8.y.is_finite().to_bitmask() == 0xff && s8.inv_pmf.to_array()[7] == 1.0);
+    }
+
+    #[test]
+    fn one_light_fast_path_matches_the_general_placement_bit_for_bit() {
+        let us = F8::new([0.0, 0.1, 0.62, 0.7, 0.8, 0.95, 0.999_999_94, 0.5]);
+        let vs = F8::new([0.9, 0.3, 0.77, 0.05, 0.6, 0.99, 0.2, 0.5]);
+        let cs = F8::new([0.0, 0.2, 0.5, 0.65, 0.75, 0.85, 0.999_99, 0.33]);
+        let active = mask_from_bools([true, true, false, true, true, true, true, true]);
+        let q = Emitter::quad(Vec3::new(-1.0, 2.0, -1.0), Vec3::X * 2.0, Vec3::Z * 2.0, Vec3::splat(4.0));
+        let t = Emitter::triangle([Vec3::ZERO, Vec3::X, Vec3::Y], Vec3::new(3.0, 0.0, 0.0));
+        for e in [Emitters::new([q], []), Emitters::new([], [t])] {
+            let fast = e.sample_x8(cs, us, vs, active);
+            let (idx, inv, _) = e.all.pick_x8(cs, active);
+            let general = e.place_x8(idx, inv, us, vs);
+            let bits = |v: Vec3x8| [v.x, v.y, v.z].map(|c| c.to_array().map(f32::to_bits));
+            assert_eq!(bits(fast.y), bits(general.y));
+            assert_eq!(bits(fast.normal), bits(general.normal));
+            assert_eq!(bits(fast.radiance), bits(general.radiance));
+            assert_eq!(fast.area.to_array(), general.area.to_array());
+            assert_eq!(fast.inv_pmf.to_array(), general.inv_pmf.to_array());
+            assert_eq!(fast.light.to_array(), general.light.to_array());
+        }
     }
 
     #[test]

@@ -8,6 +8,7 @@
 //! - [`table`]: one [`table::Row`] per variant, written as CSV, JSON or a Markdown table.
 //! - [`plot`]: a self-contained log-log SVG of error against time with a convergence-rate guide.
 
+pub mod contact;
 pub mod metrics;
 pub mod plot;
 pub mod table;

@@ -210,6 +210,53 @@ pub struct SceneDesc {
     pub directional_lights: Vec<DirectionalLightDesc>,
 }
 
+impl SceneDesc {
+    /// FNV-1a digest of everything the scene renders but the image size (a render identity records
+    /// that itself): settings, camera, materials, lights and all
+    /// geometry, whatever file it came from: `.test`, an included OBJ or its MTL), so that a
+    /// checkpoint is refused when any input file changed. Floats enter by their bits.
+    pub fn content_hash(&self) -> u64 {
+        struct Fnv(u64);
+        impl Fnv {
+            fn word(&mut self, w: u32) {
+                self.0 = (self.0 ^ u64::from(w)).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+            fn vec3(&mut self, v: Vec3) {
+                v.to_array().iter().for_each(|x| self.word(x.to_bits()));
+            }
+        }
+        impl std::fmt::Write for Fnv {
+            fn write_str(&mut self, s: &str) -> std::fmt::Result {
+                s.bytes().for_each(|b| self.word(u32::from(b)));
+                Ok(())
+            }
+        }
+        let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+        // Small parts through Debug (f32 Debug round-trips, so distinct values print differently).
+        let _ = std::fmt::Write::write_fmt(
+            &mut h,
+            format_args!(
+                "{:?}",
+                (
+                    (&self.output, &self.camera, self.spp, self.gamma.to_bits()),
+                    (self.integrator, self.max_depth, self.light_samples, self.light_stratify, self.nee, self.russian_roulette, self.importance_sampling),
+                    (&self.materials, &self.spheres, &self.quad_lights, &self.point_lights, &self.directional_lights),
+                )
+            ),
+        );
+        // Meshes can be large: their bits directly.
+        for t in &self.triangles {
+            t.v.iter().for_each(|&v| h.vec3(v));
+            h.word(t.material);
+        }
+        for t in &self.emissive_triangles {
+            t.v.iter().for_each(|&v| h.vec3(v));
+            h.vec3(t.radiance);
+        }
+        h.0
+    }
+}
+
 impl Default for SceneDesc {
     fn default() -> Self {
         Self {
