@@ -50,7 +50,7 @@ fn malformed_obj_files_give_file_and_line() {
     expect_obj_err(&d, "c.obj", &format!("{ok}# comment\nf 1 2\n"), 5, &["at least 3 vertices"]);
     expect_obj_err(&d, "d.obj", &format!("{ok}f 1 2 -4\n"), 4, &["index -4 out of range"]);
     expect_obj_err(&d, "e.obj", &format!("{ok}f 1/1 2/1 3/1\n"), 4, &["texture coordinate index 1 out of range"]);
-    expect_obj_err(&d, "f.obj", &format!("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), 2, &["finite"]);
+    expect_obj_err(&d, "f.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", 2, &["finite"]);
     expect_obj_err(&d, "g.obj", &format!("{ok}f 1 2 three\n"), 4, &["'three' is not an index"]);
     expect_obj_err(&d, "h.obj", "v 1 2\nf 1 1 1\n", 1, &["'v' expects 3 to 7 numbers"]);
     // No faces, an unreadable file and bytes that are not text: line 0 or the line of the bad byte.
@@ -357,7 +357,7 @@ fn default_camera_frames_the_bounds() {
 fn procedural_mesh_has_a_million_triangles_and_round_trips() {
     let m = obj::procedural_mesh(1_000_000);
     let torus = m.face_material.iter().filter(|&&i| i == 0).count();
-    assert!(torus >= 1_000_000 && torus < 1_010_000, "{torus}");
+    assert!((1_000_000..1_010_000).contains(&torus), "{torus}");
     assert!(m.faces.iter().all(|f| {
         let [a, b, c] = f.map(|i| m.positions[i as usize]);
         (b - a).cross(c - a).length() > 0.0
@@ -372,4 +372,43 @@ fn procedural_mesh_has_a_million_triangles_and_round_trips() {
     assert_eq!(s.emissive_triangles.len(), 2);
     assert_eq!(s.triangles.len(), small.faces.len() - 2);
     assert_eq!(small.faces.len(), small.face_material.iter().filter(|&&i| i == 0).count() + 6);
+}
+
+/// The command line: `gen-mesh`, then `render model.obj --camera`, and a malformed OBJ reported with
+/// its file and line (exit status 1, no panic).
+#[test]
+fn cli_gen_mesh_render_obj_with_camera_and_errors() {
+    let d = tmpdir("cli");
+    let strata = || std::process::Command::new(env!("CARGO_BIN_EXE_strata"));
+    let mesh = d.join("m.obj");
+    let r = strata().args(["gen-mesh", "--triangles", "400"]).arg(&mesh).output().unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(String::from_utf8_lossy(&r.stdout).contains("406 triangles"));
+    assert!(d.join("m.mtl").is_file());
+    let out = d.join("img");
+    let stats = d.join("s.json");
+    let r = strata()
+        .arg("render")
+        .arg(&mesh)
+        .args(["--camera", "0 0.5 6 0 0 0 0 1 0 40", "--size", "24x16", "--spp", "2", "--threads", "2", "-q"])
+        .arg("-o")
+        .arg(&out)
+        .arg("--stats")
+        .arg(&stats)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(d.join("img.exr").is_file() && d.join("img.png").is_file());
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!((j["integrator"].as_str(), j["width"].as_u64()), (Some("pathtracer"), Some(24)));
+    assert_eq!(j["features"]["emissive_triangles"], 2);
+    assert_eq!(j["features"]["light_selection"], "power");
+    assert_eq!(j["nonfinite_samples"], 0);
+    let bad = write(&d, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    let r = strata().arg("render").arg(&bad).args(["--size", "8x8", "-q"]).output().unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("{}:4: ", bad.display())) && err.contains("out of range"), "{err}");
+    let r = strata().arg("render").arg(&mesh).args(["--camera", "0 0 1 0 0 1 0 1 0 40"]).output().unwrap();
+    assert!(!r.status.success() && String::from_utf8_lossy(&r.stderr).contains("coincide"));
 }

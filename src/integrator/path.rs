@@ -5,7 +5,7 @@
 //!
 //! Vertex numbering: vertex 1 is the camera hit. `maxdepth N` (FORMAT.md): with NEE, direct light
 //! is gathered at vertices 1..N (N = 1 is direct lighting); without NEE, emission is counted at
-//! vertices 1..N+1. Emission of quad lights follows the NEE mode (off: always; on: vertex 1 only;
+//! vertices 1..N+1. Emission of area lights (quads, emissive triangles) follows the NEE mode (off: always; on: vertex 1 only;
 //! MIS: vertex 1, then weighted against the light-sampling pdf); `emission` of materials is not
 //! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping unless `--clamp` asks for it (biased, reported).
 //!
@@ -208,7 +208,6 @@ impl Integrator {
                     (F8::ZERO, F8::ZERO)
                 };
 
-                // Next event estimation: one light chosen uniformly, one point on it.
                 if nee_here {
                     let (u, w) = self.path_point(pixel, s, dims);
                     // One light chosen by `scene.emitters.all` (uniform among quads, by power with

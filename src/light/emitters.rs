@@ -92,7 +92,7 @@ impl Selection {
     pub fn by_weight(weights: &[f32]) -> Self {
         let w: Vec<f64> = weights.iter().map(|&w| if w.is_finite() && w > 0.0 { w as f64 } else { 0.0 }).collect();
         let total: f64 = w.iter().sum();
-        if !(total > 0.0) {
+        if total <= 0.0 {
             return Selection::Uniform(weights.len() as u32);
         }
         let mut acc = 0.0;

@@ -238,9 +238,9 @@ fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), String> {
     Ok(())
 }
 
-/// First line of MTL text with a value strata cannot use: `Ka Kd Ks Ke Tf` need 3 finite numbers
-/// >= 0, `Ns` one finite number >= 0, `Ni d Tr` one finite number, `newmtl` a name; and a colour
-/// before any `newmtl`.
+/// First line of MTL text with a value strata cannot use: `Ka Kd Ks Ke Tf` need 3 finite,
+/// non-negative numbers, `Ns` one, `Ni d Tr` one finite number, `newmtl` a name; and no colour may
+/// come before the first `newmtl`.
 pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
     let mut seen_newmtl = false;
     for (k, raw) in text.split('\n').enumerate() {
