@@ -362,15 +362,7 @@ impl Integrator {
                     sc.shadow.push((ray, lit));
                     sc.owner.push(i as u32);
                 }
-                if let Some(l) = log.as_deref_mut() {
-                    l.shadow.extend_from_slice(&sc.shadow);
-                }
-                for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
-                    let occluded = scene.accel.occluded8(ray, *lit);
-                    c.packet(RayKind::Shadow, *lit);
-                    let visible = *lit & !occluded;
-                    sc.acc[sc.owner[j] as usize] += masked(sc.contrib[j], visible);
-                }
+                trace_shadow_batch(scene, &mut sc.shadow, &sc.contrib, &sc.owner, &mut sc.acc, c, log.as_deref_mut());
             }
             let scale = Vec3x8::splat(light.radiance).scale(inv_n * F8::splat(light.area));
             for (o, acc) in out.iter_mut().zip(&sc.acc) {
@@ -433,15 +425,7 @@ impl Integrator {
                 sc.shadow.push((ray, lit));
                 sc.owner.push(i as u32);
             }
-            if let Some(l) = log.as_deref_mut() {
-                l.shadow.extend_from_slice(&sc.shadow);
-            }
-            for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
-                let occluded = scene.accel.occluded8(ray, *lit);
-                c.packet(RayKind::Shadow, *lit);
-                let visible = *lit & !occluded;
-                out[sc.owner[j] as usize] += masked(sc.contrib[j], visible);
-            }
+            trace_shadow_batch(scene, &mut sc.shadow, &sc.contrib, &sc.owner, out, c, log.as_deref_mut());
         }
     }
 }
@@ -481,6 +465,27 @@ fn analytic_direct(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
 /// kd/pi + ks (s+2)/(2 pi) max(0, r . wi)^s with r the mirror of wo about n; zero on inactive lanes.
 /// `any_spec = false` promises ks = 0 on every lane and skips the lobe.
 #[inline]
+/// Traces a batch of shadow packets back to back (logging them) and adds `contrib[j]` to
+/// `acc[owner[j]]` on the lanes of packet j whose shadow ray reached the light.
+fn trace_shadow_batch(
+    scene: &Scene,
+    shadow: &mut [(Ray8, Mask8)],
+    contrib: &[Vec3x8],
+    owner: &[u32],
+    acc: &mut [Vec3x8],
+    c: &mut Counters,
+    log: Option<&mut RayLog>,
+) {
+    if let Some(l) = log {
+        l.shadow.extend_from_slice(shadow);
+    }
+    for (j, (ray, lit)) in shadow.iter_mut().enumerate() {
+        let occluded = scene.accel.occluded8(ray, *lit);
+        c.packet(RayKind::Shadow, *lit);
+        acc[owner[j] as usize] += masked(contrib[j], *lit & !occluded);
+    }
+}
+
 fn brdf_eval(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8, any_spec: bool) -> Vec3x8 {
     let mut f = sh.kd.scale(F8::splat(1.0 / PI));
     if any_spec {

@@ -11,30 +11,6 @@ use crate::scene::desc::{BrdfKind, CameraDesc, Material, SceneDesc};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
-/// A parallelogram area light a + u ab + v ac, one-sided, emitting towards `normal`.
-#[derive(Clone, Copy, Debug)]
-pub struct QuadLight {
-    /// corner
-    pub a: Vec3,
-    /// first edge
-    pub ab: Vec3,
-    /// second edge
-    pub ac: Vec3,
-    /// emitted radiance
-    pub radiance: Vec3,
-    /// unit emitting normal, normalize(ac x ab)
-    pub normal: Vec3,
-    /// area |ab x ac|
-    pub area: f32,
-}
-
-impl QuadLight {
-    /// The four corners in the order a, a+ab, a+ab+ac, a+ac.
-    pub fn corners(&self) -> [Vec3; 4] {
-        [self.a, self.a + self.ab, self.a + self.ab + self.ac, self.a + self.ac]
-    }
-}
-
 /// Pinhole camera, look-at, full vertical field of view.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
@@ -127,7 +103,7 @@ pub struct Scene {
     /// camera for the image size in `desc`
     pub camera: Camera,
     /// quad lights (indices `0..lights.len()` of `emitters`)
-    pub lights: Vec<QuadLight>,
+    pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
     /// materials (desc materials, then one black material per light)
@@ -203,15 +179,7 @@ impl Scene {
         let black = materials.len() as u32;
         materials.push(Material { ambient: Vec3::ZERO, ..Material::default() });
         for (i, q) in desc.quad_lights.iter().enumerate() {
-            let cross = q.ab.cross(q.ac);
-            let light = QuadLight {
-                a: q.a,
-                ab: q.ab,
-                ac: q.ac,
-                radiance: q.radiance,
-                normal: (-cross).normalize_or_zero(),
-                area: cross.length(),
-            };
+            let light = Emitter::quad(q.a, q.ab, q.ac, q.radiance);
             let base = vertices.len() as u32;
             vertices.extend_from_slice(&light.corners());
             indices.push([base, base + 1, base + 2]);
@@ -233,7 +201,7 @@ impl Scene {
             tri_light.push((lights.len() + tri_emitters.len()) as u32);
             tri_emitters.push(e);
         }
-        let emitters = Emitters::new(lights.iter().map(|q| Emitter::quad(q.a, q.ab, q.ac, q.radiance)), tri_emitters);
+        let emitters = Emitters::new(lights.iter().copied(), tri_emitters);
         let tri_normal: Vec<Vec3> = indices
             .iter()
             .map(|t| {
