@@ -177,17 +177,22 @@ fn load_mtl(path: &Path) -> Result<tobj::MTLLoadResult, SceneError> {
     Ok(loaded)
 }
 
+/// The non-blank lines of OBJ/MTL text as (1-based line number, command, arguments), comments
+/// (`#` to the end of the line) removed.
+fn commands(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
+    text.split('\n').enumerate().filter_map(|(k, raw)| {
+        let mut tok = raw.split('#').next().unwrap_or_default().split_ascii_whitespace();
+        let cmd = tok.next()?;
+        Some((k + 1, cmd, tok.collect()))
+    })
+}
+
 /// First line of OBJ text that strata or tobj cannot read, with the reason: `v` needs 3 finite
 /// numbers, `vt` 1 to 3 numbers, `vn` 3 numbers, `f` at least 3 vertex references `i`, `i/t`,
 /// `i//n` or `i/t/n` with non-zero indices inside the lists read so far (negative = relative).
 pub fn locate_obj_error(text: &str) -> Option<(usize, String)> {
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
-    for (k, raw) in text.split('\n').enumerate() {
-        let line = k + 1;
-        let content = raw.split('#').next().unwrap_or_default();
-        let mut tok = content.split_ascii_whitespace();
-        let Some(cmd) = tok.next() else { continue };
-        let args: Vec<&str> = tok.collect();
+    for (line, cmd, args) in commands(text) {
         let floats = |min: usize, max: usize, what: &str| -> Result<(), String> {
             if args.len() < min || args.len() > max {
                 let want = if min == max { format!("{min}") } else { format!("{min} to {max}") };
@@ -243,12 +248,7 @@ fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), String> {
 /// come before the first `newmtl`.
 pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
     let mut seen_newmtl = false;
-    for (k, raw) in text.split('\n').enumerate() {
-        let line = k + 1;
-        let content = raw.split('#').next().unwrap_or_default();
-        let mut tok = content.split_ascii_whitespace();
-        let Some(cmd) = tok.next() else { continue };
-        let args: Vec<&str> = tok.collect();
+    for (line, cmd, args) in commands(text) {
         let numbers = |n: usize, non_negative: bool| -> Result<(), String> {
             if args.len() != n {
                 return Err(format!("'{cmd}' expects {n} number{}, got {}", if n == 1 { "" } else { "s" }, args.len()));
