@@ -68,6 +68,12 @@ pub struct RenderOptions {
     pub camera: Option<crate::scene::desc::CameraDesc>,
     /// path tracer: direction sampling override (default: the scene's `importancesampling`)
     pub importance_sampling: Option<crate::scene::desc::ImportanceSampling>,
+    /// path tracer: next event estimation override (default: the scene's `nexteventestimation`)
+    pub nee: Option<crate::scene::desc::Nee>,
+    /// path tracer: Russian roulette override (default: the scene's `russianroulette`)
+    pub russian_roulette: Option<bool>,
+    /// maximum depth override, -1 = unbounded (default: the scene's `maxdepth`)
+    pub max_depth: Option<i32>,
     /// resource caps (`--limit NAME=VALUE`), applied to the scene file and to the overrides
     pub limits: Limits,
 }
@@ -130,6 +136,19 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, String> {
     if let Some(s) = opts.importance_sampling {
         desc.importance_sampling = s;
     }
+    if let Some(n) = opts.nee {
+        desc.nee = n;
+    }
+    if let Some(r) = opts.russian_roulette {
+        desc.russian_roulette = r;
+    }
+    if let Some(d) = opts.max_depth {
+        if d < -1 || i64::from(d) > i64::from(limits.max_depth) {
+            let (max, hint) = (limits.max_depth, parse::limit_hint("max_depth"));
+            return Err(format!("--max-depth {d} is outside -1..={max} ({hint})"));
+        }
+        desc.max_depth = d;
+    }
     Ok(desc)
 }
 
@@ -165,6 +184,17 @@ pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
         "analyticdirect" => IntegratorKind::AnalyticDirect,
         "direct" => IntegratorKind::Direct,
         "pathtracer" => IntegratorKind::PathTracer,
+        _ => return None,
+    })
+}
+
+/// Parses a next-event-estimation mode as the format spells it: off, on or mis.
+pub fn parse_nee(s: &str) -> Option<crate::scene::desc::Nee> {
+    use crate::scene::desc::Nee;
+    Some(match s {
+        "off" => Nee::Off,
+        "on" => Nee::On,
+        "mis" => Nee::Mis,
         _ => return None,
     })
 }

@@ -148,6 +148,15 @@ struct RenderArgs {
     /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
     #[arg(long, value_parser = parse_importance_sampling)]
     importance_sampling: Option<strata::scene::desc::ImportanceSampling>,
+    /// Path tracer next event estimation: off, on, mis (default: the scene's nexteventestimation).
+    #[arg(long, value_parser = parse_nee)]
+    nee: Option<strata::scene::desc::Nee>,
+    /// Path tracer Russian roulette: on, off (default: the scene's russianroulette).
+    #[arg(long, value_parser = parse_on_off)]
+    russian_roulette: Option<bool>,
+    /// Maximum depth, -1 = unbounded (default: the scene's maxdepth).
+    #[arg(long, allow_negative_numbers = true)]
+    max_depth: Option<i32>,
     /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
     #[arg(short = 'o', long = "out")]
     out: Option<PathBuf>,
@@ -214,6 +223,9 @@ impl RenderArgs {
             stop: None,
             camera: self.camera,
             importance_sampling: self.importance_sampling,
+            nee: self.nee,
+            russian_roulette: self.russian_roulette,
+            max_depth: self.max_depth,
             limits: limits_of(&self.limits),
         }
     }
@@ -262,6 +274,18 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
 
 fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, String> {
     app::parse_integrator(s).ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
+}
+
+fn parse_nee(s: &str) -> Result<strata::scene::desc::Nee, String> {
+    app::parse_nee(s).ok_or_else(|| format!("unknown next event estimation `{s}` (off, on, mis)"))
+}
+
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got `{s}`")),
+    }
 }
 
 fn parse_importance_sampling(s: &str) -> Result<strata::scene::desc::ImportanceSampling, String> {

@@ -121,12 +121,12 @@ fn reference_then_compare_writes_tables_and_plot() {
 }
 
 #[test]
-fn importance_sampling_flag_overrides_the_scene_and_rejects_unknown_names() {
+fn path_tracer_flags_override_the_scene_and_reject_unknown_names() {
     let d = tmpdir("is");
     let stats = d.join("stats.json");
     let r = strata()
         .args(["render", "--integrator", "pathtracer", "--spp", "1", "--size", "16x16", "--threads", "2", "-q"])
-        .args(["--importance-sampling", "cosine", "-o"])
+        .args(["--importance-sampling", "cosine", "--nee", "mis", "--russian-roulette", "on", "--max-depth", "-1", "-o"])
         .arg(d.join("img"))
         .arg("--stats")
         .arg(&stats)
@@ -135,6 +135,13 @@ fn importance_sampling_flag_overrides_the_scene_and_rejects_unknown_names() {
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!(j["importance_sampling"], "cosine");
+    assert_eq!((j["nee"].as_str(), j["russian_roulette"].as_bool(), j["max_depth"].as_i64()), (Some("mis"), Some(true), Some(-1)));
+    for (flag, value, msg) in [("--nee", "always", "unknown next event estimation `always`"), ("--russian-roulette", "yes", "expected on or off"), ("--max-depth", "-2", "--max-depth -2 is outside")] {
+        let bad = strata().args(["render", "--size", "8x8", flag, value]).output().unwrap();
+        assert!(!bad.status.success(), "{flag} {value}");
+        let err = String::from_utf8_lossy(&bad.stderr);
+        assert!(err.contains(msg), "{flag} {value}: {err}");
+    }
     let bad = strata().args(["render", "--importance-sampling", "phong"]).output().unwrap();
     assert!(!bad.status.success());
     let err = String::from_utf8_lossy(&bad.stderr);
