@@ -2,6 +2,9 @@
 //! processes then merged, time budgets, and refusal of checkpoints or parts that do not belong.
 //! Every comparison is of bits: the PNG files byte for byte and the EXR pixels (RGB and variance).
 
+mod common;
+
+use common::{strata, tmpdir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -11,16 +14,6 @@ fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_diffuse_path.test")
 }
 
-fn strata() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_strata"))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("strata-ckpt-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// `render SCENE --size 64x48 --spp SPP --seed 11 -q` plus `extra`, output stem `out`.
 fn render_cmd(spp: u32, out: &Path, extra: &[&str]) -> Command {

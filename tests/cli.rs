@@ -2,17 +2,8 @@
 
 mod common;
 
-use std::process::Command;
+use common::{strata, tmpdir};
 
-fn strata() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_strata"))
-}
-
-fn tmpdir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("strata-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 #[test]
 fn render_default_scene_writes_exr_png_and_stats() {

@@ -12,11 +12,6 @@ use strata::app::RenderOptions;
 use strata::scene::obj;
 use strata::scene::parse::{parse_file, Limits};
 
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("strata-obj-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -379,7 +374,6 @@ fn procedural_mesh_has_a_million_triangles_and_round_trips() {
 #[test]
 fn cli_gen_mesh_render_obj_with_camera_and_errors() {
     let d = tmpdir("cli");
-    let strata = || std::process::Command::new(env!("CARGO_BIN_EXE_strata"));
     let mesh = d.join("m.obj");
     let r = strata().args(["gen-mesh", "--triangles", "400"]).arg(&mesh).output().unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));

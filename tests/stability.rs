@@ -20,13 +20,6 @@ fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
 }
 
-/// A fresh scratch directory.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("strata-stability-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// A rendered image: per-pixel means and variances of the mean (f64), and the non-finite count.
 struct Img {
@@ -175,7 +168,7 @@ fn tiny_bright_light_matches_a_large_light_of_equal_power() {
         / blocks(&al, 4).iter().flat_map(|b| b.0).sum::<f64>();
     eprintln!("analytic |tiny - large| / large over the image: {rel:.3}");
     assert!(at.mean.iter().flatten().any(|&v| v > 0.1), "the tiny light lights the floor");
-    let dir = scratch("tiny");
+    let dir = tmpdir("tiny");
     for ((name, ot), (_, ol)) in integrators(&tiny, &dir).into_iter().zip(integrators(&large, &dir)) {
         let (t, l) = (render(&ot), render(&ol));
         compare(&t, &at, None, 4).assert_ok(&format!("{name}: tiny light vs its exact irradiance"));
@@ -193,7 +186,7 @@ fn light_almost_touching_a_surface_matches_its_exact_irradiance() {
     let a = analytic(near.clone(), 5);
     let peak = a.mean.iter().flatten().fold(0.0f64, |m, &v| m.max(v));
     assert!(peak > 0.1, "the floor in front of the light is lit (peak {peak})");
-    let dir = scratch("near");
+    let dir = tmpdir("near");
     for (name, o) in integrators(&near, &dir) {
         let r = render(&RenderOptions { spp: Some(256), seed: 5, ..o });
         compare(&r, &a, None, 4).assert_ok(&format!("{name}: near light vs its exact irradiance"));
@@ -238,7 +231,7 @@ fn scaled_scene(s: f64, dir: &Path) -> PathBuf {
 /// shadow acne (darkening) and no light leaking through contacts (brightening) at either scale.
 #[test]
 fn cornell_box_renders_the_same_at_scale_1e_minus_3_and_1e3() {
-    let dir = scratch("scale");
+    let dir = tmpdir("scale");
     let reference = render(&opts_for(scaled_scene(1.0, &dir), IntegratorKind::PathTracer, 1));
     for (s, seed) in [(1e-3, 2), (1e3, 3)] {
         let img = render(&opts_for(scaled_scene(s, &dir), IntegratorKind::PathTracer, seed));
@@ -270,7 +263,7 @@ fn cornell_with(extra: &str) -> String {
 /// scene extent that scales the ray offsets.
 #[test]
 fn zero_area_triangles_leave_the_image_unchanged() {
-    let dir = scratch("degenerate");
+    let dir = tmpdir("degenerate");
     let degenerate = "vertex 0 1 0\nvertex 0.5 1 0\nvertex 1e6 1e6 1e6\nvertex 2e6 2e6 2e6\nvertex 3e6 3e6 3e6\n\
                       tri 16 16 16\ntri 16 17 17\ntri 18 19 20\ntri 18 18 20\ntri 16 17 16";
     let plain = write_scene(&dir, "plain.test", &cornell_with(""));
@@ -289,7 +282,7 @@ fn zero_area_triangles_leave_the_image_unchanged() {
 /// would let shadow rays escape and light the inside).
 #[test]
 fn camera_inside_geometry_sees_a_black_interior() {
-    let dir = scratch("inside");
+    let dir = tmpdir("inside");
     let text = std::fs::read_to_string(scene("cornell_scale.test")).unwrap();
     // Inside the cube (centre (0.35, 0.3, -0.2), half side 0.3) and inside the sphere.
     for (name, camera) in [("cube", "camera 0.35 0.3 -0.05  0.35 0.3 -1  0 1 0  90"), ("sphere", "camera -0.45 0.35 0.2  0 1 -1  0 1 0  90")] {
@@ -306,7 +299,7 @@ fn camera_inside_geometry_sees_a_black_interior() {
 /// Degenerate lights and cameras are clear errors naming the file and line.
 #[test]
 fn degenerate_lights_and_cameras_are_errors_with_file_and_line() {
-    let dir = scratch("degenerate-errors");
+    let dir = tmpdir("degenerate-errors");
     let text = std::fs::read_to_string(scene("cornell_scale.test")).unwrap();
     let line_of = |needle: &str| text.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
     let cases = [
@@ -333,7 +326,7 @@ fn degenerate_lights_and_cameras_are_errors_with_file_and_line() {
 /// file, or the scene fails to load after a good render wrote the files. No temporary file is left.
 #[test]
 fn failed_renders_keep_existing_outputs_and_leave_no_temporaries() {
-    let dir = scratch("atomic");
+    let dir = tmpdir("atomic");
     let stem = dir.join("img");
     let base = RenderOptions { size: Some((16, 16)), spp: Some(1), threads: 2, out: Some(stem.clone()), ..Default::default() };
     app::run_render(&base).expect("first render");
@@ -366,7 +359,7 @@ fn a_write_cut_short_never_truncates_the_final_files() {
         eprintln!("skipped: no /bin/sh to set a file-size limit");
         return;
     }
-    let dir = scratch("fsize");
+    let dir = tmpdir("fsize");
     let stem = dir.join("img");
     let args = |seed: &str| {
         ["render", "--size", "64x64", "--spp", "2", "--threads", "1", "--quiet", "--seed", seed, "-o"]

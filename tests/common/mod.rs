@@ -61,3 +61,17 @@ pub fn hit_triangle(o: glam::DVec3, d: glam::DVec3, v: [glam::DVec3; 3]) -> Opti
     let t = e2.dot(q) / det;
     (u >= 0.0 && w >= 0.0 && u + w <= 1.0 && t > 1e-9).then_some(t)
 }
+
+/// The `strata` binary of this build, as a command to run.
+pub fn strata() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
+}
+
+/// A fresh, empty scratch directory `strata-NAME-PID` under the system temp dir (names are unique
+/// within a test binary; the pid keeps binaries that run at once apart).
+pub fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("strata-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
