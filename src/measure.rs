@@ -16,7 +16,7 @@ use cpu_time::ThreadTime;
 pub const REPEATS: usize = 3;
 
 /// CPU seconds the calling thread spends in `f`.
-fn thread_seconds(f: impl FnOnce()) -> f64 {
+pub fn thread_seconds(f: impl FnOnce()) -> f64 {
     let t = ThreadTime::now();
     f();
     t.elapsed().as_secs_f64()

@@ -5,9 +5,10 @@
 //!
 //! Vertex numbering: vertex 1 is the camera hit. `maxdepth N` (FORMAT.md): with NEE, direct light
 //! is gathered at vertices 1..N (N = 1 is direct lighting); without NEE, emission is counted at
-//! vertices 1..N+1. Emission of area lights (quads, emissive triangles) follows the NEE mode (off: always; on: vertex 1 only;
-//! MIS: vertex 1, then weighted against the light-sampling pdf); `emission` of materials is not
-//! light-sampled and is counted at every vertex. Estimators stay unbiased: no clamping unless `--clamp` asks for it (biased, reported).
+//! vertices 1..N+1. Emission of area lights (quads, emissive triangles) follows the NEE mode (off:
+//! always; on: vertex 1 only; MIS: vertex 1, then weighted against the light-sampling pdf);
+//! `emission` of materials is not light-sampled and is counted at every vertex. Estimators stay
+//! unbiased: no clamping unless `--clamp` asks for it (biased, reported).
 //!
 //! Sampler dimensions of vertex v: `DIM_PATH_BASE + 4 (v-1) + {0: light point, 1: (light choice,
 //! lobe choice), 2: BSDF direction, 3: (Russian roulette, -)}`. Each is a stratified set over the
