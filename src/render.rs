@@ -1,10 +1,9 @@
 //! Tiles, threads and accumulation: the only place with threads.
 //!
 //! The image is cut into 16x16-pixel tiles; a tile is cut into 4x2-pixel packets. Tiles run in
-//! parallel under rayon; each pixel's samples are accumulated in f64 dyadic blocks (see `film`) in increasing sample
-//! order,
-//! and every sample value is a pure function of (pixel, sample, dimension, seed), so the image is
-//! bit-identical whatever the thread count or tile schedule.
+//! parallel under rayon; each pixel's samples are accumulated in f64 dyadic blocks (see `film`) in
+//! increasing sample order, and every sample value is a pure function of (pixel, sample,
+//! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
 use crate::film::{combine, leaf_moments, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
