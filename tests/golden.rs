@@ -1,0 +1,78 @@
+//! Golden images: EXR pixel hashes (RGB and variance layers, f32 bits) of renders covering every
+//! integrator, sampler, lobe set, NEE mode and light kind. Recorded before the [1 of 5] restructuring;
+//! a refactor that changes any bit of these images fails here. Print the current table with
+//! `STRATA_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture`.
+
+mod common;
+
+use common::{corpus, strata, tmpdir};
+use std::path::PathBuf;
+
+/// FNV-1a over the bits of every channel sample, in file channel order.
+fn pixel_hash(path: &std::path::Path) -> u64 {
+    use exr::prelude::*;
+    let image = read_first_flat_layer_from_file(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for ch in &image.layer_data.channel_data.list {
+        for b in ch.name.as_slice() {
+            h = (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3);
+        }
+        for v in ch.sample_data.values_as_f32() {
+            for b in v.to_bits().to_le_bytes() {
+                h = (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3);
+            }
+        }
+    }
+    h
+}
+
+/// (name, scene relative to the corpus or "scenes/...", extra flags, expected hash).
+const CASES: &[(&str, &str, &str, u64)] = &[
+    ("builtin-direct-halton", "", "--light-sampler halton", 0x755b2855f1de1cc3),
+    ("hw1-scene5-whitted", "hw1/scene5.test", "", 0x9b5c3e38a9b4a347),
+    ("hw1-scene7-whitted", "hw1/scene7.test", "--spp 2", 0x4fe55c176700caea),
+    ("hw2-analytic", "hw2/analytic.test", "", 0x32c75862e52b8fe4),
+    ("hw2-direct9-stratified", "hw2/direct9.test", "--light-sampler stratified", 0x576251b62325e0d3),
+    ("hw2-sphere-independent", "hw2/sphere.test", "--light-sampler independent --pixel-sampler independent", 0x5b67379731d7bc73),
+    ("hw2-dragon-grid", "hw2/dragon.test", "--light-sampler grid-center", 0x65e4bc6150f1b0f6),
+    ("hw3-cornellSimple-hemi", "hw3/cornellSimple.test", "--spp 4", 0xcf89307cefb3e3b4),
+    ("hw3-cornellNEE-sobol", "hw3/cornellNEE.test", "--spp 4 --pixel-sampler sobol", 0x4da65490a2e76d8a),
+    ("hw3-cornellRR", "hw3/cornellRR.test", "--spp 4", 0x8a8b5dbea5120805),
+    ("hw4-cornellBRDF-pmj", "hw4/cornellBRDF.test", "--spp 4 --pixel-sampler pmj02", 0x2e990eadb2635e69),
+    ("hw4-ggx-mis", "hw4/ggx.test", "--spp 4", 0xd24571ef91f70d91),
+    ("hw4-mis", "hw4/mis.test", "--spp 4", 0x1dbacee0868e3c4a),
+    ("hw4-cornellMIS-nee-on", "hw4/cornellMIS.test", "--spp 4 --nee on --importance-sampling cosine", 0xbc94580a3cf65f7d),
+    ("obj-cornell-emissive", "scenes/cornell_obj.test", "--spp 4", 0x8d258864674dead5),
+    ("builtin-path-clamp", "scenes/cornell_diffuse_path.test", "--spp 4 --clamp 2 --kernel general", 0x6e0c5eb40272cc0c),
+];
+
+#[test]
+fn golden_images_are_bit_identical() {
+    let Some(corpus) = corpus() else { return };
+    let print = std::env::var_os("STRATA_GOLDEN_PRINT").is_some();
+    let d = tmpdir("golden");
+    let mut bad = Vec::new();
+    for &(name, scene, flags, want) in CASES {
+        let out = d.join(name);
+        let mut cmd = strata();
+        cmd.arg("render");
+        if let Some(s) = scene.strip_prefix("scenes/") {
+            cmd.arg(PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes")).join(s));
+        } else if !scene.is_empty() {
+            cmd.arg(corpus.join(scene));
+        }
+        cmd.args(["--size", "40x30", "--seed", "7", "--threads", "2", "--quiet"]);
+        cmd.args(flags.split_whitespace());
+        let r = cmd.arg("-o").arg(&out).output().unwrap();
+        assert!(r.status.success(), "{name}: {}", String::from_utf8_lossy(&r.stderr));
+        let got = pixel_hash(&out.with_extension("exr"));
+        if print {
+            println!("    (\"{name}\", \"{scene}\", \"{flags}\", 0x{got:016x}),");
+        }
+        if got != want {
+            bad.push(format!("{name}: 0x{got:016x}, recorded 0x{want:016x}"));
+        }
+    }
+    std::fs::remove_dir_all(&d).ok();
+    assert!(bad.is_empty(), "images changed:\n{}", bad.join("\n"));
+}
