@@ -13,13 +13,23 @@ use strata::scene::desc::IntegratorKind;
 
 fn scenes() -> Vec<(&'static str, RenderOptions)> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let diffuse = RenderOptions { scene: Some(root.join("scenes/cornell_diffuse_path.test")), size: Some((128, 128)), spp: Some(4), ..Default::default() };
+    let diffuse = RenderOptions {
+        scene: Some(root.join("scenes/cornell_diffuse_path.test")),
+        size: Some((128, 128)),
+        spp: Some(4),
+        ..Default::default()
+    };
     let brdf = root.join("../shared/cse168/hw4/cornellBRDF.test");
     let phong = if brdf.is_file() {
         RenderOptions { scene: Some(brdf), size: Some((128, 128)), spp: Some(4), ..Default::default() }
     } else {
         eprintln!("note: {} not found; the Phong case is the built-in box path traced", brdf.display());
-        RenderOptions { integrator: Some(IntegratorKind::PathTracer), size: Some((128, 128)), spp: Some(4), ..Default::default() }
+        RenderOptions {
+            integrator: Some(IntegratorKind::PathTracer),
+            size: Some((128, 128)),
+            spp: Some(4),
+            ..Default::default()
+        }
     };
     vec![("diffuse-cornell", diffuse), ("phong-cornellBRDF", phong)]
 }
@@ -36,14 +46,17 @@ fn kernels(c: &mut Criterion) {
             strata::render::render(&scene, it, &mut film, 0..it.spp, &pool)
         };
         let mut g = c.benchmark_group(name);
-        g.sample_size(10).warm_up_time(std::time::Duration::from_millis(300)).measurement_time(std::time::Duration::from_secs(3));
+        g.sample_size(10)
+            .warm_up_time(std::time::Duration::from_millis(300))
+            .measurement_time(std::time::Duration::from_secs(3));
         g.bench_function("specialized", |b| b.iter(|| run(&spec)));
         g.bench_function("general", |b| b.iter(|| run(&gen)));
         g.finish();
         // Interleaved timing in one run, so both kernels see the same machine load; CPU seconds of
         // the pool's one worker (nested `install` runs inline there), so other processes on a
         // shared machine are not charged.
-        let cpu = |it: &strata::integrator::Integrator| pool.install(|| strata::measure::thread_seconds(|| drop(run(it))));
+        let cpu =
+            |it: &strata::integrator::Integrator| pool.install(|| strata::measure::thread_seconds(|| drop(run(it))));
         let (mut ts, mut tg) = (Vec::new(), Vec::new());
         for _ in 0..7 {
             ts.push(cpu(&spec));

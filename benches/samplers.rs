@@ -108,11 +108,30 @@ fn warps(c: &mut Criterion) {
             });
         };
     }
-    pair!("uniform_hemisphere", |p| warp::sample_uniform_hemisphere(black_box(p)), |q| warp::sample_uniform_hemisphere_x8(black_box(q), all));
-    pair!("cosine", |p| warp::sample_cosine_hemisphere(black_box(p)), |q| warp::sample_cosine_hemisphere_x8(black_box(q), all));
-    pair!("phong_lobe", |p| warp::sample_phong_lobe(black_box(p), 30.0), |q| warp::sample_phong_lobe_x8(black_box(q), F8::splat(30.0), all));
-    pair!("ggx_half", |p| warp::sample_ggx_half(black_box(p), 0.3), |q| warp::sample_ggx_half_x8(black_box(q), F8::splat(0.3), all));
-    pair!("parallelogram", |p| warp::sample_parallelogram(a, ab, ac, black_box(p)), |q| warp::sample_parallelogram_x8(a8, ab8, ac8, black_box(q), all));
+    pair!("uniform_hemisphere", |p| warp::sample_uniform_hemisphere(black_box(p)), |q| {
+        warp::sample_uniform_hemisphere_x8(black_box(q), all)
+    });
+    pair!("cosine", |p| warp::sample_cosine_hemisphere(black_box(p)), |q| warp::sample_cosine_hemisphere_x8(
+        black_box(q),
+        all
+    ));
+    pair!("phong_lobe", |p| warp::sample_phong_lobe(black_box(p), 30.0), |q| warp::sample_phong_lobe_x8(
+        black_box(q),
+        F8::splat(30.0),
+        all
+    ));
+    pair!("ggx_half", |p| warp::sample_ggx_half(black_box(p), 0.3), |q| warp::sample_ggx_half_x8(
+        black_box(q),
+        F8::splat(0.3),
+        all
+    ));
+    pair!("parallelogram", |p| warp::sample_parallelogram(a, ab, ac, black_box(p)), |q| warp::sample_parallelogram_x8(
+        a8,
+        ab8,
+        ac8,
+        black_box(q),
+        all
+    ));
     g.finish();
 }
 
@@ -127,15 +146,29 @@ fn techniques() -> Vec<(&'static str, String, RenderOptions, u32)> {
         eprintln!("note: {} not found; equal-time variance on the built-in box (direct) only", corpus.display());
         RenderOptions { integrator: Some(IntegratorKind::Direct), ..base.clone() }
     };
-    let direct = RenderOptions { pixel_sampler: Some(SamplerKind::GridCenter), light_samples: Some(9), size: Some((128, 128)), ..direct };
+    let direct = RenderOptions {
+        pixel_sampler: Some(SamplerKind::GridCenter),
+        light_samples: Some(9),
+        size: Some((128, 128)),
+        ..direct
+    };
     let mut v: Vec<_> = SamplerKind::ALL
         .iter()
         .map(|&k| ("direct x9", k.name().to_string(), RenderOptions { light_sampler: Some(k), ..direct.clone() }, 1))
         .collect();
     let brdf = corpus.join("hw4/cornellBRDF.test");
     if brdf.is_file() {
-        for (name, s) in [("hemisphere", ImportanceSampling::Hemisphere), ("cosine", ImportanceSampling::Cosine), ("brdf", ImportanceSampling::Brdf)] {
-            v.push(("path 8spp", name.to_string(), RenderOptions { scene: Some(brdf.clone()), importance_sampling: Some(s), ..base.clone() }, 8));
+        for (name, s) in [
+            ("hemisphere", ImportanceSampling::Hemisphere),
+            ("cosine", ImportanceSampling::Cosine),
+            ("brdf", ImportanceSampling::Brdf),
+        ] {
+            v.push((
+                "path 8spp",
+                name.to_string(),
+                RenderOptions { scene: Some(brdf.clone()), importance_sampling: Some(s), ..base.clone() },
+                8,
+            ));
         }
     }
     v
@@ -186,10 +219,20 @@ fn equal_time(c: &mut Criterion) {
     for ((table, name, opts, spp), &secs) in techs.iter().zip(&secs) {
         if reference.as_ref().map(|r| r.0) != Some(*table) {
             let r = if *spp == 1 {
-                let o = RenderOptions { light_sampler: Some(SamplerKind::Stratified), light_samples: Some(1024), threads: 0, ..opts.clone() };
+                let o = RenderOptions {
+                    light_sampler: Some(SamplerKind::Stratified),
+                    light_samples: Some(1024),
+                    threads: 0,
+                    ..opts.clone()
+                };
                 strata::experiments::reference_two_halves(&o)
             } else {
-                let o = RenderOptions { importance_sampling: Some(ImportanceSampling::Brdf), spp: Some(512), threads: 0, ..opts.clone() };
+                let o = RenderOptions {
+                    importance_sampling: Some(ImportanceSampling::Brdf),
+                    spp: Some(512),
+                    threads: 0,
+                    ..opts.clone()
+                };
                 strata::experiments::reference_spp(&o)
             };
             reference = Some((table, r.unwrap()));

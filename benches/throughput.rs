@@ -21,18 +21,29 @@ fn scenes() -> Vec<(String, RenderOptions)> {
     let mut v = vec![
         ("builtin-cornell".to_string(), RenderOptions { size: Some((256, 256)), spp: Some(1), ..Default::default() }),
         // The path tracer's target scene: diffuse Cornell box with NEE.
-        ("cornell-diffuse-path".to_string(), RenderOptions { scene: Some(own), size: Some((256, 256)), spp: Some(4), ..Default::default() }),
+        (
+            "cornell-diffuse-path".to_string(),
+            RenderOptions { scene: Some(own), size: Some((256, 256)), spp: Some(4), ..Default::default() },
+        ),
     ];
     // The million-triangle mesh, generated here (never committed).
     let mesh_path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("torus1m.obj");
     let mesh = strata::scene::obj::procedural_mesh(1_000_000);
     strata::scene::obj::write_obj(&mesh_path, &mesh).expect("write the procedural mesh");
-    v.push(("torus-1m".to_string(), RenderOptions { scene: Some(mesh_path), size: Some((320, 240)), spp: Some(2), ..Default::default() }));
+    v.push((
+        "torus-1m".to_string(),
+        RenderOptions { scene: Some(mesh_path), size: Some((320, 240)), spp: Some(2), ..Default::default() },
+    ));
     let corpus = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168"));
     if corpus.is_dir() {
         for name in ["hw2/cornell", "hw2/direct3x3", "hw2/dragon", "hw3/cornellNEE", "hw4/cornellMIS", "hw4/dragon"] {
             let spp = if name.starts_with("hw2") { 1 } else { 4 };
-            let o = RenderOptions { scene: Some(corpus.join(format!("{name}.test"))), size: Some((320, 240)), spp: Some(spp), ..Default::default() };
+            let o = RenderOptions {
+                scene: Some(corpus.join(format!("{name}.test"))),
+                size: Some((320, 240)),
+                spp: Some(spp),
+                ..Default::default()
+            };
             v.push((name.replace('/', "-"), o));
         }
     } else {
@@ -53,7 +64,9 @@ fn throughput(c: &mut Criterion) {
         let sh: u64 = log.shadow.iter().map(|(_, m)| lanes(m)).sum();
         let bo: u64 = log.bounce.iter().map(|(_, m)| lanes(m)).sum();
         let mut g = c.benchmark_group(name.clone());
-        g.sample_size(10).warm_up_time(std::time::Duration::from_millis(500)).measurement_time(std::time::Duration::from_secs(2));
+        g.sample_size(10)
+            .warm_up_time(std::time::Duration::from_millis(500))
+            .measurement_time(std::time::Duration::from_secs(2));
         g.throughput(Throughput::Elements(cam + sh + bo));
         g.bench_function("render", |b| {
             b.iter(|| {
@@ -68,7 +81,11 @@ fn throughput(c: &mut Criterion) {
         if bo > 0 {
             g.throughput(Throughput::Elements(bo));
             g.bench_function("embree_bounce", |b| {
-                b.iter_batched(|| log.bounce.clone(), |mut p| measure::replay_bounce(&scene, &mut p), BatchSize::LargeInput)
+                b.iter_batched(
+                    || log.bounce.clone(),
+                    |mut p| measure::replay_bounce(&scene, &mut p),
+                    BatchSize::LargeInput,
+                )
             });
         }
         g.throughput(Throughput::Elements(sh));
@@ -82,7 +99,12 @@ fn throughput(c: &mut Criterion) {
     for (name, r) in table {
         println!(
             "{name:18} {:10.2}        {:8.2} / {:8.2} / {:8.2} / {:8.2}          {:5.1} %",
-            r.renderer_mrays, r.raw_mixed_mrays, r.raw_camera_mrays, r.raw_bounce_mrays, r.raw_shadow_mrays, 100.0 * r.ratio
+            r.renderer_mrays,
+            r.raw_mixed_mrays,
+            r.raw_camera_mrays,
+            r.raw_bounce_mrays,
+            r.raw_shadow_mrays,
+            100.0 * r.ratio
         );
     }
 }

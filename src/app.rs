@@ -1,5 +1,6 @@
 //! The `strata render` command as a library function (the binary, tests and benches share it).
 
+use crate::checkpoint::{self, Header};
 use crate::film::{self, Film, Metadata};
 use crate::integrator::kernel::{features_json, Kernel};
 use crate::integrator::Integrator;
@@ -8,7 +9,6 @@ use crate::sampler::SamplerKind;
 use crate::scene::build::Scene;
 use crate::scene::desc::{IntegratorKind, SceneDesc};
 use crate::scene::parse::{self, Limits};
-use crate::checkpoint::{self, Header};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -216,7 +216,10 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
     // Every integrator of the format is implemented (raytracer, analyticdirect, direct,
     // pathtracer); a new kind must be handled here and in `Integrator::radiance_tile`.
     match desc.integrator {
-        IntegratorKind::RayTracer | IntegratorKind::AnalyticDirect | IntegratorKind::Direct | IntegratorKind::PathTracer => {}
+        IntegratorKind::RayTracer
+        | IntegratorKind::AnalyticDirect
+        | IntegratorKind::Direct
+        | IntegratorKind::PathTracer => {}
     }
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {
@@ -228,7 +231,8 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
         return Err(format!("--light-samples {n} exceeds the limit of {max} ({hint})"));
     }
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
-    let mut integrator = Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    let mut integrator =
+        Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
@@ -239,7 +243,9 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
 /// Hash of the scene's bytes (the file as read, or the built-in scene's text).
 pub fn scene_hash(opts: &RenderOptions) -> Result<String, String> {
     Ok(match &opts.scene {
-        Some(p) => checkpoint::hash_bytes(&std::fs::read(p).map_err(|e| format!("{}: cannot read scene file: {e}", p.display()))?),
+        Some(p) => checkpoint::hash_bytes(
+            &std::fs::read(p).map_err(|e| format!("{}: cannot read scene file: {e}", p.display()))?,
+        ),
         None => checkpoint::hash_bytes(DEFAULT_SCENE.as_bytes()),
     })
 }
@@ -427,10 +433,16 @@ impl Progress {
         }
         let mrays = self.rays as f64 / self.seconds.max(1e-12) / 1e6;
         let (line, frac) = match self.budget {
-            Some(b) => (format!("{} spp, {mrays:.2} Mrays/s, {:.1} s of {b} s budget left", self.done, (b - elapsed).max(0.0)), (elapsed / b).min(1.0)),
+            Some(b) => (
+                format!("{} spp, {mrays:.2} Mrays/s, {:.1} s of {b} s budget left", self.done, (b - elapsed).max(0.0)),
+                (elapsed / b).min(1.0),
+            ),
             None => {
                 let eta = self.secs_per_spp().unwrap_or(0.0) * (self.total - self.done) as f64;
-                (format!("{}/{} spp, {mrays:.2} Mrays/s, ETA {eta:.1} s", self.done, self.total), self.done as f64 / self.total.max(1) as f64)
+                (
+                    format!("{}/{} spp, {mrays:.2} Mrays/s, ETA {eta:.1} s", self.done, self.total),
+                    self.done as f64 / self.total.max(1) as f64,
+                )
             }
         };
         if self.tty {
@@ -483,7 +495,8 @@ fn with_ext(stem: &Path, ext: &str) -> PathBuf {
 /// EXR metadata of a render or merge state: version, scene and its hash, integrator, samplers,
 /// seed, spp held, sample range, total render and CPU seconds, rays, and the parts it came from.
 pub fn header_metadata(h: &Header) -> Metadata {
-    let opt = |k: &str| h.options.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
+    let opt =
+        |k: &str| h.options.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
     let mut m: Metadata = vec![
         ("strata.version".into(), h.strata_version.clone()),
         ("strata.scene".into(), h.scene.clone()),
@@ -564,13 +577,15 @@ pub fn summary(out: &RenderOutput) -> String {
     // The settings that matter for this integrator only.
     let technique = match d.integrator {
         IntegratorKind::Direct => format!(" (light {} x{})", it.light_set.kind().name(), it.light_set.n()),
-        IntegratorKind::PathTracer => format!(
-            " (nee {}, {} sampling, rr {}, maxdepth {})",
-            format!("{:?}", it.nee).to_lowercase(),
-            format!("{:?}", it.strategy).to_lowercase(),
-            if it.russian_roulette { "on" } else { "off" },
-            it.max_depth
-        ) + &it.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default(),
+        IntegratorKind::PathTracer => {
+            format!(
+                " (nee {}, {} sampling, rr {}, maxdepth {})",
+                format!("{:?}", it.nee).to_lowercase(),
+                format!("{:?}", it.strategy).to_lowercase(),
+                if it.russian_roulette { "on" } else { "off" },
+                it.max_depth
+            ) + &it.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default()
+        }
         _ => String::new(),
     };
     format!(
@@ -619,7 +634,8 @@ pub fn stop_on_signals() -> Result<Arc<AtomicBool>, String> {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let flag = Arc::new(AtomicBool::new(false));
     for sig in [SIGINT, SIGTERM] {
-        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&flag)).map_err(|e| format!("signal handler: {e}"))?;
+        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&flag))
+            .map_err(|e| format!("signal handler: {e}"))?;
         signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(|e| format!("signal handler: {e}"))?;
     }
     Ok(flag)
@@ -679,7 +695,13 @@ pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, String> {
             return Err(format!("{} and {} overlap", name(pa, ha), name(pb, hb)));
         }
         if hb.samples[0] > ha.samples[1] {
-            return Err(format!("samples {}..{} are missing (between {} and {})", ha.samples[1], hb.samples[0], name(pa, ha), name(pb, hb)));
+            return Err(format!(
+                "samples {}..{} are missing (between {} and {})",
+                ha.samples[1],
+                hb.samples[0],
+                name(pa, ha),
+                name(pb, hb)
+            ));
         }
     }
     let last = loaded.last().map(|(_, h, _)| h.samples[1]).unwrap_or(0);
@@ -708,7 +730,8 @@ pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, String> {
     let stem = stem_of(out);
     let (mean, var) = (film.mean(), film.variance_of_mean());
     let exr = with_ext(&stem, "exr");
-    film::write_exr(&exr, w, h, &mean, Some(&var), &header_metadata(&header)).map_err(|e| format!("{}: {e}", exr.display()))?;
+    film::write_exr(&exr, w, h, &mean, Some(&var), &header_metadata(&header))
+        .map_err(|e| format!("{}: {e}", exr.display()))?;
     let gamma = header.options.get("gamma").and_then(|v| v.as_f64()).unwrap_or(1.0) as f32;
     let png = with_ext(&stem, "png");
     film::write_png(&png, w, h, &mean, gamma).map_err(|e| format!("{}: {e}", png.display()))?;

@@ -62,7 +62,10 @@ impl Header {
             ));
         }
         if self.strata_version != want.strata_version {
-            return Some(format!("it was written by strata {} ({label}: {})", self.strata_version, want.strata_version));
+            return Some(format!(
+                "it was written by strata {} ({label}: {})",
+                self.strata_version, want.strata_version
+            ));
         }
         if (self.width, self.height) != (want.width, want.height) {
             return Some(format!("it is {}x{} ({label}: {}x{})", self.width, self.height, want.width, want.height));
@@ -138,7 +141,8 @@ pub fn to_bytes(header: &Header, film: &Film) -> Vec<u8> {
 
 /// Writes a checkpoint atomically (temporary file, fsync, rename).
 pub fn write(path: &Path, header: &Header, film: &Film) -> Result<(), String> {
-    film::write_atomic(path, &to_bytes(header, film)).map_err(|e| format!("{}: cannot write checkpoint: {e}", path.display()))
+    film::write_atomic(path, &to_bytes(header, film))
+        .map_err(|e| format!("{}: cannot write checkpoint: {e}", path.display()))
 }
 
 /// Parses checkpoint bytes; `name` labels errors.
@@ -167,7 +171,8 @@ pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), String> {
     if pixels == 0 || pixels > max {
         return Err(bad(format!("image size {}x{} outside 1..={max} pixels", header.width, header.height)));
     }
-    let expected = (hend as u64).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
+    let expected =
+        (hend as u64).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
     if expected != bytes.len() as u64 {
         return Err(bad(format!(
             "truncated or corrupt: {} bytes, expected {expected} for {} blocks of {}x{} pixels",
@@ -210,17 +215,22 @@ mod tests {
     fn film(r: std::ops::Range<u32>) -> Film {
         let mut f = Film::new(3, 2);
         for s in r {
-            let px: Vec<[f32; 3]> = (0..6).map(|p| [s as f32 * 0.3 + p as f32, 1.0 / (1.0 + s as f32), -(p as f32)]).collect();
+            let px: Vec<[f32; 3]> =
+                (0..6).map(|p| [s as f32 * 0.3 + p as f32, 1.0 / (1.0 + s as f32), -(p as f32)]).collect();
             f.add_sample(s, &px);
         }
         f
     }
 
     fn header() -> Header {
-        let options = [("spp", serde_json::json!(64)), ("seed", serde_json::json!(3)), ("pixel_sampler", serde_json::json!("sobol"))]
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect();
+        let options = [
+            ("spp", serde_json::json!(64)),
+            ("seed", serde_json::json!(3)),
+            ("pixel_sampler", serde_json::json!("sobol")),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
         Header {
             strata_version: "0.1.0".into(),
             scene: "a.test".into(),

@@ -51,7 +51,17 @@ impl Config {
     /// The committed configuration: 160-pixel-wide images, K = 16, references of 2 x 4096 light
     /// samples and 1024 spp.
     pub fn full(corpus: PathBuf, out: PathBuf) -> Self {
-        Config { corpus, out, runs: 16, width: 160, ref_light_samples: 4096, ref_spp: 1024, threads: 0, verbose: true, sheet_factor: 2 }
+        Config {
+            corpus,
+            out,
+            runs: 16,
+            width: 160,
+            ref_light_samples: 4096,
+            ref_spp: 1024,
+            threads: 0,
+            verbose: true,
+            sheet_factor: 2,
+        }
     }
 }
 
@@ -87,11 +97,19 @@ pub struct Stats {
 }
 
 /// Per-pixel-channel statistics of `runs` against `reference` whose per-value variance is `ref_var`.
-pub fn stats(runs: &[Vec<[f32; 3]>], reference: &[[f32; 3]], ref_var: &[[f32; 3]], gamma: f32, seconds: f64, spp: u32) -> Stats {
+pub fn stats(
+    runs: &[Vec<[f32; 3]>],
+    reference: &[[f32; 3]],
+    ref_var: &[[f32; 3]],
+    gamma: f32,
+    seconds: f64,
+    spp: u32,
+) -> Stats {
     let k = runs.len() as f64;
     let m = 3.0 * reference.len() as f64;
     let q = |v: f32| f64::from(film::to_u8(v, gamma));
-    let (mut var, mut var8, mut mse, mut mse8, mut err, mut sq, mut den, mut refv) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut var, mut var8, mut mse, mut mse8, mut err, mut sq, mut den, mut refv) =
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     let mut run_err = vec![0.0f64; runs.len()];
     for (i, px) in reference.iter().enumerate() {
         for c in 0..3 {
@@ -131,7 +149,13 @@ pub fn stats(runs: &[Vec<[f32; 3]>], reference: &[[f32; 3]], ref_var: &[[f32; 3]
         mse_8bit: mse8 / m,
         bias,
         bias_se,
-        z: if bias_se > 0.0 { bias / bias_se } else if bias == 0.0 { 0.0 } else { f64::INFINITY.copysign(bias) },
+        z: if bias_se > 0.0 {
+            bias / bias_se
+        } else if bias == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY.copysign(bias)
+        },
         rms_bias: ((sq - den) / m).max(0.0).sqrt(),
         bias_ratio: if den > 0.0 { sq / den } else { f64::INFINITY },
         efficiency: report::efficiency(mse, seconds).unwrap_or(f64::NAN),
@@ -175,7 +199,11 @@ fn film_of(opts: &RenderOptions, seed: u64) -> Result<(Film, f32, f64), String> 
     let o = RenderOptions { seed, ..opts.clone() };
     let out = app::render_to_film(&o)?;
     if out.stats.counters.nonfinite != 0 {
-        return Err(format!("{}: {} non-finite samples", out.scene.desc.source.display(), out.stats.counters.nonfinite));
+        return Err(format!(
+            "{}: {} non-finite samples",
+            out.scene.desc.source.display(),
+            out.stats.counters.nonfinite
+        ));
     }
     Ok((out.film, out.scene.desc.gamma, out.stats.seconds))
 }
@@ -224,7 +252,12 @@ fn g3(x: f64) -> String {
 
 fn scene_opts(cfg: &Config, rel: &str, aspect: f64) -> RenderOptions {
     let h = ((f64::from(cfg.width) / aspect).round() as u32).max(1);
-    RenderOptions { scene: Some(cfg.corpus.join(rel)), size: Some((cfg.width, h)), threads: cfg.threads, ..Default::default() }
+    RenderOptions {
+        scene: Some(cfg.corpus.join(rel)),
+        size: Some((cfg.width, h)),
+        threads: cfg.threads,
+        ..Default::default()
+    }
 }
 
 fn log(cfg: &Config, msg: &str) {
@@ -243,8 +276,16 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, String> {
     ];
     let mut rows = Vec::new();
     let mut series: Vec<Series> = Vec::new();
-    for (name, rel, aspect) in [("sphere", "hw2/sphere.test", 4.0 / 3.0), ("cornell", "hw2/cornell.test", 1.0), ("dragon", "hw2/dragon.test", 4.0 / 3.0)] {
-        let base = RenderOptions { spp: Some(1), pixel_sampler: Some(SamplerKind::GridCenter), ..scene_opts(cfg, rel, aspect) };
+    for (name, rel, aspect) in [
+        ("sphere", "hw2/sphere.test", 4.0 / 3.0),
+        ("cornell", "hw2/cornell.test", 1.0),
+        ("dragon", "hw2/dragon.test", 4.0 / 3.0),
+    ] {
+        let base = RenderOptions {
+            spp: Some(1),
+            pixel_sampler: Some(SamplerKind::GridCenter),
+            ..scene_opts(cfg, rel, aspect)
+        };
         log(cfg, &format!("direct {name}: reference 2 x {} stratified light samples", cfg.ref_light_samples));
         let reference = reference_two_halves(&RenderOptions {
             light_sampler: Some(SamplerKind::Stratified),
@@ -254,7 +295,14 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, String> {
         let (w, h) = reference.size;
         let mut tiles = Vec::new();
         for n in [9u32, 25] {
-            tiles.push(contact::tile_from_linear(w, h, &reference.rgb, cfg.sheet_factor, reference.gamma, vec!["reference".into(), format!("2x{} str", cfg.ref_light_samples)]));
+            tiles.push(contact::tile_from_linear(
+                w,
+                h,
+                &reference.rgb,
+                cfg.sheet_factor,
+                reference.gamma,
+                vec!["reference".into(), format!("2x{} str", cfg.ref_light_samples)],
+            ));
             for (label, kind) in kinds {
                 log(cfg, &format!("direct {name}: {label} x{n}, {} runs", cfg.runs));
                 let o = RenderOptions { light_sampler: Some(kind), light_samples: Some(n), ..base.clone() };
@@ -266,7 +314,11 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, String> {
                     &imgs[0],
                     cfg.sheet_factor,
                     reference.gamma,
-                    vec![format!("{} {n}", label.replace("grid-center", "grid-ctr")), format!("v8 {}", g3(st.variance_8bit)), format!("rb {}", g3(st.rms_bias))],
+                    vec![
+                        format!("{} {n}", label.replace("grid-center", "grid-ctr")),
+                        format!("v8 {}", g3(st.variance_8bit)),
+                        format!("rb {}", g3(st.rms_bias)),
+                    ],
                 ));
                 let sname = format!("{name} {label}");
                 let p = (f64::from(n), st.mse.sqrt());
@@ -274,14 +326,27 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, String> {
                     Some(s) => s.points.push(p),
                     None => series.push(Series { name: sname, points: vec![p] }),
                 }
-                rows.push(Row { table: "direct".into(), scene: name.into(), variant: label.into(), setting: format!("{n}"), stats: st });
+                rows.push(Row {
+                    table: "direct".into(),
+                    scene: name.into(),
+                    variant: label.into(),
+                    setting: format!("{n}"),
+                    stats: st,
+                });
             }
         }
-        let sheet = contact::layout(&tiles, 5, Some(&format!("hw2 {name}: direct lighting, pixel centre, K={}", cfg.runs)));
+        let sheet =
+            contact::layout(&tiles, 5, Some(&format!("hw2 {name}: direct lighting, pixel centre, K={}", cfg.runs)));
         let p = cfg.out.join(format!("direct-{name}.png"));
         contact::write_sheet(&p, &sheet).map_err(|e| format!("{}: {e}", p.display()))?;
     }
-    let svg = report::loglog_svg(&series, "direct lighting: RMSE against light samples", "light samples", "RMSE", report::plot::RMSE_SLOPE);
+    let svg = report::loglog_svg(
+        &series,
+        "direct lighting: RMSE against light samples",
+        "light samples",
+        "RMSE",
+        report::plot::RMSE_SLOPE,
+    );
     let p = cfg.out.join("direct.svg");
     film::write_atomic(&p, svg.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
     Ok(rows)
@@ -310,7 +375,10 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
             title: "pixel jitter: random vs 2x2 strata",
             scene: "hw3 cornellNEE",
             reference: is(&nee, ImportanceSampling::Cosine),
-            variants: [("random", px(&nee, SamplerKind::Independent)), ("stratified", px(&nee, SamplerKind::Stratified))],
+            variants: [
+                ("random", px(&nee, SamplerKind::Independent)),
+                ("stratified", px(&nee, SamplerKind::Stratified)),
+            ],
             spp: 4,
             ladder: &[1, 4, 16],
         },
@@ -319,7 +387,10 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
             title: "pixel jitter: random vs 5x1 strata",
             scene: "hw3 cornellNEE",
             reference: is(&nee, ImportanceSampling::Cosine),
-            variants: [("random", px(&nee, SamplerKind::Independent)), ("stratified", px(&nee, SamplerKind::Stratified))],
+            variants: [
+                ("random", px(&nee, SamplerKind::Independent)),
+                ("stratified", px(&nee, SamplerKind::Stratified)),
+            ],
             spp: 5,
             ladder: &[5],
         },
@@ -328,7 +399,10 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
             title: "direction sampling: hemisphere vs cosine",
             scene: "hw3 cornellNEE",
             reference: is(&nee, ImportanceSampling::Cosine),
-            variants: [("hemisphere", is(&nee, ImportanceSampling::Hemisphere)), ("cosine", is(&nee, ImportanceSampling::Cosine))],
+            variants: [
+                ("hemisphere", is(&nee, ImportanceSampling::Hemisphere)),
+                ("cosine", is(&nee, ImportanceSampling::Cosine)),
+            ],
             spp: 10,
             ladder: &[2, 5, 10, 20],
         },
@@ -337,7 +411,10 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
             title: "direction sampling: cosine vs Phong-lobe BRDF",
             scene: "hw4 cornellBRDF",
             reference: is(&brdf, ImportanceSampling::Brdf),
-            variants: [("cosine", is(&brdf, ImportanceSampling::Cosine)), ("brdf", is(&brdf, ImportanceSampling::Brdf))],
+            variants: [
+                ("cosine", is(&brdf, ImportanceSampling::Cosine)),
+                ("brdf", is(&brdf, ImportanceSampling::Brdf)),
+            ],
             spp: 10,
             ladder: &[2, 5, 10, 20],
         },
@@ -346,7 +423,8 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
     let mut refs: Vec<(RenderOptions, Reference)> = Vec::new();
     for case in &cases {
         let ro = RenderOptions { spp: Some(cfg.ref_spp), ..case.reference.clone() };
-        let cached = refs.iter().position(|(o, _)| o.scene == ro.scene && o.importance_sampling == ro.importance_sampling);
+        let cached =
+            refs.iter().position(|(o, _)| o.scene == ro.scene && o.importance_sampling == ro.importance_sampling);
         let ri = match cached {
             Some(i) => i,
             None => {
@@ -357,8 +435,14 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
         };
         let reference = &refs[ri].1;
         let (w, h) = reference.size;
-        let mut tiles =
-            vec![contact::tile_from_linear(w, h, &reference.rgb, cfg.sheet_factor, reference.gamma, vec!["reference".into(), format!("{} spp", cfg.ref_spp)])];
+        let mut tiles = vec![contact::tile_from_linear(
+            w,
+            h,
+            &reference.rgb,
+            cfg.sheet_factor,
+            reference.gamma,
+            vec!["reference".into(), format!("{} spp", cfg.ref_spp)],
+        )];
         let mut series = Vec::new();
         let mut main: Vec<Stats> = Vec::new();
         for (label, o) in &case.variants {
@@ -387,7 +471,13 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
             series.push(Series { name: (*label).into(), points });
         }
         for ((label, _), st) in case.variants.iter().zip(&main) {
-            rows.push(Row { table: case.key.into(), scene: case.scene.into(), variant: (*label).into(), setting: "equal spp".into(), stats: st.clone() });
+            rows.push(Row {
+                table: case.key.into(),
+                scene: case.scene.into(),
+                variant: (*label).into(),
+                setting: "equal spp".into(),
+                stats: st.clone(),
+            });
         }
         // Equal time: the faster technique gets the spp that costs what the slower one spent.
         let (ta, tb) = (main[0].seconds / f64::from(main[0].spp), main[1].seconds / f64::from(main[1].spp));
@@ -397,8 +487,13 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
         let eq_spp = ((budget / per_spp).round() as u32).max(1);
         let (label, o) = &case.variants[fast];
         log(cfg, &format!("path {}: equal time, {label} at {eq_spp} spp", case.key));
-        let (imgs, secs) = if eq_spp == main[fast].spp { (Vec::new(), main[fast].seconds) } else { runs(o, eq_spp, cfg.runs)? };
-        let st = if imgs.is_empty() { main[fast].clone() } else { stats(&imgs, &reference.rgb, &reference.var, reference.gamma, secs, eq_spp) };
+        let (imgs, secs) =
+            if eq_spp == main[fast].spp { (Vec::new(), main[fast].seconds) } else { runs(o, eq_spp, cfg.runs)? };
+        let st = if imgs.is_empty() {
+            main[fast].clone()
+        } else {
+            stats(&imgs, &reference.rgb, &reference.var, reference.gamma, secs, eq_spp)
+        };
         if !imgs.is_empty() {
             tiles.push(contact::tile_from_linear(
                 w,
@@ -410,12 +505,31 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, String> {
             ));
         }
         let (sl, _) = &case.variants[slow];
-        rows.push(Row { table: case.key.into(), scene: case.scene.into(), variant: (*sl).into(), setting: "equal time".into(), stats: main[slow].clone() });
-        rows.push(Row { table: case.key.into(), scene: case.scene.into(), variant: (*label).into(), setting: "equal time".into(), stats: st });
-        let sheet = contact::layout(&tiles, tiles.len(), Some(&format!("{}: {}, K={}", case.scene, case.title, cfg.runs)));
+        rows.push(Row {
+            table: case.key.into(),
+            scene: case.scene.into(),
+            variant: (*sl).into(),
+            setting: "equal time".into(),
+            stats: main[slow].clone(),
+        });
+        rows.push(Row {
+            table: case.key.into(),
+            scene: case.scene.into(),
+            variant: (*label).into(),
+            setting: "equal time".into(),
+            stats: st,
+        });
+        let sheet =
+            contact::layout(&tiles, tiles.len(), Some(&format!("{}: {}, K={}", case.scene, case.title, cfg.runs)));
         let p = cfg.out.join(format!("path-{}.png", case.key));
         contact::write_sheet(&p, &sheet).map_err(|e| format!("{}: {e}", p.display()))?;
-        let svg = report::loglog_svg(&series, &format!("{}: {}", case.scene, case.title), "seconds", "RMSE", report::plot::RMSE_SLOPE);
+        let svg = report::loglog_svg(
+            &series,
+            &format!("{}: {}", case.scene, case.title),
+            "seconds",
+            "RMSE",
+            report::plot::RMSE_SLOPE,
+        );
         let p = cfg.out.join(format!("path-{}.svg", case.key));
         film::write_atomic(&p, svg.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
     }
@@ -446,7 +560,10 @@ pub fn markdown(rows: &[Row], cfg: &Config) -> String {
             j += 1;
         }
         let (head, sheet) = if r0.table == "direct" {
-            (format!("## Direct lighting, hw2 {}, {} light samples", r0.scene, r0.setting), format!("direct-{}.png", r0.scene))
+            (
+                format!("## Direct lighting, hw2 {}, {} light samples", r0.scene, r0.setting),
+                format!("direct-{}.png", r0.scene),
+            )
         } else {
             (format!("## {} `{}`, {}", r0.scene, r0.table, r0.setting), format!("path-{}.png", r0.table))
         };
@@ -458,7 +575,11 @@ pub fn markdown(rows: &[Row], cfg: &Config) -> String {
             } else {
                 "Tiles: the reference, then run 1 of each technique at equal spp, then the faster one at equal time."
             };
-            let _ = writeln!(md, "![{sheet}]({sheet})\n\n{caption} Images box-downsampled by {} for the sheet.\n", cfg.sheet_factor);
+            let _ = writeln!(
+                md,
+                "![{sheet}]({sheet})\n\n{caption} Images box-downsampled by {} for the sheet.\n",
+                cfg.sheet_factor
+            );
             shown.push(sheet);
         }
         let _ = writeln!(md, "| variant | spp | s | var | var8 | var ratio | MSE | MSE8 | bias | se | z | rms bias | b-ratio | eff | eff ratio |");
@@ -515,7 +636,9 @@ pub fn run(cfg: &Config) -> Result<String, String> {
 
 /// `Path` of the corpus beside the crate or in `$STRATA_CSE168`.
 pub fn default_corpus() -> PathBuf {
-    std::env::var_os("STRATA_CSE168").map(PathBuf::from).unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/cse168"))
+    std::env::var_os("STRATA_CSE168")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/cse168"))
 }
 
 #[cfg(test)]
@@ -528,7 +651,8 @@ mod tests {
         let zero = vec![[0.0f32; 3]; 6];
         // Two runs at r - d and r + d: no bias, per-value variance 2 d^2, MSE d^2.
         let d = 0.125f32;
-        let runs: Images = vec![r.iter().map(|p| p.map(|v| v - d)).collect(), r.iter().map(|p| p.map(|v| v + d)).collect()];
+        let runs: Images =
+            vec![r.iter().map(|p| p.map(|v| v - d)).collect(), r.iter().map(|p| p.map(|v| v + d)).collect()];
         let s = stats(&runs, &r, &zero, 1.0, 2.0, 4);
         assert_eq!((s.runs, s.spp), (2, 4));
         assert!((s.variance - 2.0 * f64::from(d * d)).abs() < 1e-12, "{}", s.variance);

@@ -173,13 +173,28 @@ impl Film {
 
     /// A film from its stored parts (a checkpoint): `blocks` must be the canonical blocks of
     /// `samples` and `data` hold `blocks.len() * width * height` moments.
-    pub fn from_parts(width: u32, height: u32, samples: Range<u32>, blocks: Vec<Block>, data: Vec<Moments>) -> Result<Self, String> {
+    pub fn from_parts(
+        width: u32,
+        height: u32,
+        samples: Range<u32>,
+        blocks: Vec<Block>,
+        data: Vec<Moments>,
+    ) -> Result<Self, String> {
         if canonical_blocks(samples.clone()) != blocks {
-            return Err(format!("the block list is not the dyadic decomposition of samples {}..{}", samples.start, samples.end));
+            return Err(format!(
+                "the block list is not the dyadic decomposition of samples {}..{}",
+                samples.start, samples.end
+            ));
         }
         let mut f = Film::new(width, height);
         if data.len() != blocks.len() * f.pixels() {
-            return Err(format!("{} block values, expected {} blocks x {}x{} pixels", data.len(), blocks.len(), width, height));
+            return Err(format!(
+                "{} block values, expected {} blocks x {}x{} pixels",
+                data.len(),
+                blocks.len(),
+                width,
+                height
+            ));
         }
         f.samples = samples;
         f.blocks = blocks;
@@ -232,7 +247,10 @@ impl Film {
     /// one film that took all the samples. Errors if the sizes differ or the ranges do not touch.
     pub fn merge(&mut self, other: &Film) -> Result<(), String> {
         if (self.width, self.height) != (other.width, other.height) {
-            return Err(format!("merging a {}x{} film into a {}x{} one", other.width, other.height, self.width, self.height));
+            return Err(format!(
+                "merging a {}x{} film into a {}x{} one",
+                other.width, other.height, self.width, self.height
+            ));
         }
         if other.samples.is_empty() {
             return Ok(());
@@ -348,8 +366,7 @@ pub fn write_exr(
     meta: &Metadata,
 ) -> io::Result<()> {
     use exr::prelude::*;
-    let bad =
-        |msg: String| io::Error::new(io::ErrorKind::InvalidInput, format!("EXR {}: {msg}", path.display()));
+    let bad = |msg: String| io::Error::new(io::ErrorKind::InvalidInput, format!("EXR {}: {msg}", path.display()));
     let n = width as usize * height as usize;
     if n == 0 {
         return Err(bad(format!("empty image {width}x{height}")));
@@ -566,7 +583,11 @@ mod tests {
                     push_block(&mut counter, Block::leaf(s));
                 });
                 assert_eq!(counter, bl, "{lo}..{hi}: the binary counter builds the canonical blocks");
-                assert!(bl.len() <= 2 * (32 - (hi - lo).max(1).leading_zeros()) as usize, "{lo}..{hi}: {} blocks", bl.len());
+                assert!(
+                    bl.len() <= 2 * (32 - (hi - lo).max(1).leading_zeros()) as usize,
+                    "{lo}..{hi}: {} blocks",
+                    bl.len()
+                );
             }
         }
     }
@@ -616,10 +637,8 @@ mod tests {
     fn exr_round_trip_is_bit_exact_with_variance_and_metadata() {
         let d = scratch("exr");
         let (w, h) = (5u32, 3u32);
-        let special =
-            [0.0, -0.0, 1e-45, 1.2e-38, 3.0e38, f32::MAX, f32::INFINITY, f32::NAN, -7.25, 1.0 / 3.0];
-        let rgb: Vec<[f32; 3]> =
-            (0..15).map(|i| [special[i % 10], i as f32 * 0.1, special[(i * 7) % 10]]).collect();
+        let special = [0.0, -0.0, 1e-45, 1.2e-38, 3.0e38, f32::MAX, f32::INFINITY, f32::NAN, -7.25, 1.0 / 3.0];
+        let rgb: Vec<[f32; 3]> = (0..15).map(|i| [special[i % 10], i as f32 * 0.1, special[(i * 7) % 10]]).collect();
         let var: Vec<[f32; 3]> = (0..15).map(|i| [1e-30 * i as f32, 2.5e-12, i as f32]).collect();
         let meta: Metadata = [("spp", "64"), ("sampler", "sobol"), ("seconds", "1.25"), ("note", "grüße, ✓")]
             .map(|(k, v)| (k.to_string(), v.to_string()))

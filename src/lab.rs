@@ -77,7 +77,9 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
                 images.push(film.mean());
             }
             let stats = RunStats::from_runs(&images, &img.rgb).map_err(|e| format!("variant {}: {e}", v.name))?;
-            rows.push(Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats).map_err(|e| e.to_string())?);
+            rows.push(
+                Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats).map_err(|e| e.to_string())?,
+            );
         }
     }
     Ok(rows)
@@ -98,7 +100,9 @@ pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, St
         }
     }
     let svg = report::loglog_svg(&series, title, "seconds", "RMSE", report::plot::RMSE_SLOPE);
-    for (name, text) in [("rows.csv", report::to_csv(rows)), ("rows.json", json), ("table.md", md.clone()), ("error.svg", svg)] {
+    for (name, text) in
+        [("rows.csv", report::to_csv(rows)), ("rows.json", json), ("table.md", md.clone()), ("error.svg", svg)]
+    {
         let p: PathBuf = dir.join(name);
         film::write_atomic(&p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
     }

@@ -260,7 +260,8 @@ fn parse_clamp(s: &str) -> Result<f32, String> {
 
 fn parse_range(s: &str) -> Result<(u32, u32), String> {
     let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B, got `{s}`"))?;
-    let p = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected A..B with non-negative integers, got `{s}`"));
+    let p =
+        |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected A..B with non-negative integers, got `{s}`"));
     let (a, b) = (p(a)?, p(b)?);
     if a >= b {
         return Err(format!("expected A..B with A < B, got `{s}`"));
@@ -269,11 +270,13 @@ fn parse_range(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
-    SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton, sobol, pmj02)"))
+    SamplerKind::parse(s)
+        .ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton, sobol, pmj02)"))
 }
 
 fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, String> {
-    app::parse_integrator(s).ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
+    app::parse_integrator(s)
+        .ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
 }
 
 fn parse_nee(s: &str) -> Result<strata::scene::desc::Nee, String> {
@@ -289,7 +292,8 @@ fn parse_on_off(s: &str) -> Result<bool, String> {
 }
 
 fn parse_importance_sampling(s: &str) -> Result<strata::scene::desc::ImportanceSampling, String> {
-    app::parse_importance_sampling(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+    app::parse_importance_sampling(s)
+        .ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
 }
 
 fn main() -> ExitCode {
@@ -339,12 +343,30 @@ fn main() -> ExitCode {
         Cmd::GenMesh { out, triangles } => {
             let mesh = strata::scene::obj::procedural_mesh(triangles);
             strata::scene::obj::write_obj(&out, &mesh)
-                .map(|mtl| println!("{}: {} triangles, {} vertices (materials {})", out.display(), mesh.faces.len(), mesh.positions.len(), mtl.display()))
+                .map(|mtl| {
+                    println!(
+                        "{}: {} triangles, {} vertices (materials {})",
+                        out.display(),
+                        mesh.faces.len(),
+                        mesh.positions.len(),
+                        mtl.display()
+                    )
+                })
                 .map_err(|e| format!("{}: {e}", out.display()))
         }
         Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
             let corpus = corpus.unwrap_or_else(strata::experiments::default_corpus);
-            let cfg = strata::experiments::Config { corpus, out: out.clone(), runs, width, ref_light_samples, ref_spp, threads, verbose: true, sheet_factor };
+            let cfg = strata::experiments::Config {
+                corpus,
+                out: out.clone(),
+                runs,
+                width,
+                ref_light_samples,
+                ref_spp,
+                threads,
+                verbose: true,
+                sheet_factor,
+            };
             strata::experiments::run(&cfg).map(|md| {
                 println!("{md}");
                 println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
@@ -385,7 +407,8 @@ fn run_compare(
         let mut argv = vec!["strata".to_string(), "render".to_string()];
         argv.extend(scene.iter().map(|p| p.display().to_string()));
         argv.extend(flags.split_whitespace().map(str::to_string));
-        let cli = Cli::try_parse_from(&argv).map_err(|e| format!("--variant {name}: {}", e.to_string().lines().next().unwrap_or("")))?;
+        let cli = Cli::try_parse_from(&argv)
+            .map_err(|e| format!("--variant {name}: {}", e.to_string().lines().next().unwrap_or("")))?;
         let Cmd::Render(args) = cli.cmd else { unreachable!("parsed as render") };
         let mut opts = args.options();
         opts.size = size.or(opts.size);
@@ -401,7 +424,11 @@ fn run_compare(
         (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
     };
     let rows = strata::lab::compare(&variants, reference, runs, &mode)?;
-    let title = format!("{} vs {}", scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()), reference.display());
+    let title = format!(
+        "{} vs {}",
+        scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
+        reference.display()
+    );
     let md = strata::lab::write_outputs(&rows, out, &title)?;
     println!("{md}");
     println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", out.display());

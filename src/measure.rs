@@ -9,8 +9,8 @@ use crate::film::Film;
 use crate::integrator::{Counters, Integrator, RayLog, Scratch};
 use crate::render::{self, TILE};
 use crate::scene::build::Scene;
-use serde::Serialize;
 use cpu_time::ThreadTime;
+use serde::Serialize;
 
 /// Times each part (renderer, camera, bounce and shadow replays) is run; the fastest counts.
 pub const REPEATS: usize = 3;
@@ -56,14 +56,17 @@ pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
     let camera_rays: u64 = log.camera.iter().map(|(_, m)| lanes(m)).sum();
     let shadow_rays: u64 = log.shadow.iter().map(|(_, m)| lanes(m)).sum();
     let bounce_rays: u64 = log.bounce.iter().map(|(_, m)| lanes(m)).sum();
-    let (mut t_render, mut t_cam, mut t_bounce, mut t_sh) = (f64::INFINITY, f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let (mut t_render, mut t_cam, mut t_bounce, mut t_sh) =
+        (f64::INFINITY, f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut total_rays = 0;
     for _ in 0..REPEATS {
         // Whole renderer on the pool's one worker (nested `install` runs inline there).
         let (t, rays) = pool.install(|| {
             let mut film = Film::new(scene.desc.width, scene.desc.height);
             let mut rays = 0;
-            let t = thread_seconds(|| rays = render::render(scene, integrator, &mut film, 0..spp, &pool).counters.total_rays());
+            let t = thread_seconds(|| {
+                rays = render::render(scene, integrator, &mut film, 0..spp, &pool).counters.total_rays()
+            });
             (t, rays)
         });
         t_render = t_render.min(t);

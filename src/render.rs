@@ -50,7 +50,12 @@ impl PixelPacket {
                 pix[i as usize] = y * width + x;
             }
         }
-        Self { pixel: U8::new(pix), x: u8_to_f8(U8::new(xs)), y: u8_to_f8(U8::new(ys)), active: mask_from_bools(inside) }
+        Self {
+            pixel: U8::new(pix),
+            x: u8_to_f8(U8::new(xs)),
+            y: u8_to_f8(U8::new(ys)),
+            active: mask_from_bools(inside),
+        }
     }
 }
 

@@ -14,7 +14,6 @@ fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell_diffuse_path.test")
 }
 
-
 /// `render SCENE --size 64x48 --spp SPP --seed 11 -q` plus `extra`, output stem `out`.
 fn render_cmd(spp: u32, out: &Path, extra: &[&str]) -> Command {
     let mut c = strata();

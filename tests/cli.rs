@@ -4,7 +4,6 @@ mod common;
 
 use common::{strata, tmpdir};
 
-
 #[test]
 fn render_default_scene_writes_exr_png_and_stats() {
     let d = tmpdir("default");
@@ -78,7 +77,8 @@ fn rays_reports_renderer_next_to_embree() {
 fn reference_then_compare_writes_tables_and_plot() {
     let d = tmpdir("compare");
     let reference = d.join("ref");
-    let r = strata().args(["reference", "--size", "32x24", "--spp", "16", "-q", "-o"]).arg(&reference).output().unwrap();
+    let r =
+        strata().args(["reference", "--size", "32x24", "--spp", "16", "-q", "-o"]).arg(&reference).output().unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let img = strata::film::read_exr(&d.join("ref.exr")).unwrap();
     assert!(img.variance.is_some(), "a reference carries its variance layer");
@@ -87,7 +87,12 @@ fn reference_then_compare_writes_tables_and_plot() {
         .args(["compare", "--size", "32x24", "--runs", "2", "--spp-ladder", "1,2"])
         .arg("--reference")
         .arg(d.join("ref.exr"))
-        .args(["--variant", "random=--light-sampler=independent", "--variant", "strat=--light-sampler=stratified --light-samples 4"])
+        .args([
+            "--variant",
+            "random=--light-sampler=independent",
+            "--variant",
+            "strat=--light-sampler=stratified --light-samples 4",
+        ])
         .arg("--out")
         .arg(&out)
         .output()
@@ -117,7 +122,17 @@ fn path_tracer_flags_override_the_scene_and_reject_unknown_names() {
     let stats = d.join("stats.json");
     let r = strata()
         .args(["render", "--integrator", "pathtracer", "--spp", "1", "--size", "16x16", "--threads", "2", "-q"])
-        .args(["--importance-sampling", "cosine", "--nee", "mis", "--russian-roulette", "on", "--max-depth", "-1", "-o"])
+        .args([
+            "--importance-sampling",
+            "cosine",
+            "--nee",
+            "mis",
+            "--russian-roulette",
+            "on",
+            "--max-depth",
+            "-1",
+            "-o",
+        ])
         .arg(d.join("img"))
         .arg("--stats")
         .arg(&stats)
@@ -126,8 +141,15 @@ fn path_tracer_flags_override_the_scene_and_reject_unknown_names() {
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!(j["importance_sampling"], "cosine");
-    assert_eq!((j["nee"].as_str(), j["russian_roulette"].as_bool(), j["max_depth"].as_i64()), (Some("mis"), Some(true), Some(-1)));
-    for (flag, value, msg) in [("--nee", "always", "unknown next event estimation `always`"), ("--russian-roulette", "yes", "expected on or off"), ("--max-depth", "-2", "--max-depth -2 is outside")] {
+    assert_eq!(
+        (j["nee"].as_str(), j["russian_roulette"].as_bool(), j["max_depth"].as_i64()),
+        (Some("mis"), Some(true), Some(-1))
+    );
+    for (flag, value, msg) in [
+        ("--nee", "always", "unknown next event estimation `always`"),
+        ("--russian-roulette", "yes", "expected on or off"),
+        ("--max-depth", "-2", "--max-depth -2 is outside"),
+    ] {
         let bad = strata().args(["render", "--size", "8x8", flag, value]).output().unwrap();
         assert!(!bad.status.success(), "{flag} {value}");
         let err = String::from_utf8_lossy(&bad.stderr);

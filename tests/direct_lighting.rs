@@ -9,7 +9,6 @@ use strata::sampler::SamplerKind;
 use strata::scene::desc::IntegratorKind;
 use strata::scene::parse::{parse_file, Limits};
 
-
 /// `analyticdirect` on hw2/analytic.test at pixel centres against an evaluation written here from
 /// the format's definitions: our own camera rays and ray-triangle hits, and the irradiance as a
 /// 400x400 midpoint quadrature of cos cos / d^2 over the one-sided light (not Arvo's formula).
@@ -49,9 +48,9 @@ fn analyticdirect_matches_independent_quadrature() {
             }
             // Pixels that see the light (or nothing) are not what this test is about.
             let lq = [la, la + lab, la + lab + lac, la + lac];
-            let sees_light = [[0, 1, 2], [0, 2, 3]].iter().any(|t| {
-                hit_triangle(eye, d, t.map(|i| lq[i])).is_some_and(|tl| best.is_none_or(|(b, _)| tl < b))
-            });
+            let sees_light = [[0, 1, 2], [0, 2, 3]]
+                .iter()
+                .any(|t| hit_triangle(eye, d, t.map(|i| lq[i])).is_some_and(|tl| best.is_none_or(|(b, _)| tl < b)));
             let Some((t, i)) = best else { continue };
             if sees_light {
                 continue;
@@ -67,7 +66,8 @@ fn analyticdirect_matches_independent_quadrature() {
             let mut g = 0.0;
             for j in 0..m {
                 for k in 0..m {
-                    let y = la + lab * ((f64::from(j) + 0.5) / f64::from(m)) + lac * ((f64::from(k) + 0.5) / f64::from(m));
+                    let y =
+                        la + lab * ((f64::from(j) + 0.5) / f64::from(m)) + lac * ((f64::from(k) + 0.5) / f64::from(m));
                     let to = y - x;
                     let d2 = to.length_squared();
                     let wi = to / d2.sqrt();
@@ -94,7 +94,11 @@ fn analyticdirect_matches_independent_quadrature() {
 /// Renders `scene` with the sampled `direct` integrator and with `analyticdirect` over identical
 /// camera rays (same spp, pixel sampler and seed); returns (direct film means, its variance of the
 /// mean, analytic means).
-fn direct_and_exact(scene: std::path::PathBuf, spp: u32, sampler: Option<SamplerKind>) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+fn direct_and_exact(
+    scene: std::path::PathBuf,
+    spp: u32,
+    sampler: Option<SamplerKind>,
+) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>) {
     let mut o = opts(scene, 80, 60, spp);
     o.light_sampler = sampler;
     let f = film(&o);
@@ -112,7 +116,12 @@ fn z_test(d: &[[f64; 3]], var: &[[f64; 3]], exact: &[[f64; 3]]) -> (f64, usize) 
     for i in 0..d.len() {
         for c in 0..3 {
             if var[i][c] == 0.0 {
-                assert!((d[i][c] - exact[i][c]).abs() <= 1e-6 * exact[i][c].abs().max(1.0), "pixel {i}: {} vs {}", d[i][c], exact[i][c]);
+                assert!(
+                    (d[i][c] - exact[i][c]).abs() <= 1e-6 * exact[i][c].abs().max(1.0),
+                    "pixel {i}: {} vs {}",
+                    d[i][c],
+                    exact[i][c]
+                );
                 continue;
             }
             let z = (d[i][c] - exact[i][c]) / var[i][c].sqrt();
@@ -149,9 +158,11 @@ fn stratified_beats_random_at_equal_samples() {
     let Some(c) = corpus() else { return };
     let mse = |sampler: SamplerKind| {
         let (d, _, exact) = direct_and_exact(c.join("hw2/direct9.test"), 16, Some(sampler));
-        d.iter().zip(&exact).map(|(a, b)| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>()).sum::<f64>() / (3 * d.len()) as f64
+        d.iter().zip(&exact).map(|(a, b)| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>()).sum::<f64>()
+            / (3 * d.len()) as f64
     };
-    let (random, strat, halton) = (mse(SamplerKind::Independent), mse(SamplerKind::Stratified), mse(SamplerKind::Halton));
+    let (random, strat, halton) =
+        (mse(SamplerKind::Independent), mse(SamplerKind::Stratified), mse(SamplerKind::Halton));
     eprintln!("MSE against exact: independent {random:.3e}, stratified {strat:.3e} (ratio {:.2}), halton {halton:.3e} (ratio {:.2})", random / strat, random / halton);
     assert!(random / strat > 3.0, "stratified should beat random by 3x: {random} vs {strat}");
     assert!(random / halton > 3.0, "halton should beat random by 3x: {random} vs {halton}");
@@ -161,13 +172,13 @@ fn stratified_beats_random_at_equal_samples() {
 #[test]
 fn bit_identical_across_thread_counts() {
     let base = strata::app::RenderOptions { size: Some((72, 56)), spp: Some(3), seed: 7, ..Default::default() };
-    let films: Vec<_> = [1usize, 2, 3]
-        .iter()
-        .map(|&t| film(&strata::app::RenderOptions { threads: t, ..base.clone() }))
-        .collect();
+    let films: Vec<_> =
+        [1usize, 2, 3].iter().map(|&t| film(&strata::app::RenderOptions { threads: t, ..base.clone() })).collect();
     for f in &films[1..] {
         assert_eq!(f.count, films[0].count);
-        let bits = |f: &strata::film::Film| f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
+        let bits = |f: &strata::film::Film| {
+            f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>()
+        };
         assert_eq!(bits(f), bits(&films[0]));
     }
     // A different seed changes the image (the test can fail).
@@ -196,7 +207,8 @@ fn every_hw2_scene_renders() {
 /// bits of 0..7 (progressive rendering and, later, resume depend on it).
 #[test]
 fn passes_are_bit_identical_to_one_render() {
-    let o = strata::app::RenderOptions { size: Some((40, 24)), spp: Some(7), seed: 5, threads: 2, ..Default::default() };
+    let o =
+        strata::app::RenderOptions { size: Some((40, 24)), spp: Some(7), seed: 5, threads: 2, ..Default::default() };
     let (scene, integ) = strata::app::prepare(&o).unwrap();
     let pool = strata::render::thread_pool(2).unwrap();
     let mut one = strata::film::Film::new(40, 24);
@@ -205,6 +217,7 @@ fn passes_are_bit_identical_to_one_render() {
     strata::render::render(&scene, &integ, &mut parts, 0..3, &pool);
     strata::render::render(&scene, &integ, &mut parts, 3..7, &pool);
     assert_eq!(one.count, parts.count);
-    let bits = |f: &strata::film::Film| f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
+    let bits =
+        |f: &strata::film::Film| f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
     assert_eq!(bits(&one), bits(&parts));
 }

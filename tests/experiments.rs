@@ -21,14 +21,17 @@ fn tiny_experiments_write_tables_sheets_and_plots() {
         sheet_factor: 1,
     };
     let md = strata::experiments::run(&cfg).expect("experiments run");
-    for f in ["results.md", "results.json", "direct.svg", "direct-sphere.png", "direct-cornell.png", "direct-dragon.png"] {
+    for f in
+        ["results.md", "results.json", "direct.svg", "direct-sphere.png", "direct-cornell.png", "direct-dragon.png"]
+    {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     for k in ["pixel4", "pixel5", "cosine", "brdf"] {
         assert!(out.join(format!("path-{k}.png")).is_file() && out.join(format!("path-{k}.svg")).is_file(), "{k}");
     }
     assert!(md.contains("## Direct lighting, hw2 dragon, 25 light samples"));
-    let rows: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
     let rows = rows.as_array().unwrap();
     assert_eq!(rows.len(), 3 * 2 * 4 + 4 * 4, "24 direct rows, 4 path tables of 2 equal-spp + 2 equal-time rows");
     let get = |scene: &str, variant: &str, setting: &str, key: &str| -> f64 {

@@ -33,7 +33,12 @@ const CASES: &[(&str, &str, &str, u64)] = &[
     ("hw1-scene7-whitted", "hw1/scene7.test", "--spp 2", 0x4fe55c176700caea),
     ("hw2-analytic", "hw2/analytic.test", "", 0x32c75862e52b8fe4),
     ("hw2-direct9-stratified", "hw2/direct9.test", "--light-sampler stratified", 0x576251b62325e0d3),
-    ("hw2-sphere-independent", "hw2/sphere.test", "--light-sampler independent --pixel-sampler independent", 0x5b67379731d7bc73),
+    (
+        "hw2-sphere-independent",
+        "hw2/sphere.test",
+        "--light-sampler independent --pixel-sampler independent",
+        0x5b67379731d7bc73,
+    ),
     ("hw2-dragon-grid", "hw2/dragon.test", "--light-sampler grid-center", 0x65e4bc6150f1b0f6),
     ("hw3-cornellSimple-hemi", "hw3/cornellSimple.test", "--spp 4", 0xcf89307cefb3e3b4),
     ("hw3-cornellNEE-sobol", "hw3/cornellNEE.test", "--spp 4 --pixel-sampler sobol", 0x4da65490a2e76d8a),
@@ -41,9 +46,19 @@ const CASES: &[(&str, &str, &str, u64)] = &[
     ("hw4-cornellBRDF-pmj", "hw4/cornellBRDF.test", "--spp 4 --pixel-sampler pmj02", 0x2e990eadb2635e69),
     ("hw4-ggx-mis", "hw4/ggx.test", "--spp 4", 0xd24571ef91f70d91),
     ("hw4-mis", "hw4/mis.test", "--spp 4", 0x1dbacee0868e3c4a),
-    ("hw4-cornellMIS-nee-on", "hw4/cornellMIS.test", "--spp 4 --nee on --importance-sampling cosine", 0xbc94580a3cf65f7d),
+    (
+        "hw4-cornellMIS-nee-on",
+        "hw4/cornellMIS.test",
+        "--spp 4 --nee on --importance-sampling cosine",
+        0xbc94580a3cf65f7d,
+    ),
     ("obj-cornell-emissive", "scenes/cornell_obj.test", "--spp 4", 0x8d258864674dead5),
-    ("builtin-path-clamp", "scenes/cornell_diffuse_path.test", "--spp 4 --clamp 2 --kernel general", 0x6e0c5eb40272cc0c),
+    (
+        "builtin-path-clamp",
+        "scenes/cornell_diffuse_path.test",
+        "--spp 4 --clamp 2 --kernel general",
+        0x6e0c5eb40272cc0c,
+    ),
 ];
 
 #[test]

@@ -46,7 +46,12 @@ fn check(text: &str, source: &Path, limits: &Limits) -> Result<(), TestCaseError
     let base = CountingAlloc::start();
     let result = parse_str(text, source, limits);
     let peak = CountingAlloc::peak_above(base);
-    prop_assert!(peak <= cap(text.len()), "{} bytes of text allocated {peak} bytes (cap {})", text.len(), cap(text.len()));
+    prop_assert!(
+        peak <= cap(text.len()),
+        "{} bytes of text allocated {peak} bytes (cap {})",
+        text.len(),
+        cap(text.len())
+    );
     if let Err(e) = result {
         check_error(&e, text, source)?;
     }
@@ -70,7 +75,8 @@ fn files() -> &'static [(PathBuf, String)] {
     static FILES: OnceLock<Vec<(PathBuf, String)>> = OnceLock::new();
     FILES.get_or_init(|| {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let corpus = std::env::var_os("STRATA_CSE168").map(PathBuf::from).unwrap_or_else(|| root.join("../shared/cse168"));
+        let corpus =
+            std::env::var_os("STRATA_CSE168").map(PathBuf::from).unwrap_or_else(|| root.join("../shared/cse168"));
         let mut dirs = vec![root.join("scenes")];
         if corpus.is_dir() {
             dirs.extend(["hw1", "hw2", "hw3", "hw4"].map(|h| corpus.join(h)));
@@ -80,7 +86,8 @@ fn files() -> &'static [(PathBuf, String)] {
         let mut out = vec![];
         for d in dirs {
             let Ok(entries) = std::fs::read_dir(&d) else { continue };
-            let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "test")).collect();
+            let mut paths: Vec<PathBuf> =
+                entries.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "test")).collect();
             paths.sort();
             for p in paths {
                 if let Ok(t) = std::fs::read_to_string(&p) {
@@ -94,16 +101,73 @@ fn files() -> &'static [(PathBuf, String)] {
 }
 
 const COMMANDS: [&str; 34] = [
-    "size", "output", "camera", "spp", "gamma", "maxdepth", "maxverts", "vertex", "tri", "sphere", "pushTransform",
-    "popTransform", "translate", "rotate", "scale", "diffuse", "specular", "shininess", "emission", "ambient", "brdf",
-    "roughness", "quadLight", "point", "directional", "attenuation", "integrator", "lightsamples", "lightstratify",
-    "nexteventestimation", "russianroulette", "importancesampling", "Vertex", "tri#",
+    "size",
+    "output",
+    "camera",
+    "spp",
+    "gamma",
+    "maxdepth",
+    "maxverts",
+    "vertex",
+    "tri",
+    "sphere",
+    "pushTransform",
+    "popTransform",
+    "translate",
+    "rotate",
+    "scale",
+    "diffuse",
+    "specular",
+    "shininess",
+    "emission",
+    "ambient",
+    "brdf",
+    "roughness",
+    "quadLight",
+    "point",
+    "directional",
+    "attenuation",
+    "integrator",
+    "lightsamples",
+    "lightstratify",
+    "nexteventestimation",
+    "russianroulette",
+    "importancesampling",
+    "Vertex",
+    "tri#",
 ];
 
 const NASTY: [&str; 30] = [
-    "nan", "NaN", "-inf", "inf", "1e39", "-1e39", "-1", "0", "-0", "1e-45", "99999999999999999999", "4294967296",
-    "18446744073709551616", "9e15", "1e15", "2.5", "0x10", "+", "-", ".", "e5", "x", "é", "\u{0}", "\u{feff}", "on",
-    "ggx", "pathtracer", "#", "1e308",
+    "nan",
+    "NaN",
+    "-inf",
+    "inf",
+    "1e39",
+    "-1e39",
+    "-1",
+    "0",
+    "-0",
+    "1e-45",
+    "99999999999999999999",
+    "4294967296",
+    "18446744073709551616",
+    "9e15",
+    "1e15",
+    "2.5",
+    "0x10",
+    "+",
+    "-",
+    ".",
+    "e5",
+    "x",
+    "é",
+    "\u{0}",
+    "\u{feff}",
+    "on",
+    "ggx",
+    "pathtracer",
+    "#",
+    "1e308",
 ];
 
 /// One token: a small integer, an arbitrary finite or special float, or a nasty string.
@@ -232,7 +296,8 @@ fn dense_and_greedy_inputs_stay_under_the_cap() {
         (0..5_000).map(|i| format!("diffuse {i} 0 0\nsphere 0 0 0 1\n")).collect::<String>(),
         "point 0 0 0 1 1 1\n".repeat(20_000),
         "pushTransform\n".repeat(4_096),
-        "maxverts 1000000000000000\nsize 65536 4096\nspp 16777216\nlightsamples 1048576\nmaxdepth 1000000\n".to_string(),
+        "maxverts 1000000000000000\nsize 65536 4096\nspp 16777216\nlightsamples 1048576\nmaxdepth 1000000\n"
+            .to_string(),
         format!("vertex {} 0 0\n", "1".repeat(1 << 20)),
     ];
     for text in &cases {
@@ -240,7 +305,12 @@ fn dense_and_greedy_inputs_stay_under_the_cap() {
         let r = parse_str(text, Path::new("dense.test"), &Limits::default());
         let peak = CountingAlloc::peak_above(base);
         let head: String = text.chars().take(30).collect();
-        assert!(peak <= cap(text.len()), "{head:?}...: {} bytes allocated {peak} (cap {})", text.len(), cap(text.len()));
+        assert!(
+            peak <= cap(text.len()),
+            "{head:?}...: {} bytes allocated {peak} (cap {})",
+            text.len(),
+            cap(text.len())
+        );
         if let Err(e) = r {
             // A 1 MiB token is shown shortened, not copied into the message.
             assert!(e.line >= 1 && e.message.len() < 400, "{head:?}...: {} byte message", e.message.len());
@@ -252,8 +322,16 @@ fn dense_and_greedy_inputs_stay_under_the_cap() {
 #[test]
 fn resource_caps_name_the_limit_and_how_to_raise_it() {
     let parse = |text: &str, limits: &Limits| parse_str(text, Path::new("caps.test"), limits);
-    let small = Limits { max_pixels: 100, max_side: 20, max_vertices: 2, max_primitives: 1, max_spp: 8, max_depth: 4,
-        max_light_samples: 3, max_transform_depth: 1 };
+    let small = Limits {
+        max_pixels: 100,
+        max_side: 20,
+        max_vertices: 2,
+        max_primitives: 1,
+        max_spp: 8,
+        max_depth: 4,
+        max_light_samples: 3,
+        max_transform_depth: 1,
+    };
     let cases = [
         ("size 11 10", "max_pixels", "size 10 10"),
         ("size 21 1", "max_side", "size 20 1"),
@@ -288,7 +366,8 @@ fn cli_limit_flag_raises_caps_and_overrides_are_capped() {
     let dir = std::env::temp_dir().join(format!("strata-hostile-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let run = |args: &[&str]| {
-        let o = std::process::Command::new(bin).args(args).arg("-o").arg(dir.join("img")).arg("--quiet").output().unwrap();
+        let o =
+            std::process::Command::new(bin).args(args).arg("-o").arg(dir.join("img")).arg("--quiet").output().unwrap();
         (o.status.success(), String::from_utf8_lossy(&o.stderr).into_owned())
     };
     let base = ["render", "--size", "8x8", "--threads", "1"];

@@ -12,7 +12,6 @@ use strata::app::RenderOptions;
 use strata::scene::obj;
 use strata::scene::parse::{parse_file, Limits};
 
-
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
@@ -154,13 +153,20 @@ fn materials_follow_the_mtl_where_given_and_the_current_material_elsewhere() {
         "m.obj",
         "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nusemtl kd_only\nf 2 4 3\nusemtl full\nf 1 2 4\nusemtl lamp\nf 1 2 3 4\n",
     );
-    let t = write(&d, "s.test", "specular 0.25 0.25 0.25\nshininess 7\nemission 0.01 0 0\ntranslate 0 0 -2\nscale 2 2 2\nobj m.obj\n");
+    let t = write(
+        &d,
+        "s.test",
+        "specular 0.25 0.25 0.25\nshininess 7\nemission 0.01 0 0\ntranslate 0 0 -2\nscale 2 2 2\nobj m.obj\n",
+    );
     let s = parse_file(&t, &Limits::default()).unwrap();
     assert_eq!(s.triangles.len(), 3);
     let mat = |i: usize| s.materials[s.triangles[i].material as usize];
     // No usemtl: the current material.
     assert_eq!(mat(0).diffuse, Vec3::ZERO);
-    assert_eq!((mat(0).specular, mat(0).shininess, mat(0).emission), (Vec3::splat(0.25), 7.0, Vec3::new(0.01, 0.0, 0.0)));
+    assert_eq!(
+        (mat(0).specular, mat(0).shininess, mat(0).emission),
+        (Vec3::splat(0.25), 7.0, Vec3::new(0.01, 0.0, 0.0))
+    );
     // Kd from the MTL, Ks and Ns from the current material.
     assert_eq!((mat(1).diffuse, mat(1).specular, mat(1).shininess), (Vec3::new(0.1, 0.2, 0.3), Vec3::splat(0.25), 7.0));
     assert_eq!((mat(2).diffuse, mat(2).specular, mat(2).shininess), (Vec3::splat(0.4), Vec3::splat(0.5), 30.0));
@@ -193,8 +199,16 @@ fn equivalent_scenes(dir: &Path, settings: &str, sphere: bool) -> (PathBuf, Path
     let q = write(dir, "quad.test", &format!("{room}{settings}\nquadLight -0.4 1.8 -0.6 0 0 0.9 0.8 0 0 {l}\n"));
     write(dir, "light.mtl", &format!("newmtl lamp\nKd 0.5 0.5 0.5\nKe {l}\n"));
     // Corners relative to (0, 1.8, 0): a, a+ab, a+ab+ac, a+ac; faces wound for a -y normal.
-    write(dir, "light.obj", "mtllib light.mtl\nv -0.4 0 -0.6\nv -0.4 0 0.3\nv 0.4 0 0.3\nv 0.4 0 -0.6\nusemtl lamp\nf 1 4 3\nf 1 3 2\n");
-    let t = write(dir, "tri.test", &format!("{room}{settings}\npushTransform\ntranslate 0 1.8 0\nobj light.obj\npopTransform\n"));
+    write(
+        dir,
+        "light.obj",
+        "mtllib light.mtl\nv -0.4 0 -0.6\nv -0.4 0 0.3\nv 0.4 0 0.3\nv 0.4 0 -0.6\nusemtl lamp\nf 1 4 3\nf 1 3 2\n",
+    );
+    let t = write(
+        dir,
+        "tri.test",
+        &format!("{room}{settings}\npushTransform\ntranslate 0 1.8 0\nobj light.obj\npopTransform\n"),
+    );
     (q, t)
 }
 
@@ -263,13 +277,25 @@ fn emissive_triangles_match_the_quad_light_direct() {
 
 #[test]
 fn emissive_triangles_match_the_quad_light_pathtracer_mis() {
-    assert_equivalent("eq-mis", "integrator pathtracer\nnexteventestimation mis\nimportancesampling brdf\nmaxdepth 3", 64);
+    assert_equivalent(
+        "eq-mis",
+        "integrator pathtracer\nnexteventestimation mis\nimportancesampling brdf\nmaxdepth 3",
+        64,
+    );
 }
 
 #[test]
 fn emissive_triangles_match_the_quad_light_pathtracer_nee_off_and_on() {
-    assert_equivalent("eq-off", "integrator pathtracer\nnexteventestimation off\nimportancesampling cosine\nmaxdepth 2", 128);
-    assert_equivalent("eq-on", "integrator pathtracer\nnexteventestimation on\nimportancesampling cosine\nmaxdepth 3", 64);
+    assert_equivalent(
+        "eq-off",
+        "integrator pathtracer\nnexteventestimation off\nimportancesampling cosine\nmaxdepth 2",
+        128,
+    );
+    assert_equivalent(
+        "eq-on",
+        "integrator pathtracer\nnexteventestimation on\nimportancesampling cosine\nmaxdepth 3",
+        64,
+    );
 }
 
 /// `analyticdirect` is deterministic: the triangle pair's irradiance is the quad's (the shared
@@ -329,7 +355,11 @@ fn default_camera_frames_the_bounds() {
         let cam = strata::scene::build::Camera::new(&desc, w, h);
         let mut max_ndc: f32 = 0.0;
         for k in 0..8 {
-            let p = Vec3::new(if k & 1 == 0 { lo.x } else { hi.x }, if k & 2 == 0 { lo.y } else { hi.y }, if k & 4 == 0 { lo.z } else { hi.z });
+            let p = Vec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
             let d = p - cam.eye;
             let z = d.dot(cam.look);
             assert!(z > 0.0, "corner behind the camera");

@@ -11,7 +11,16 @@ use strata::app::RenderOptions;
 
 /// The built-in Cornell box (scenes/cornell.test) with the given settings replacing its own.
 fn variant(name: &str, settings: &[&str]) -> PathBuf {
-    let keys = ["integrator", "nexteventestimation", "importancesampling", "maxdepth", "russianroulette", "spp", "lightsamples", "lightstratify"];
+    let keys = [
+        "integrator",
+        "nexteventestimation",
+        "importancesampling",
+        "maxdepth",
+        "russianroulette",
+        "spp",
+        "lightsamples",
+        "lightstratify",
+    ];
     let mut text: String = strata::app::DEFAULT_SCENE
         .lines()
         .filter(|l| !keys.iter().any(|k| l.trim_start().starts_with(k)))
@@ -88,7 +97,12 @@ fn estimators_agree_with_each_other() {
         assert!(z.abs() < 4.5, "{name} disagrees with the MIS reference: z = {z}");
         assert!(outliers * 100 < e.mean.len() * 3, "{name}: {outliers} outlier channels");
     }
-    let direct_only = estimate("depth1", &["integrator pathtracer", "maxdepth 1", "importancesampling brdf", "nexteventestimation mis"], 256, 3);
+    let direct_only = estimate(
+        "depth1",
+        &["integrator pathtracer", "maxdepth 1", "importancesampling brdf", "nexteventestimation mis"],
+        256,
+        3,
+    );
     let (z, _) = agreement(&direct_only, &reference);
     assert!(z.abs() > 10.0, "maxdepth 1 should differ from maxdepth 3: z = {z}");
 }
@@ -108,7 +122,12 @@ fn russian_roulette_is_unbiased() {
 /// sample per light; the box has one light).
 #[test]
 fn maxdepth_1_with_nee_equals_direct() {
-    let path = estimate("pt-direct", &["integrator pathtracer", "maxdepth 1", "nexteventestimation on", "importancesampling cosine"], 256, 6);
+    let path = estimate(
+        "pt-direct",
+        &["integrator pathtracer", "maxdepth 1", "nexteventestimation on", "importancesampling cosine"],
+        256,
+        6,
+    );
     let direct = estimate("direct", &["integrator direct", "lightsamples 1"], 256, 7);
     let (z, outliers) = agreement(&path, &direct);
     eprintln!("maxdepth 1 + NEE vs direct: aggregate z = {z:.2}, outliers {outliers}");
@@ -121,7 +140,18 @@ fn maxdepth_1_with_nee_equals_direct() {
 #[test]
 fn course_path_tracing_scenes_are_finite_and_packets_full() {
     let Some(c) = corpus() else { return };
-    for name in ["hw3/cornellSimple", "hw3/cornellNEE", "hw3/cornellRR", "hw3/dragon", "hw4/cornellCosine", "hw4/cornellBRDF", "hw4/cornellMIS", "hw4/ggx", "hw4/mis", "hw4/dragon"] {
+    for name in [
+        "hw3/cornellSimple",
+        "hw3/cornellNEE",
+        "hw3/cornellRR",
+        "hw3/dragon",
+        "hw4/cornellCosine",
+        "hw4/cornellBRDF",
+        "hw4/cornellMIS",
+        "hw4/ggx",
+        "hw4/mis",
+        "hw4/dragon",
+    ] {
         let o = opts(c.join(format!("{name}.test")), 64, 48, 2);
         let out = strata::app::render_to_film(&o).unwrap_or_else(|e| panic!("{name}: {e}"));
         let cnt = out.stats.counters;
@@ -133,17 +163,34 @@ fn course_path_tracing_scenes_are_finite_and_packets_full() {
         if cnt.shadow_packets > 20 {
             assert!(cnt.shadow_occupancy() > 0.9, "{name}: shadow occupancy {}", cnt.shadow_occupancy());
         }
-        eprintln!("{name}: mean path length {:.2}, occupancy bounce {:.3} shadow {:.3}", cnt.mean_path_length(), cnt.bounce_occupancy(), cnt.shadow_occupancy());
+        eprintln!(
+            "{name}: mean path length {:.2}, occupancy bounce {:.3} shadow {:.3}",
+            cnt.mean_path_length(),
+            cnt.bounce_occupancy(),
+            cnt.shadow_occupancy()
+        );
     }
 }
 
 /// Path tracing is bit-identical whatever the thread count (compaction order is per tile).
 #[test]
 fn path_tracing_is_bit_identical_across_thread_counts() {
-    let scene = variant("det", &["integrator pathtracer", "maxdepth -1", "russianroulette on", "importancesampling brdf", "nexteventestimation mis"]);
+    let scene = variant(
+        "det",
+        &[
+            "integrator pathtracer",
+            "maxdepth -1",
+            "russianroulette on",
+            "importancesampling brdf",
+            "nexteventestimation mis",
+        ],
+    );
     let f = |t: usize| film(&RenderOptions { threads: t, ..opts(scene.clone(), 40, 24, 3) });
     let (a, b) = (f(1), f(3));
-    assert_eq!(a.sum.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>(), b.sum.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>());
+    assert_eq!(
+        a.sum.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        b.sum.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
     assert_eq!(a.sum_sq, b.sum_sq);
 }
 

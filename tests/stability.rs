@@ -20,7 +20,6 @@ fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
 }
 
-
 /// A rendered image: per-pixel means and variances of the mean (f64), and the non-finite count.
 struct Img {
     w: usize,
@@ -121,7 +120,11 @@ fn compare(a: &Img, b: &Img, expected: Option<&[[f64; 3]]>, block: usize) -> Com
 
 /// Per-block means of `a - b` (an expected difference from two noiseless renders).
 fn block_diff(a: &Img, b: &Img, block: usize) -> Vec<[f64; 3]> {
-    blocks(a, block).iter().zip(blocks(b, block)).map(|((ma, _), (mb, _))| std::array::from_fn(|c| ma[c] - mb[c])).collect()
+    blocks(a, block)
+        .iter()
+        .zip(blocks(b, block))
+        .map(|((ma, _), (mb, _))| std::array::from_fn(|c| ma[c] - mb[c]))
+        .collect()
 }
 
 fn opts_for(path: PathBuf, integrator: IntegratorKind, seed: u64) -> RenderOptions {
@@ -164,8 +167,8 @@ fn tiny_bright_light_matches_a_large_light_of_equal_power() {
     let (tiny, large) = (scene("light_tiny.test"), scene("light_large.test"));
     let (at, al) = (analytic(tiny.clone(), 3), analytic(large.clone(), 3));
     let expected = block_diff(&at, &al, 4);
-    let rel: f64 = expected.iter().flatten().map(|v| v.abs()).sum::<f64>()
-        / blocks(&al, 4).iter().flat_map(|b| b.0).sum::<f64>();
+    let rel: f64 =
+        expected.iter().flatten().map(|v| v.abs()).sum::<f64>() / blocks(&al, 4).iter().flat_map(|b| b.0).sum::<f64>();
     eprintln!("analytic |tiny - large| / large over the image: {rel:.3}");
     assert!(at.mean.iter().flatten().any(|&v| v > 0.1), "the tiny light lights the floor");
     let dir = tmpdir("tiny");
@@ -285,7 +288,10 @@ fn camera_inside_geometry_sees_a_black_interior() {
     let dir = tmpdir("inside");
     let text = std::fs::read_to_string(scene("cornell_scale.test")).unwrap();
     // Inside the cube (centre (0.35, 0.3, -0.2), half side 0.3) and inside the sphere.
-    for (name, camera) in [("cube", "camera 0.35 0.3 -0.05  0.35 0.3 -1  0 1 0  90"), ("sphere", "camera -0.45 0.35 0.2  0 1 -1  0 1 0  90")] {
+    for (name, camera) in [
+        ("cube", "camera 0.35 0.3 -0.05  0.35 0.3 -1  0 1 0  90"),
+        ("sphere", "camera -0.45 0.35 0.2  0 1 -1  0 1 0  90"),
+    ] {
         let p = write_scene(&dir, &format!("{name}.test"), &text.replace("camera 0 1 3.6  0 1 0  0 1 0  40", camera));
         for integ in [IntegratorKind::Direct, IntegratorKind::PathTracer] {
             let img = render(&RenderOptions { spp: Some(16), ..opts_for(p.clone(), integ, 6) });
@@ -303,8 +309,16 @@ fn degenerate_lights_and_cameras_are_errors_with_file_and_line() {
     let text = std::fs::read_to_string(scene("cornell_scale.test")).unwrap();
     let line_of = |needle: &str| text.lines().position(|l| l.starts_with(needle)).unwrap() + 1;
     let cases = [
-        ("quadLight -0.3 1.99 -0.3  0 0 0.6  0.6 0 0  12 10 8", "quadLight -0.3 1.99 -0.3  0 0 0.6  0 0 1.2  12 10 8", "area"),
-        ("quadLight -0.3 1.99 -0.3  0 0 0.6  0.6 0 0  12 10 8", "quadLight -0.3 1.99 -0.3  0 0 0  0.6 0 0  12 10 8", "area"),
+        (
+            "quadLight -0.3 1.99 -0.3  0 0 0.6  0.6 0 0  12 10 8",
+            "quadLight -0.3 1.99 -0.3  0 0 0.6  0 0 1.2  12 10 8",
+            "area",
+        ),
+        (
+            "quadLight -0.3 1.99 -0.3  0 0 0.6  0.6 0 0  12 10 8",
+            "quadLight -0.3 1.99 -0.3  0 0 0  0.6 0 0  12 10 8",
+            "area",
+        ),
         ("camera 0 1 3.6  0 1 0  0 1 0  40", "camera 0 1 3.6  0 1 0  0 0 -3  40", "parallel"),
         ("camera 0 1 3.6  0 1 0  0 1 0  40", "camera 0 1 3.6  0 1 3.6  0 1 0  40", "coincide"),
         ("camera 0 1 3.6  0 1 0  0 1 0  40", "camera 0 1 3.6  0 1 0  0 0 0  40", "up vector"),
@@ -328,7 +342,8 @@ fn degenerate_lights_and_cameras_are_errors_with_file_and_line() {
 fn failed_renders_keep_existing_outputs_and_leave_no_temporaries() {
     let dir = tmpdir("atomic");
     let stem = dir.join("img");
-    let base = RenderOptions { size: Some((16, 16)), spp: Some(1), threads: 2, out: Some(stem.clone()), ..Default::default() };
+    let base =
+        RenderOptions { size: Some((16, 16)), spp: Some(1), threads: 2, out: Some(stem.clone()), ..Default::default() };
     app::run_render(&base).expect("first render");
     let (exr, png) = (std::fs::read(dir.join("img.exr")).unwrap(), std::fs::read(dir.join("img.png")).unwrap());
     // A scene that fails to parse: nothing is touched.
@@ -343,9 +358,12 @@ fn failed_renders_keep_existing_outputs_and_leave_no_temporaries() {
     assert_eq!(std::fs::read(dir.join("img.png")).unwrap(), png, "the old PNG survives");
     assert_eq!(std::fs::read(dir.join("old.exr")).unwrap(), exr);
     // The output's parent is a regular file.
-    let e = app::run_render(&RenderOptions { out: Some(dir.join("old.exr").join("x")), ..base.clone() }).err().expect("bad parent");
+    let e = app::run_render(&RenderOptions { out: Some(dir.join("old.exr").join("x")), ..base.clone() })
+        .err()
+        .expect("bad parent");
     assert!(e.contains("x.exr"), "{e}");
-    let names: Vec<String> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.contains(".tmp-")), "temporary files left: {names:?}");
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -382,7 +400,8 @@ fn a_write_cut_short_never_truncates_the_final_files() {
     assert!(stderr.contains("img.exr"), "the error names the file: {stderr}");
     assert_eq!(std::fs::read(dir.join("img.exr")).unwrap(), exr, "the old EXR survives");
     assert_eq!(std::fs::read(dir.join("img.png")).unwrap(), png, "the old PNG survives");
-    let names: Vec<String> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.contains(".tmp-")), "temporary files left: {names:?}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -20,7 +20,11 @@ fn every_hw1_scene_renders_finite_and_fast() {
         eprintln!("skipped: {} not found", dir.display());
         return;
     }
-    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "test")).collect();
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "test"))
+        .collect();
     names.sort();
     assert!(names.len() >= 10, "expected the 10 hw1 scenes, found {}", names.len());
     let start = Instant::now();
@@ -88,7 +92,19 @@ fn scene_text() -> String {
     let m = |m: Mat| {
         format!(
             "diffuse {} {} {}\nspecular {} {} {}\nshininess {}\nambient {} {} {}\nemission {} {} {}\n",
-            m.kd.x, m.kd.y, m.kd.z, m.ks.x, m.ks.y, m.ks.z, m.s, m.ambient.x, m.ambient.y, m.ambient.z, m.emission.x, m.emission.y, m.emission.z
+            m.kd.x,
+            m.kd.y,
+            m.kd.z,
+            m.ks.x,
+            m.ks.y,
+            m.ks.z,
+            m.s,
+            m.ambient.x,
+            m.ambient.y,
+            m.ambient.z,
+            m.emission.x,
+            m.emission.y,
+            m.emission.z
         )
     };
     format!(
@@ -96,8 +112,23 @@ fn scene_text() -> String {
          attenuation {} {} {}\npoint {} {} {} {} {} {}\ndirectional 0.3 -0.2 1 {} {} {}\n\
          {}vertex -10 -10 0\nvertex 10 -10 0\nvertex 10 10 0\nvertex -10 10 0\ntri 0 1 2\ntri 0 2 3\n\
          {}vertex 0.2 0.2 1\nvertex 0.8 0.2 1\nvertex 0.8 0.8 1\nvertex 0.2 0.8 1\ntri 4 5 6\ntri 4 6 7\n",
-        EYE.x, EYE.y, EYE.z, ATT.x, ATT.y, ATT.z, POINT.x, POINT.y, POINT.z, POINT_COLOUR.x, POINT_COLOUR.y, POINT_COLOUR.z,
-        DIR_COLOUR.x, DIR_COLOUR.y, DIR_COLOUR.z, m(a), m(b)
+        EYE.x,
+        EYE.y,
+        EYE.z,
+        ATT.x,
+        ATT.y,
+        ATT.z,
+        POINT.x,
+        POINT.y,
+        POINT.z,
+        POINT_COLOUR.x,
+        POINT_COLOUR.y,
+        POINT_COLOUR.z,
+        DIR_COLOUR.x,
+        DIR_COLOUR.y,
+        DIR_COLOUR.z,
+        m(a),
+        m(b)
     )
 }
 
@@ -111,7 +142,6 @@ fn triangles() -> Vec<([DVec3; 3], usize)> {
     t.extend(q(1.0, 0.2, 0.8).into_iter().map(|v| (v, 1)));
     t
 }
-
 
 fn closest(tris: &[([DVec3; 3], usize)], o: DVec3, d: DVec3) -> Option<(f64, usize)> {
     let mut best: Option<(f64, usize)> = None;
@@ -248,7 +278,13 @@ fn maxdepth_limits_mirror_recursion() {
         let text = scene_text().replace(&format!("maxdepth {MAXDEPTH}"), &format!("maxdepth {depth}"));
         let path = dir.join(format!("whitted_depth{depth}.test"));
         std::fs::write(&path, text).unwrap();
-        let o = RenderOptions { scene: Some(path), spp: Some(1), pixel_sampler: Some(SamplerKind::GridCenter), threads: 1, ..Default::default() };
+        let o = RenderOptions {
+            scene: Some(path),
+            spp: Some(1),
+            pixel_sampler: Some(SamplerKind::GridCenter),
+            threads: 1,
+            ..Default::default()
+        };
         let out = strata::app::render_to_film(&o).unwrap();
         if depth == 0 {
             assert_eq!(out.stats.counters.bounce, 0, "maxdepth 0 traces no mirror rays");

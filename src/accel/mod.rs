@@ -286,7 +286,8 @@ impl Device {
     /// `verbose=0`, or `$STRATA_EMBREE_CONFIG` when set (e.g. `isa=avx2`).
     pub fn new() -> Result<Self, AccelError> {
         let config = std::env::var("STRATA_EMBREE_CONFIG").unwrap_or_else(|_| "verbose=0".into());
-        let config = std::ffi::CString::new(config).map_err(|_| AccelError("STRATA_EMBREE_CONFIG contains a NUL byte".into()))?;
+        let config = std::ffi::CString::new(config)
+            .map_err(|_| AccelError("STRATA_EMBREE_CONFIG contains a NUL byte".into()))?;
         // SAFETY: a NUL-terminated config string; a null return is checked.
         let raw = unsafe { sys::rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
@@ -294,9 +295,7 @@ impl Device {
         }
         let sink = Box::new(ErrorSink(Mutex::new(Vec::new())));
         // SAFETY: `raw` is a live device; the sink pointer stays valid until after rtcReleaseDevice.
-        unsafe {
-            sys::rtcSetDeviceErrorFunction(raw, Some(error_callback), &*sink as *const ErrorSink as *mut c_void)
-        };
+        unsafe { sys::rtcSetDeviceErrorFunction(raw, Some(error_callback), &*sink as *const ErrorSink as *mut c_void) };
         Ok(Self { raw, sink })
     }
 
@@ -381,7 +380,14 @@ impl<'d> SceneBuilder<'d> {
         // SAFETY: live device handle.
         let scene = unsafe { sys::rtcNewScene(device.raw) };
         device.take_errors()?;
-        Ok(Self { device, scene, children: Vec::new(), user_data: Vec::new(), next_id: 0, quality: sys::RTCBuildQuality::MEDIUM })
+        Ok(Self {
+            device,
+            scene,
+            children: Vec::new(),
+            user_data: Vec::new(),
+            next_id: 0,
+            quality: sys::RTCBuildQuality::MEDIUM,
+        })
     }
 
     /// Asks for Embree's high-quality BVH build (SAH with spatial splits) for the scene and the
@@ -428,10 +434,17 @@ impl<'d> SceneBuilder<'d> {
         // exactly that many before committing.
         unsafe {
             let g = sys::rtcNewGeometry(self.device.raw, sys::RTCGeometryType::TRIANGLE);
-            let vb = sys::rtcSetNewGeometryBuffer(g, sys::RTCBufferType::VERTEX, 0, sys::RTCFormat::FLOAT3, 12, vertices.len())
-                as *mut f32;
-            let ib = sys::rtcSetNewGeometryBuffer(g, sys::RTCBufferType::INDEX, 0, sys::RTCFormat::UINT3, 12, indices.len())
-                as *mut u32;
+            let vb = sys::rtcSetNewGeometryBuffer(
+                g,
+                sys::RTCBufferType::VERTEX,
+                0,
+                sys::RTCFormat::FLOAT3,
+                12,
+                vertices.len(),
+            ) as *mut f32;
+            let ib =
+                sys::rtcSetNewGeometryBuffer(g, sys::RTCBufferType::INDEX, 0, sys::RTCFormat::UINT3, 12, indices.len())
+                    as *mut u32;
             self.device.take_errors()?;
             if vb.is_null() || ib.is_null() {
                 sys::rtcReleaseGeometry(g);
@@ -463,8 +476,14 @@ impl<'d> SceneBuilder<'d> {
         // the geometry is committed.
         unsafe {
             let g = sys::rtcNewGeometry(self.device.raw, sys::RTCGeometryType::SPHERE_POINT);
-            let vb = sys::rtcSetNewGeometryBuffer(g, sys::RTCBufferType::VERTEX, 0, sys::RTCFormat::FLOAT4, 16, spheres.len())
-                as *mut f32;
+            let vb = sys::rtcSetNewGeometryBuffer(
+                g,
+                sys::RTCBufferType::VERTEX,
+                0,
+                sys::RTCFormat::FLOAT4,
+                16,
+                spheres.len(),
+            ) as *mut f32;
             self.device.take_errors()?;
             if vb.is_null() {
                 sys::rtcReleaseGeometry(g);
@@ -514,7 +533,12 @@ impl<'d> SceneBuilder<'d> {
     /// Adds an instance (geometry id >= [`GEOM_FIRST_INSTANCE`]) of a child scene holding one
     /// triangle mesh, placed by the affine `object_to_world`. Hits report `inst_id` = the returned
     /// id, `geom_id` = 0 and `prim_id` the child's triangle.
-    pub fn add_mesh_instance(&mut self, vertices: &[Vec3], indices: &[[u32; 3]], object_to_world: &Mat4) -> Result<u32, AccelError> {
+    pub fn add_mesh_instance(
+        &mut self,
+        vertices: &[Vec3],
+        indices: &[[u32; 3]],
+        object_to_world: &Mat4,
+    ) -> Result<u32, AccelError> {
         let id = self.next_id.max(GEOM_FIRST_INSTANCE);
         self.reserve(id, "instance")?;
         let mut child = SceneBuilder::new(self.device)?;
@@ -659,7 +683,13 @@ impl Ellipsoid {
         let h = (disc / a).sqrt();
         let (t0, t1) = (b - h, b + h);
         let (tn, tf) = (f64::from(tnear), f64::from(tfar));
-        let t = if t0 > tn && t0 < tf { t0 } else if t1 > tn && t1 < tf { t1 } else { return None };
+        let t = if t0 > tn && t0 < tf {
+            t0
+        } else if t1 > tn && t1 < tf {
+            t1
+        } else {
+            return None;
+        };
         Some(t as f32).filter(|t| *t > tnear && *t < tfar)
     }
 }
@@ -763,7 +793,14 @@ fn query_args(coherent: bool, ctx: &mut RayQueryContext) -> QueryArgs {
 #[inline]
 fn finite_ray(r: &Ray8) -> Mask8 {
     let f = |a: &[f32; 8]| F8::new(*a).is_finite();
-    f(&r.org_x) & f(&r.org_y) & f(&r.org_z) & f(&r.dir_x) & f(&r.dir_y) & f(&r.dir_z) & f(&r.tnear) & !F8::new(r.tfar).is_nan()
+    f(&r.org_x)
+        & f(&r.org_y)
+        & f(&r.org_z)
+        & f(&r.dir_x)
+        & f(&r.dir_y)
+        & f(&r.dir_z)
+        & f(&r.tnear)
+        & !F8::new(r.tfar).is_nan()
 }
 
 /// Closest-hit results of a packet in SoA form.
@@ -795,7 +832,6 @@ impl Hits8 {
 /// Path of the Embree library this binary was linked against (from build.rs).
 pub const EMBREE_LIBDIR: &str = env!("STRATA_EMBREE_LIBDIR");
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -811,7 +847,12 @@ mod tests {
     fn build(dev: &Device, with_instance: bool) -> Scene {
         let mut b = SceneBuilder::new(dev).unwrap();
         // A quad at z = 5 spanning [-1,1]^2, two triangles.
-        let v = [Vec3::new(-1.0, -1.0, 5.0), Vec3::new(1.0, -1.0, 5.0), Vec3::new(1.0, 1.0, 5.0), Vec3::new(-1.0, 1.0, 5.0)];
+        let v = [
+            Vec3::new(-1.0, -1.0, 5.0),
+            Vec3::new(1.0, -1.0, 5.0),
+            Vec3::new(1.0, 1.0, 5.0),
+            Vec3::new(-1.0, 1.0, 5.0),
+        ];
         b.add_triangles(&v, &[[0, 1, 2], [0, 2, 3]]).unwrap();
         // A sphere point of radius 0.5 at (3, 0, 5); a user-geometry sphere of radius 0.5 at
         // (3, 3, 5) and an ellipsoid (0.5, 0.25, 0.5) at (0, 3, 5).

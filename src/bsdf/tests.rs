@@ -419,7 +419,11 @@ fn ggx_energy() {
             if a <= 1e-3 && theta_o <= 85.0 {
                 let f = |ks: f64| ks + (1.0 - ks) * (1.0 - (theta_o as f64).to_radians().cos()).powi(5);
                 assert!((spec - 1.0).abs() < 1e-3, "alpha={a} theta_o={theta_o}: mirror albedo {spec}");
-                assert!((total - 0.5 - f(0.5)).abs() < 1e-3, "alpha={a} theta_o={theta_o}: {total} vs {}", 0.5 + f(0.5));
+                assert!(
+                    (total - 0.5 - f(0.5)).abs() < 1e-3,
+                    "alpha={a} theta_o={theta_o}: {total} vs {}",
+                    0.5 + f(0.5)
+                );
             }
             row.push(format!("{spec:.4}/{total:.4}"));
         }

@@ -9,10 +9,10 @@ use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::light::polygonal::polygon_phi_x8;
 use crate::render::PixelPacket;
 use crate::sampler::{GridTable, PointSet, SamplerKind, Stream};
-use kernel::Kernel;
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
+use kernel::Kernel;
 use serde::Serialize;
 use std::f32::consts::PI;
 
@@ -165,7 +165,8 @@ impl Integrator {
     ) -> Self {
         let d = &scene.desc;
         let n_light = light_samples.unwrap_or(d.light_samples).max(1);
-        let light_kind = light_sampler.unwrap_or(if d.light_stratify { SamplerKind::Stratified } else { SamplerKind::Independent });
+        let light_kind =
+            light_sampler.unwrap_or(if d.light_stratify { SamplerKind::Stratified } else { SamplerKind::Independent });
         Self {
             kind: d.integrator,
             spp: spp.max(1),
@@ -318,14 +319,16 @@ impl Integrator {
         let sample_idx = U8::splat(s);
         // Lights shade nothing themselves (black, one-sided emitters).
         sc.shade.clear();
-        sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into())));
+        sc.shade
+            .extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into())));
         sc.eps.clear();
         sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
         // The Phong lobe is evaluated only in kernels that have it, and only where a hit has ks > 0.
         let any_spec = self.kernel.lobes.phong && sc.hits.iter().any(|sh| sh.ks.max_elem().simd_gt(F8::ZERO).any());
         for (li, light) in scene.lights.iter().enumerate() {
             let dim = DIM_LIGHT_BASE + li as u32;
-            let (la, lab, lac, ln) = (Vec3x8::splat(light.a), Vec3x8::splat(light.ab), Vec3x8::splat(light.ac), Vec3x8::splat(light.normal));
+            let (la, lab, lac, ln) =
+                (Vec3x8::splat(light.a), Vec3x8::splat(light.ab), Vec3x8::splat(light.ac), Vec3x8::splat(light.normal));
             sc.acc.clear();
             sc.acc.resize(pks.len(), Vec3x8::ZERO);
             sc.streams.clear();
@@ -529,7 +532,13 @@ mod tests {
                 // Directions at 0 .. ~3e-3 rad from the mirror direction.
                 let t = k as f32 * 2e-4;
                 let wi = (r + t * r.any_orthonormal_vector()).normalize();
-                let m = Material { kd: Vec3::splat(0.1), ks: Vec3::splat(0.5), shininess: s, alpha: 1.0, kind: BrdfKind::Phong };
+                let m = Material {
+                    kd: Vec3::splat(0.1),
+                    ks: Vec3::splat(0.5),
+                    shininess: s,
+                    alpha: 1.0,
+                    kind: BrdfKind::Phong,
+                };
                 let want = m.eval(to_local(wo), to_local(wi)).x;
                 let sh = SurfaceHit8 {
                     valid: mask_all(),

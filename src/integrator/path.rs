@@ -52,7 +52,8 @@ struct PathLane {
 
 impl PathLane {
     /// Padding lane: traced inactive, contributes nothing, never continues.
-    const DEAD: Self = Self { slot: u32::MAX, pixel: 0, sample: 0, o: Vec3::ZERO, d: Vec3::Z, beta: Vec3::ZERO, pdf: 0.0 };
+    const DEAD: Self =
+        Self { slot: u32::MAX, pixel: 0, sample: 0, o: Vec3::ZERO, d: Vec3::Z, beta: Vec3::ZERO, pdf: 0.0 };
 }
 
 impl ShadowLane {
@@ -132,7 +133,15 @@ impl Integrator {
                     let slot = ((si * pks.len() + p) * 8 + i) as u32;
                     // Lanes outside the image travel as inactive placeholders in the first packets.
                     let slot = if inside[i] { slot } else { u32::MAX };
-                    sc.lanes.push(PathLane { slot, pixel: pix[i], sample: s, o: org.lane(i), d: dirs[i], beta: Vec3::ONE, pdf: 0.0 });
+                    sc.lanes.push(PathLane {
+                        slot,
+                        pixel: pix[i],
+                        sample: s,
+                        o: org.lane(i),
+                        d: dirs[i],
+                        beta: Vec3::ONE,
+                        pdf: 0.0,
+                    });
                 }
             }
         }
@@ -235,10 +244,17 @@ impl Integrator {
                         let contrib = beta.mul_elem(f).mul_elem(l_rad).scale(g * w_light);
                         let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
                         // Shadow rays are compacted per lane and sent in full packets below.
-                        let (lit_b, os, ds, tf, cs) = (mask_to_bools(lit), o.to_lanes(), (y - o).to_lanes(), tfar.to_array(), contrib.to_lanes());
+                        let (lit_b, os, ds, tf, cs) =
+                            (mask_to_bools(lit), o.to_lanes(), (y - o).to_lanes(), tfar.to_array(), contrib.to_lanes());
                         for i in 0..8 {
                             if lit_b[i] {
-                                sc.shadow_lanes.push(ShadowLane { slot: slots[i], o: os[i], d: ds[i], tfar: tf[i], contrib: cs[i] });
+                                sc.shadow_lanes.push(ShadowLane {
+                                    slot: slots[i],
+                                    o: os[i],
+                                    d: ds[i],
+                                    tfar: tf[i],
+                                    contrib: cs[i],
+                                });
                             }
                         }
                     }
@@ -260,11 +276,20 @@ impl Integrator {
                     }
                     if alive.any() {
                         let wi = frame.to_world(wi_l);
-                        let (alive_b, os, ds, bs, ps) = (mask_to_bools(alive), o.to_lanes(), wi.to_lanes(), nb.to_lanes(), pdf.to_array());
+                        let (alive_b, os, ds, bs, ps) =
+                            (mask_to_bools(alive), o.to_lanes(), wi.to_lanes(), nb.to_lanes(), pdf.to_array());
                         let (pix, smp) = (pixel.to_array(), s.to_array());
                         for i in 0..8 {
                             if alive_b[i] {
-                                sc.next.push(PathLane { slot: slots[i], pixel: pix[i], sample: smp[i], o: os[i], d: ds[i], beta: bs[i], pdf: ps[i] });
+                                sc.next.push(PathLane {
+                                    slot: slots[i],
+                                    pixel: pix[i],
+                                    sample: smp[i],
+                                    o: os[i],
+                                    d: ds[i],
+                                    beta: bs[i],
+                                    pdf: ps[i],
+                                });
                             }
                         }
                     }

@@ -17,7 +17,13 @@ const UNBOUNDED_DEPTH: i32 = 64;
 
 /// Radiance added to the camera hit `sh0` (its emission `emitted + le` is already counted by the
 /// caller): local shading of the camera hit and every mirror bounce, weighted by the product of ks.
-pub(super) fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, c: &mut Counters, mut log: Option<&mut RayLog>) -> Vec3x8 {
+pub(super) fn radiance(
+    scene: &Scene,
+    max_depth: i32,
+    sh0: &SurfaceHit8,
+    c: &mut Counters,
+    mut log: Option<&mut RayLog>,
+) -> Vec3x8 {
     let bounces = if max_depth < 0 { UNBOUNDED_DEPTH } else { max_depth };
     let mut l_out = Vec3x8::ZERO;
     let mut sh = *sh0;
@@ -62,7 +68,13 @@ pub(super) fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, c: &mut
 
 /// Ambient + Blinn-Phong from every point and directional light with shadow rays, on `alive` lanes
 /// (emission excluded); zero elsewhere.
-fn local_shading(scene: &Scene, sh: &SurfaceHit8, alive: Mask8, c: &mut Counters, mut log: Option<&mut RayLog>) -> Vec3x8 {
+fn local_shading(
+    scene: &Scene,
+    sh: &SurfaceHit8,
+    alive: Mask8,
+    c: &mut Counters,
+    mut log: Option<&mut RayLog>,
+) -> Vec3x8 {
     let mut acc = masked(sh.ambient, alive);
     let eps = scene.offset_eps(sh.p);
     let o = sh.n.mul_add(eps, sh.p);

@@ -47,7 +47,15 @@ impl Emitter {
     pub fn triangle(v: [Vec3; 3], radiance: Vec3) -> Self {
         let (ab, ac) = (v[1] - v[0], v[2] - v[0]);
         let cross = ab.cross(ac);
-        Self { a: v[0], ab, ac, radiance, normal: cross.normalize_or_zero(), area: 0.5 * cross.length(), triangle: true }
+        Self {
+            a: v[0],
+            ab,
+            ac,
+            radiance,
+            normal: cross.normalize_or_zero(),
+            area: 0.5 * cross.length(),
+            triangle: true,
+        }
     }
 
     /// Polygon for [`crate::light::polygonal::polygon_phi`], wound so that its right-hand normal is
@@ -249,7 +257,8 @@ impl Emitters {
         let n_quads = list.len();
         list.extend(triangles);
         let powers: Vec<f32> = list.iter().map(Emitter::power).collect();
-        let all = if list.len() == n_quads { Selection::Uniform(n_quads as u32) } else { Selection::by_weight(&powers) };
+        let all =
+            if list.len() == n_quads { Selection::Uniform(n_quads as u32) } else { Selection::by_weight(&powers) };
         let triangles = Selection::by_weight(&powers[n_quads..]);
         Self { list, n_quads, all, triangles }
     }
@@ -461,7 +470,8 @@ mod tests {
 
     #[test]
     fn uniform_choice_x8_matches_scalar_and_inv_pmf() {
-        let quads: Vec<Emitter> = (0..3).map(|i| Emitter::quad(Vec3::X * i as f32, Vec3::X, Vec3::Z, Vec3::ONE)).collect();
+        let quads: Vec<Emitter> =
+            (0..3).map(|i| Emitter::quad(Vec3::X * i as f32, Vec3::X, Vec3::Z, Vec3::ONE)).collect();
         let e = Emitters::new(quads, []);
         let cs = [0.0, 0.1, 0.34, 0.5, 0.66, 0.67, 0.999_99, 0.2];
         let (u, v) = (F8::splat(0.3), F8::splat(0.6));
@@ -493,7 +503,15 @@ mod tests {
             for j in 0..n {
                 let s = e.sample_triangles((i as f32 + 0.5) / n as f32, (j as f32 + 0.37) / n as f32);
                 let (x, y) = (s.y.x, s.y.y);
-                let k = if x > 0.5 { 1 } else if y > 0.5 { 2 } else if x + y < 0.5 { 0 } else { 3 };
+                let k = if x > 0.5 {
+                    1
+                } else if y > 0.5 {
+                    2
+                } else if x + y < 0.5 {
+                    0
+                } else {
+                    3
+                };
                 count[k] += 1.0;
             }
         }

@@ -147,10 +147,7 @@ mod tests {
             let t = xx / (1.0 + xx * xx).sqrt();
             let exact = 4.0 * t * t.atan();
             assert!(((f64::from(phi.y) - exact) / exact).abs() < 2e-5, "s={s} h={h}: {} vs {exact}", phi.y);
-            assert!(
-                phi.x.abs() < 1e-6 * phi.y && phi.z.abs() < 1e-6 * phi.y,
-                "on-axis Phi is along the axis"
-            );
+            assert!(phi.x.abs() < 1e-6 * phi.y && phi.z.abs() < 1e-6 * phi.y, "on-axis Phi is along the axis");
         }
     }
 
@@ -248,8 +245,7 @@ mod tests {
     fn full_hemisphere_limit_is_pi() {
         // A huge light just above the receiver covers almost the whole hemisphere: Phi . n -> pi.
         let big = 1e4f32;
-        let v =
-            quad(Vec3::new(-big, 1.0, -big), Vec3::new(0.0, 0.0, 2.0 * big), Vec3::new(2.0 * big, 0.0, 0.0));
+        let v = quad(Vec3::new(-big, 1.0, -big), Vec3::new(0.0, 0.0, 2.0 * big), Vec3::new(2.0 * big, 0.0, 0.0));
         let phi = polygon_phi(Vec3::ZERO, &v);
         assert!((f64::from(phi.y) - PI).abs() < 1e-3, "{phi:?}");
     }

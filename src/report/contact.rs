@@ -149,7 +149,14 @@ pub fn layout(tiles: &[Tile], columns: usize, title: Option<&str>) -> Sheet {
 
 /// A tile from linear RGB, box-downsampled by `factor` ([`box_downsample`]), encoded with `gamma`
 /// (as the renderer's PNGs) and labelled.
-pub fn tile_from_linear(width: u32, height: u32, linear: &[[f32; 3]], factor: u32, gamma: f32, label: Vec<String>) -> Tile {
+pub fn tile_from_linear(
+    width: u32,
+    height: u32,
+    linear: &[[f32; 3]],
+    factor: u32,
+    gamma: f32,
+    label: Vec<String>,
+) -> Tile {
     let (width, height, small) = box_downsample(width, height, linear, factor);
     let rgb = small.iter().map(|p| p.map(|v| crate::film::to_u8(v, gamma))).collect();
     Tile { width, height, rgb, label }
@@ -200,7 +207,12 @@ mod tests {
     use super::*;
 
     fn tile(w: u32, h: u32, c: [u8; 3], label: &[&str]) -> Tile {
-        Tile { width: w, height: h, rgb: vec![c; (w * h) as usize], label: label.iter().map(|s| s.to_string()).collect() }
+        Tile {
+            width: w,
+            height: h,
+            rgb: vec![c; (w * h) as usize],
+            label: label.iter().map(|s| s.to_string()).collect(),
+        }
     }
 
     #[test]
@@ -219,7 +231,8 @@ mod tests {
 
     #[test]
     fn tiles_land_in_their_cells_and_labels_are_drawn_below() {
-        let tiles = [tile(10, 8, [255, 0, 0], &["A"]), tile(10, 8, [0, 255, 0], &[]), tile(6, 4, [0, 0, 255], &["1", "L"])];
+        let tiles =
+            [tile(10, 8, [255, 0, 0], &["A"]), tile(10, 8, [0, 255, 0], &[]), tile(6, 4, [0, 0, 255], &["1", "L"])];
         let s = layout(&tiles, 2, None);
         let cell_h = 8 + 2 * LINE_H;
         assert_eq!((s.width, s.height), (GAP + 2 * (10 + GAP), GAP + 2 * (cell_h + GAP)));

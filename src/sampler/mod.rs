@@ -856,8 +856,7 @@ impl Radix {
 mod tests {
     use super::*;
 
-    const UNBIASED: [SamplerKind; 3] =
-        [SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Halton];
+    const UNBIASED: [SamplerKind; 3] = [SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Halton];
 
     fn u8_from(f: impl FnMut(usize) -> u32) -> U8 {
         U8::new(std::array::from_fn(f))
@@ -1118,10 +1117,21 @@ mod tests {
                     for k in [0, 1, n / 2, n.saturating_sub(1), n.wrapping_add(3), u32::MAX] {
                         let (x8, y8) = st8.point(k);
                         let (xr, yr) = set.point_x8(pixel, sample, dim, U8::splat(k), seed);
-                        assert_eq!(x8.to_array().map(f32::to_bits), xr.to_array().map(f32::to_bits), "{kind:?} n={n} k={k}");
-                        assert_eq!(y8.to_array().map(f32::to_bits), yr.to_array().map(f32::to_bits), "{kind:?} n={n} k={k}");
+                        assert_eq!(
+                            x8.to_array().map(f32::to_bits),
+                            xr.to_array().map(f32::to_bits),
+                            "{kind:?} n={n} k={k}"
+                        );
+                        assert_eq!(
+                            y8.to_array().map(f32::to_bits),
+                            yr.to_array().map(f32::to_bits),
+                            "{kind:?} n={n} k={k}"
+                        );
                         let (x1, y1) = st1.point(k);
-                        assert_eq!((x1.to_bits(), y1.to_bits()), (x8.to_array()[3].to_bits(), y8.to_array()[3].to_bits()));
+                        assert_eq!(
+                            (x1.to_bits(), y1.to_bits()),
+                            (x8.to_array()[3].to_bits(), y8.to_array()[3].to_bits())
+                        );
                     }
                 }
             }
@@ -1206,8 +1216,7 @@ mod tests {
             }
             for k in 0..n {
                 let [x, y] = point_2d(SamplerKind::GridCenter, 5, 0, 0, k, n, 1);
-                let (ex, ey) =
-                    ((f64::from(k % nx) + 0.5) / f64::from(nx), (f64::from(k / nx) + 0.5) / f64::from(ny));
+                let (ex, ey) = ((f64::from(k % nx) + 0.5) / f64::from(nx), (f64::from(k / nx) + 0.5) / f64::from(ny));
                 // Exact for power-of-two axes, else the centre rounded down to the 2^-24 grid.
                 let tol = 1.0 / f64::from(FIXED_ONE);
                 assert!(f64::from(x) <= ex && ex - f64::from(x) < tol, "n={n} k={k} x={x} vs {ex}");
@@ -1359,15 +1368,12 @@ mod tests {
             var[kind as usize] = v;
         }
         let (rs, rh) = (var[0] / var[1], var[0] / var[3]);
-        println!(
-            "exact {exact:.6}; variance ratio independent/stratified {rs:.2}, independent/halton {rh:.2}"
-        );
+        println!("exact {exact:.6}; variance ratio independent/stratified {rs:.2}, independent/halton {rh:.2}");
         assert!(rs >= 4.0 && rh >= 4.0, "ratios {rs} {rh}");
         // Grid centres: every pixel gives the midpoint rule on the 4 x 4 grid.
-        let midpoint: f64 = (0..16)
-            .map(|k| integrand((f64::from(k % 4) + 0.5) / 4.0, (f64::from(k / 4) + 0.5) / 4.0))
-            .sum::<f64>()
-            / 16.0;
+        let midpoint: f64 =
+            (0..16).map(|k| integrand((f64::from(k % 4) + 0.5) / 4.0, (f64::from(k / 4) + 0.5) / 4.0)).sum::<f64>()
+                / 16.0;
         let (mean, v) = estimate_stats(SamplerKind::GridCenter, n, 50, seed);
         assert!((mean - midpoint).abs() < 1e-12 && v < 1e-24, "{mean} vs {midpoint}");
     }

@@ -138,8 +138,7 @@ fn build_table(t: u32) -> Vec<[u32; 2]> {
                 let high_first = rand24(t, s, 2) & 1 != 0;
                 half + s + if first == high_first { 1 << (2 * c) } else { 0 }
             };
-            pts[index as usize] =
-                [xc << (B - l) | rand24(t, index, 0) >> l, yc << (B - l) | rand24(t, index, 1) >> l];
+            pts[index as usize] = [xc << (B - l) | rand24(t, index, 0) >> l, yc << (B - l) | rand24(t, index, 1) >> l];
         }
     }
     pts
@@ -147,7 +146,9 @@ fn build_table(t: u32) -> Vec<[u32; 2]> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::sobol::tests::{assert_net, assert_x8_matches_scalar, estimate_stats, exact_integral, fixed, random_point};
+    use super::super::sobol::tests::{
+        assert_net, assert_x8_matches_scalar, estimate_stats, exact_integral, fixed, random_point,
+    };
     use super::*;
 
     fn table_point(t: u32, i: u32) -> [f32; 2] {
@@ -187,14 +188,8 @@ mod tests {
                 let (mut sx, mut sy) = (vec![false; 1 << m], vec![false; 1 << m]);
                 for i in 0..1 << m {
                     let [x, y] = table_point(t, i);
-                    assert!(
-                        !std::mem::replace(&mut sx[(fixed(x) >> (24 - m)) as usize], true),
-                        "t {t} m {m} x"
-                    );
-                    assert!(
-                        !std::mem::replace(&mut sy[(fixed(y) >> (24 - m)) as usize], true),
-                        "t {t} m {m} y"
-                    );
+                    assert!(!std::mem::replace(&mut sx[(fixed(x) >> (24 - m)) as usize], true), "t {t} m {m} x");
+                    assert!(!std::mem::replace(&mut sy[(fixed(y) >> (24 - m)) as usize], true), "t {t} m {m} y");
                 }
             }
         }
@@ -223,9 +218,7 @@ mod tests {
 
     #[test]
     fn streams_are_nets_and_in_range() {
-        for (pixel, dim, seed) in
-            [(0, 0, 0), (1, 1, 7), (77, 5, 3), (123_456, 13, u64::MAX), (u32::MAX, 2, 42)]
-        {
+        for (pixel, dim, seed) in [(0, 0, 0), (1, 1, 7), (77, 5, 3), (123_456, 13, u64::MAX), (u32::MAX, 2, 42)] {
             for m in 0..=LOG_POINTS {
                 let n = 1u32 << m;
                 let pts: Vec<_> = (0..n).map(|k| pmj02_2d(pixel, 0, dim, k, n, seed)).collect();

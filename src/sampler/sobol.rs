@@ -73,8 +73,7 @@ fn sobol_owen<L: Words>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) 
 #[inline]
 fn pascal<L: Words>(i: L) -> L {
     let mut e = i;
-    for (s, m) in [(1, 0x5555_5555), (2, 0x3333_3333), (4, 0x0f0f_0f0f), (8, 0x00ff_00ff), (16, 0x0000_ffff)]
-    {
+    for (s, m) in [(1, 0x5555_5555), (2, 0x3333_3333), (4, 0x0f0f_0f0f), (8, 0x00ff_00ff), (16, 0x0000_ffff)] {
         e = e.xor(e.shr(s).and(L::splat(m)));
     }
     e
@@ -148,10 +147,7 @@ pub(super) mod tests {
     /// 24-bit fixed-point value of a coordinate (exact).
     pub(in crate::sampler) fn fixed(x: f32) -> u32 {
         let y = f64::from(x) * 16_777_216.0;
-        assert!(
-            y.fract() == 0.0 && (0.0..16_777_216.0).contains(&y),
-            "{x} is not on the 2^-24 grid in [0, 1)"
-        );
+        assert!(y.fract() == 0.0 && (0.0..16_777_216.0).contains(&y), "{x} is not on the 2^-24 grid in [0, 1)");
         y as u32
     }
 
@@ -188,16 +184,7 @@ pub(super) mod tests {
         let v = direction_numbers();
         assert_eq!(
             &v[..8],
-            &[
-                0x8000_0000,
-                0xc000_0000,
-                0xa000_0000,
-                0xf000_0000,
-                0x8800_0000,
-                0xcc00_0000,
-                0xaa00_0000,
-                0xff00_0000
-            ]
+            &[0x8000_0000, 0xc000_0000, 0xa000_0000, 0xf000_0000, 0x8800_0000, 0xcc00_0000, 0xaa00_0000, 0xff00_0000]
         );
         let reference = |i: u32| (0..32).filter(|&c| i >> c & 1 == 1).fold(0, |acc, c| acc ^ v[c]);
         let mut st = 3u64;
@@ -331,9 +318,7 @@ pub(super) mod tests {
 
     #[test]
     fn nets_after_scrambling() {
-        for (pixel, dim, seed) in
-            [(0, 0, 0), (1, 1, 7), (77, 5, 3), (123_456, 13, u64::MAX), (u32::MAX, 2, 42)]
-        {
+        for (pixel, dim, seed) in [(0, 0, 0), (1, 1, 7), (77, 5, 3), (123_456, 13, u64::MAX), (u32::MAX, 2, 42)] {
             for m in 0..=10 {
                 let n = 1u32 << m;
                 // The first 2^m points of the pixel's sequence, and the n-point sets of samples 1 and 9.
@@ -356,8 +341,7 @@ pub(super) mod tests {
             assert!(base.iter().zip(&other).all(|(a, b)| a != b), "{pixel} {dim} {seed}");
         }
         // First points of many pixels are spread out (no shared unscrambled origin).
-        let mut firsts: Vec<_> =
-            (0..1000).map(|p| sobol_owen_2d(p, 0, 0, 0, 16, 0).map(f32::to_bits)).collect();
+        let mut firsts: Vec<_> = (0..1000).map(|p| sobol_owen_2d(p, 0, 0, 0, 16, 0).map(f32::to_bits)).collect();
         firsts.sort_unstable();
         firsts.dedup();
         assert_eq!(firsts.len(), 1000);
@@ -380,11 +364,7 @@ pub(super) mod tests {
     }
 
     /// Mean and variance over `pixels` of the n-point estimate of [`integrand`] with `point(pixel, k)`.
-    pub(in crate::sampler) fn estimate_stats(
-        n: u32,
-        pixels: u32,
-        point: impl Fn(u32, u32) -> [f32; 2],
-    ) -> (f64, f64) {
+    pub(in crate::sampler) fn estimate_stats(n: u32, pixels: u32, point: impl Fn(u32, u32) -> [f32; 2]) -> (f64, f64) {
         let est: Vec<f64> = (0..pixels)
             .map(|p| {
                 (0..n).map(|k| point(p, k)).map(|[u, v]| integrand(f64::from(u), f64::from(v))).sum::<f64>()

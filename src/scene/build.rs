@@ -51,7 +51,9 @@ impl Camera {
         let aspect = w / h;
         let sx = (x * F8::splat(2.0 / w) - F8::ONE) * F8::splat(aspect);
         let sy = F8::ONE - y * F8::splat(2.0 / h);
-        let d = Vec3x8::splat(self.look * self.plane_dist) + Vec3x8::splat(self.right).scale(sx) + Vec3x8::splat(self.up).scale(sy);
+        let d = Vec3x8::splat(self.look * self.plane_dist)
+            + Vec3x8::splat(self.right).scale(sx)
+            + Vec3x8::splat(self.up).scale(sy);
         d.normalize_or_zero()
     }
 
@@ -159,9 +161,8 @@ impl Scene {
     /// Builds the scene. Quad lights become two triangles each, after the scene's triangles, then
     /// come the emissive triangles (zero-area ones are dropped: they can be neither hit nor sampled).
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
-        let cam_desc = desc
-            .camera
-            .ok_or_else(|| BuildError::Invalid(format!("{}: no camera command", desc.source.display())))?;
+        let cam_desc =
+            desc.camera.ok_or_else(|| BuildError::Invalid(format!("{}: no camera command", desc.source.display())))?;
         let camera = Camera::new(&cam_desc, desc.width, desc.height);
         let mut materials = desc.materials.clone();
         let mut vertices = Vec::with_capacity(desc.triangles.len() * 3 + desc.quad_lights.len() * 4);
@@ -382,7 +383,9 @@ mod tests {
 
     #[test]
     fn similarity_transforms_are_spheres_others_ellipsoids() {
-        let m = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)) * Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.7) * Mat4::from_scale(Vec3::splat(0.25));
+        let m = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0))
+            * Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.7)
+            * Mat4::from_scale(Vec3::splat(0.25));
         let s = as_sphere(&m).unwrap();
         assert!((s - Vec4::new(1.0, 2.0, 3.0, 0.25)).abs().max_element() < 1e-6);
         assert!(as_sphere(&Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0))).is_none());
@@ -391,7 +394,8 @@ mod tests {
 
     #[test]
     fn camera_dirs_x8_match_scalar_per_lane() {
-        let desc = CameraDesc { eye: Vec3::new(0.1, 1.0, 3.0), center: Vec3::new(0.0, 1.0, 0.0), up: Vec3::Y, fovy_deg: 45.0 };
+        let desc =
+            CameraDesc { eye: Vec3::new(0.1, 1.0, 3.0), center: Vec3::new(0.0, 1.0, 0.0), up: Vec3::Y, fovy_deg: 45.0 };
         let cam = Camera::new(&desc, 640, 480);
         let xs = [0.0, 0.5, 639.99, 320.0, 100.25, 7.0, 500.5, 320.5];
         let ys = [0.0, 479.99, 0.5, 240.0, 13.75, 400.0, 99.0, 240.5];

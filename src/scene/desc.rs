@@ -239,7 +239,15 @@ impl SceneDesc {
                 "{:?}",
                 (
                     (&self.output, &self.camera, self.spp, self.gamma.to_bits()),
-                    (self.integrator, self.max_depth, self.light_samples, self.light_stratify, self.nee, self.russian_roulette, self.importance_sampling),
+                    (
+                        self.integrator,
+                        self.max_depth,
+                        self.light_samples,
+                        self.light_stratify,
+                        self.nee,
+                        self.russian_roulette,
+                        self.importance_sampling
+                    ),
                     (&self.materials, &self.spheres, &self.quad_lights, &self.point_lights, &self.directional_lights),
                 )
             ),

@@ -1,5 +1,5 @@
 //! Scene description, parsing and building.
-pub mod desc;
-pub mod parse;
 pub mod build;
+pub mod desc;
 pub mod obj;
+pub mod parse;

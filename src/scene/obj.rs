@@ -201,7 +201,9 @@ pub fn locate_obj_error(text: &str) -> Option<(usize, String)> {
             for (i, a) in args.iter().enumerate() {
                 match a.parse::<f32>() {
                     Ok(v) if v.is_finite() => {}
-                    _ => return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a))),
+                    _ => {
+                        return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)))
+                    }
                 }
             }
             Ok(())
@@ -229,7 +231,9 @@ fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), String> {
         if parts.len() > 3 {
             return Err(format!("face vertex {}: '{}' is not i, i/t, i//n or i/t/n", j + 1, short(a)));
         }
-        for (p, (&s, (n, what))) in parts.iter().zip([(nv, "vertex"), (nt, "texture coordinate"), (nn, "normal")]).enumerate() {
+        for (p, (&s, (n, what))) in
+            parts.iter().zip([(nv, "vertex"), (nt, "texture coordinate"), (nn, "normal")]).enumerate()
+        {
             if s.is_empty() && p > 0 {
                 continue;
             }
@@ -257,9 +261,15 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
                 match a.parse::<f32>() {
                     Ok(v) if v.is_finite() && (!non_negative || v >= 0.0) => {}
                     Ok(_) if non_negative => {
-                        return Err(format!("'{cmd}' argument {}: expected a finite number >= 0, got '{}'", i + 1, short(a)))
+                        return Err(format!(
+                            "'{cmd}' argument {}: expected a finite number >= 0, got '{}'",
+                            i + 1,
+                            short(a)
+                        ))
                     }
-                    _ => return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a))),
+                    _ => {
+                        return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)))
+                    }
                 }
             }
             Ok(())
@@ -336,7 +346,12 @@ pub fn scene_from_obj(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneEr
     let current = whole_scene_material();
     let mut index_of = std::collections::HashMap::new();
     place(&mesh, &current, Ok, &mut desc, &mut |m: Material, d: &mut SceneDesc| {
-        let key: Vec<u32> = [m.diffuse, m.specular, m.emission, m.ambient].iter().flat_map(|v| v.to_array()).chain([m.shininess, m.roughness]).map(f32::to_bits).collect();
+        let key: Vec<u32> = [m.diffuse, m.specular, m.emission, m.ambient]
+            .iter()
+            .flat_map(|v| v.to_array())
+            .chain([m.shininess, m.roughness])
+            .map(f32::to_bits)
+            .collect();
         Ok(*index_of.entry(key).or_insert_with(|| {
             d.materials.push(m);
             d.materials.len() as u32 - 1
@@ -422,7 +437,13 @@ pub fn procedural_mesh(min_triangles: usize) -> ObjMesh {
     quad([Vec3::new(-e, y0, -e), Vec3::new(e, y0, -e), Vec3::new(e, y1 + 0.2, -e), Vec3::new(-e, y1 + 0.2, -e)], 1);
     quad([Vec3::new(-0.5, y1, -0.5), Vec3::new(0.5, y1, -0.5), Vec3::new(0.5, y1, 0.5), Vec3::new(-0.5, y1, 0.5)], 2);
     mesh.materials = vec![
-        MtlMaterial { name: "torus".into(), kd: Some(Vec3::new(0.7, 0.45, 0.3)), ks: Some(Vec3::splat(0.2)), ns: Some(40.0), ke: None },
+        MtlMaterial {
+            name: "torus".into(),
+            kd: Some(Vec3::new(0.7, 0.45, 0.3)),
+            ks: Some(Vec3::splat(0.2)),
+            ns: Some(40.0),
+            ke: None,
+        },
         MtlMaterial { name: "floor".into(), kd: Some(Vec3::splat(0.6)), ks: None, ns: None, ke: None },
         MtlMaterial { name: "light".into(), kd: Some(Vec3::ZERO), ks: None, ns: None, ke: Some(Vec3::splat(20.0)) },
     ];

@@ -87,13 +87,12 @@ impl Limits {
     /// Sets one limit from `NAME=VALUE` (the `--limit` flag); VALUE is a non-negative integer that
     /// must fit the field. Errors name the known limits.
     pub fn set(&mut self, assignment: &str) -> Result<(), String> {
-        let (name, value) = assignment
-            .split_once('=')
-            .ok_or_else(|| format!("--limit `{assignment}`: expected NAME=VALUE, NAME one of {}", Self::NAMES.join(", ")))?;
+        let (name, value) = assignment.split_once('=').ok_or_else(|| {
+            format!("--limit `{assignment}`: expected NAME=VALUE, NAME one of {}", Self::NAMES.join(", "))
+        })?;
         let (name, value) = (name.trim(), value.trim());
-        let v: u64 = value
-            .parse()
-            .map_err(|_| format!("--limit {name}: expected a non-negative integer, got `{value}`"))?;
+        let v: u64 =
+            value.parse().map_err(|_| format!("--limit {name}: expected a non-negative integer, got `{value}`"))?;
         let range = |max: u64| {
             if v <= max {
                 Ok(v)
@@ -534,11 +533,17 @@ impl<'l> Parser<'l> {
         let n = d.triangles.len() + d.emissive_triangles.len() + d.spheres.len() + d.quad_lights.len();
         if n + mesh.faces.len() > self.limits.max_primitives {
             let max = self.limits.max_primitives;
-            return Err(format!("obj '{}': more than {max} primitives and lights ({})", show(name), hint("max_primitives")));
+            return Err(format!(
+                "obj '{}': more than {max} primitives and lights ({})",
+                show(name),
+                hint("max_primitives")
+            ));
         }
         let (matrix, current, lookup) = (self.matrix, self.material, &mut self.material_lookup);
-        obj::place(&mesh, &current, |p| to_world(&matrix, p), &mut self.desc, &mut |m, d| intern_material(lookup, d, &m))
-            .map_err(|e| format!("obj '{}': {e}", show(name)))
+        obj::place(&mesh, &current, |p| to_world(&matrix, p), &mut self.desc, &mut |m, d| {
+            intern_material(lookup, d, &m)
+        })
+        .map_err(|e| format!("obj '{}': {e}", show(name)))
     }
 
     /// Right-multiplies the current matrix: M <- M * x.

@@ -95,11 +95,7 @@ impl Vec3x8 {
     /// Gathers eight scalar vectors into lanes.
     #[inline]
     pub fn from_lanes(v: [Vec3; 8]) -> Self {
-        Self {
-            x: F8::new(v.map(|p| p.x)),
-            y: F8::new(v.map(|p| p.y)),
-            z: F8::new(v.map(|p| p.z)),
-        }
+        Self { x: F8::new(v.map(|p| p.x)), y: F8::new(v.map(|p| p.y)), z: F8::new(v.map(|p| p.z)) }
     }
     /// Lane `i` as a scalar vector.
     #[inline]
@@ -120,11 +116,7 @@ impl Vec3x8 {
     /// Per-lane cross product.
     #[inline]
     pub fn cross(self, o: Self) -> Self {
-        Self {
-            x: self.y * o.z - self.z * o.y,
-            y: self.z * o.x - self.x * o.z,
-            z: self.x * o.y - self.y * o.x,
-        }
+        Self { x: self.y * o.z - self.z * o.y, y: self.z * o.x - self.x * o.z, z: self.x * o.y - self.y * o.x }
     }
     /// Per-lane squared length.
     #[inline]
@@ -253,10 +245,7 @@ pub fn frame_from_normal(n: Vec3) -> (Vec3, Vec3) {
     let sign = 1.0f32.copysign(n.z);
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
-    (
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
+    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
 /// Sets flush-to-zero and denormals-are-zero on the calling thread (lives in `accel`, which holds
