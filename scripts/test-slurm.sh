@@ -54,10 +54,21 @@ if [ ${#need[@]} -gt 0 ]; then
   if [ ! -e /usr/sbin/policy-rc.d ]; then
     printf '#!/bin/sh\nexit 101\n' >/usr/sbin/policy-rc.d && chmod +x /usr/sbin/policy-rc.d && made_policy=1
   fi
-  if ! apt-cache show slurm-wlm >/dev/null 2>&1; then timeout 300 apt-get update -qq; fi
-  DEBIAN_FRONTEND=noninteractive timeout 600 apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null \
-    || { [ -z "$made_policy" ] || rm -f /usr/sbin/policy-rc.d; die "apt-get install ${need[*]} failed"; }
+  aptlog=$(mktemp /tmp/strata-slurm-apt.XXXXXX)
+  update() { timeout 300 apt-get update -qq >>"$aptlog" 2>&1; }
+  apt_install() {
+    DEBIAN_FRONTEND=noninteractive timeout 600 apt-get install -y -qq --no-install-recommends "${need[@]}" >>"$aptlog" 2>&1
+  }
+  updated=''
+  if ! apt-cache show slurm-wlm >/dev/null 2>&1; then update || true; updated=1; fi
+  # Stale package lists (a version gone from the mirror): update once and retry.
+  if ! apt_install && ! { [ -z "$updated" ] && update && apt_install; }; then
+    [ -z "$made_policy" ] || rm -f /usr/sbin/policy-rc.d
+    tail -n 20 "$aptlog" >&2; rm -f "$aptlog"
+    die "apt-get install ${need[*]} failed"
+  fi
   [ -z "$made_policy" ] || rm -f /usr/sbin/policy-rc.d
+  rm -f "$aptlog"
   say "installed in $(( SECONDS - t )) s"
 fi
 
