@@ -9,7 +9,10 @@
 #
 # Tasks are requeued on preemption or node failure and resume from their checkpoint: Slurm's
 # SIGTERM makes strata finish the current pass, write its checkpoint and exit; a SIGKILL loses
-# at most --checkpoint-every seconds. Use absolute paths (tasks run on other nodes).
+# at most CHECKPOINT_EVERY seconds (default 600). Use absolute paths (tasks run on other nodes).
+# Every variable here (and CHECKPOINT_EVERY, QUIET of slurm-part.sbatch) reaches the jobs through
+# --export=ALL. If a task fails, the merge job is cancelled (--kill-on-invalid-dep) rather than
+# left pending. scripts/test-slurm.sh runs this on a one-node Slurm and requeues a task.
 set -euo pipefail
 : "${SCENE:?set SCENE to a .test file (absolute path)}"
 export SCENE SPP=${SPP:-65536} SHARDS=${SHARDS:-64} OUT=${OUT:-$PWD/ref} FLAGS=${FLAGS:-}
@@ -18,6 +21,8 @@ here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$PARTS"
 array=$(sbatch --parsable --export=ALL --array=0-$(( SHARDS - 1 )) --cpus-per-task="${CPUS:-32}" \
     --output="$PARTS/slurm-%A_%a.log" "$here/slurm-part.sbatch")
-merge=$(sbatch --parsable --export=ALL --dependency=afterok:"$array" --output="$PARTS/slurm-merge-%j.log" \
-    "$here/slurm-merge.sbatch")
+array=${array%%;*}  # --parsable prints JOBID;CLUSTER on a multi-cluster setup
+merge=$(sbatch --parsable --export=ALL --dependency=afterok:"$array" --kill-on-invalid-dep=yes \
+    --output="$PARTS/slurm-merge-%j.log" "$here/slurm-merge.sbatch")
+merge=${merge%%;*}
 echo "submitted array $array ($SHARDS parts) and merge $merge -> $OUT.exr"
