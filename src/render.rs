@@ -38,9 +38,17 @@ impl RenderStats {
     }
 }
 
+/// Errors of the render layer.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// the worker pool could not be built (message: rayon's)
+    #[error("{0}")]
+    ThreadPool(#[from] rayon::ThreadPoolBuildError),
+}
+
 /// Builds a rayon pool of `threads` workers (0 = all cores), each with FTZ/DAZ set.
-pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, rayon::ThreadPoolBuildError> {
-    rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, RenderError> {
+    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()?)
 }
 
 /// Renders samples `samples.start..samples.end` of every pixel into `film`, which accumulates:

@@ -154,7 +154,10 @@ pub type DiffuseGgx = (super::Ggx, ());
 /// no material is GGX without the GGX lobe). Under that promise the compiled-out lobes change
 /// nothing, bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Lobes(pub u32);
+pub struct Lobes(
+    /// the [`Lobe::BIT`]s of the lobes present
+    pub u32,
+);
 
 impl Lobes {
     /// Every lobe compiled in: the general kernel, right for any scene.

@@ -8,7 +8,9 @@ use super::*;
 use crate::sampling::chi2::{chi2_test, ggx_core, phong_core, Grid, Rng};
 use crate::sampling::GGX_ALPHA_MIN;
 use crate::simd::mask_from_bools;
+use crate::simd::{Vec3x8, F8};
 use glam::DVec3;
+use glam::Vec3;
 use std::f64::consts::PI;
 
 const STRATEGIES: [ImportanceSampling; 3] =
