@@ -10,7 +10,7 @@ use std::f32::consts::PI;
 /// side for this to be exact).
 pub fn radiance(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
     let mut l_out = Vec3x8::ZERO;
-    let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into());
+    let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)));
     // Quad lights, then emissive triangles (same polygon formula; `Emitter::corners` winds both alike).
     for light in &scene.emitters.list {
         let phi = polygon_phi_x8(sh.p, &light.corners(), shade);

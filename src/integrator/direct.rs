@@ -51,7 +51,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
     let sample_idx = U8::splat(s);
     // Lights shade nothing themselves (black, one-sided emitters).
     sc.shade.clear();
-    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)).into())));
+    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
     sc.eps.clear();
     sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
     for (gi, group) in groups(scene).enumerate() {

@@ -65,7 +65,7 @@ impl ShadowLane {
 /// Pads `v` with `dead` up to a multiple of 8 lanes.
 #[inline]
 fn pad8<T: Copy>(v: &mut Vec<T>, dead: T) {
-    while v.len() % 8 != 0 {
+    while !v.len().is_multiple_of(8) {
         v.push(dead);
     }
 }
@@ -100,7 +100,7 @@ impl Integrator {
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
         let n = self.spp;
         let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-        let k = permute_x8(s, n, U8::splat(key_base) ^ pixel * U8::splat(0x9e37_79b1));
+        let k = permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)));
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
     }
 }
@@ -268,7 +268,7 @@ impl Integrator {
                     if self.russian_roulette {
                         let (u_rr, _) = self.path_point(pixel, s, dims + 3);
                         let q = nb.max_elem().min(F8::ONE);
-                        alive = alive & u_rr.simd_lt(q);
+                        alive &= u_rr.simd_lt(q);
                         nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
                     }
                     if alive.any() {
