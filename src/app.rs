@@ -169,23 +169,12 @@ pub fn parse_camera(s: &str) -> Result<crate::scene::desc::CameraDesc, String> {
 
 /// Integrator name as the format spells it.
 pub fn integrator_name(k: IntegratorKind) -> &'static str {
-    match k {
-        IntegratorKind::RayTracer => "raytracer",
-        IntegratorKind::AnalyticDirect => "analyticdirect",
-        IntegratorKind::Direct => "direct",
-        IntegratorKind::PathTracer => "pathtracer",
-    }
+    k.name()
 }
 
 /// Parses an integrator name.
 pub fn parse_integrator(s: &str) -> Option<IntegratorKind> {
-    Some(match s {
-        "raytracer" => IntegratorKind::RayTracer,
-        "analyticdirect" => IntegratorKind::AnalyticDirect,
-        "direct" => IntegratorKind::Direct,
-        "pathtracer" => IntegratorKind::PathTracer,
-        _ => return None,
-    })
+    IntegratorKind::parse(s)
 }
 
 /// Parses a next-event-estimation mode as the format spells it: off, on or mis.

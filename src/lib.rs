@@ -2,6 +2,7 @@
 pub mod accel;
 pub mod app;
 pub mod bsdf;
+pub mod camera;
 pub mod checkpoint;
 pub mod experiments;
 pub mod film;

@@ -1,14 +1,16 @@
-//! Tiles, threads and accumulation: the only place with threads.
+//! Tiles, threads and accumulation: the only place with threads. (The tile's packets are made in
+//! `camera`, their radiance in `integrator`; this module imports both, neither imports it.)
 //!
 //! The image is cut into 16x16-pixel tiles; a tile is cut into 4x2-pixel packets. Tiles run in
 //! parallel under rayon; each pixel's samples are accumulated in f64 dyadic blocks (see `film`) in
 //! increasing sample order, and every sample value is a pure function of (pixel, sample,
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
+pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
 use crate::film::{combine, leaf_moments, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
-use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
+use crate::simd::Vec3x8;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -16,49 +18,6 @@ use std::time::Instant;
 pub const TILE: u32 = 16;
 /// Pixel samples of a tile traced as one wavefront.
 pub const SAMPLE_BATCH: u32 = 16;
-/// Packet footprint: 4 pixels wide, 2 tall.
-pub const PACKET_W: u32 = 4;
-/// Packet footprint height.
-pub const PACKET_H: u32 = 2;
-
-/// The pixels of one 4x2 packet: linear pixel ids, pixel coordinates and the in-image mask.
-#[derive(Clone, Copy, Debug)]
-pub struct PixelPacket {
-    /// linear pixel index y * width + x (0 for lanes outside the image)
-    pub pixel: U8,
-    /// pixel x
-    pub x: F8,
-    /// pixel y
-    pub y: F8,
-    /// lanes inside the image
-    pub active: Mask8,
-}
-
-impl PixelPacket {
-    /// Packet whose top-left pixel is (x0, y0), clipped to a `width` x `height` image.
-    pub fn new(x0: u32, y0: u32, width: u32, height: u32) -> Self {
-        let mut pix = [0u32; 8];
-        let mut inside = [false; 8];
-        let mut xs = [0u32; 8];
-        let mut ys = [0u32; 8];
-        for i in 0..8u32 {
-            let (x, y) = (x0 + i % PACKET_W, y0 + i / PACKET_W);
-            xs[i as usize] = x;
-            ys[i as usize] = y;
-            if x < width && y < height {
-                inside[i as usize] = true;
-                pix[i as usize] = y * width + x;
-            }
-        }
-        Self {
-            pixel: U8::new(pix),
-            x: u8_to_f8(U8::new(xs)),
-            y: u8_to_f8(U8::new(ys)),
-            active: mask_from_bools(inside),
-        }
-    }
-}
-
 /// What a render produced besides the film.
 #[derive(Clone, Debug, Default)]
 pub struct RenderStats {
@@ -79,9 +38,17 @@ impl RenderStats {
     }
 }
 
+/// Errors of the render layer.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// the worker pool could not be built (message: rayon's)
+    #[error("{0}")]
+    ThreadPool(#[from] rayon::ThreadPoolBuildError),
+}
+
 /// Builds a rayon pool of `threads` workers (0 = all cores), each with FTZ/DAZ set.
-pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, rayon::ThreadPoolBuildError> {
-    rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, RenderError> {
+    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()?)
 }
 
 /// Renders samples `samples.start..samples.end` of every pixel into `film`, which accumulates:
@@ -254,14 +221,6 @@ fn accumulate(
         }
         data[(depth - carries) * tn + j] = acc;
     }
-}
-
-/// The 4x2 packets covering the `tw` x `th` tile at (x0, y0) of a `w` x `h` image, row by row.
-pub fn tile_packets(x0: u32, y0: u32, tw: u32, th: u32, w: u32, h: u32) -> Vec<PixelPacket> {
-    (0..th.div_ceil(PACKET_H))
-        .flat_map(|py| (0..tw.div_ceil(PACKET_W)).map(move |px| (px, py)))
-        .map(|(px, py)| PixelPacket::new(x0 + px * PACKET_W, y0 + py * PACKET_H, w, h))
-        .collect()
 }
 
 #[cfg(test)]

@@ -8,9 +8,11 @@
 //! f_spec = F D / (lambda(wi) lambda(wo)) with no division by a grazing cosine. This equals the format's
 //! expression wherever it is defined (wi.z, wo.z > 0); elsewhere the caller sets f = 0.
 
+use super::{Lobe, Material, Material8};
 use crate::sampling::{
     dot, fmadd, ggx_a2, ggx_a2_x8, ggx_d, ggx_d_x8, mul_add3, normalize_or_zero, sample_ggx_half, sample_ggx_half_x8,
 };
+use crate::scene::desc::BrdfKind;
 use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;
 
@@ -64,4 +66,38 @@ pub(super) fn sample(wo: Vec3, u: [f32; 2], alpha: f32) -> Vec3 {
 pub(super) fn sample_x8(wo: Vec3x8, u: [F8; 2], alpha: F8, active: Mask8) -> Vec3x8 {
     let h = sample_ggx_half_x8(u, alpha, active).0;
     h.scale(F8::splat(2.0) * wo.dot(h)) - wo
+}
+
+/// The GGX microfacet lobe (`brdf ggx`).
+#[derive(Clone, Copy, Debug)]
+pub struct Ggx;
+
+impl Lobe for Ggx {
+    const BIT: u32 = 2;
+    const NAME: &'static str = "ggx";
+    const KIND: BrdfKind = BrdfKind::Ggx;
+    fn used_by(m: &crate::scene::desc::Material) -> bool {
+        // Its Fresnel term makes a lobe even with ks = 0.
+        m.brdf == BrdfKind::Ggx
+    }
+    #[inline]
+    fn eval_pdf(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        lobe(wo, wi, m.ks, m.alpha)
+    }
+    #[inline]
+    fn sample(m: &Material, wo: Vec3, u: [f32; 2]) -> Vec3 {
+        sample(wo, u, m.alpha)
+    }
+    #[inline]
+    fn lanes(m: &Material8) -> Mask8 {
+        m.ggx
+    }
+    #[inline]
+    fn eval_pdf_x8(m: &Material8, wo: Vec3x8, wi: Vec3x8) -> (Vec3x8, F8) {
+        lobe_x8(wo, wi, m.ks, m.alpha)
+    }
+    #[inline]
+    fn sample_x8(m: &Material8, wo: Vec3x8, u: [F8; 2], active: Mask8) -> Vec3x8 {
+        sample_x8(wo, u, m.alpha, active)
+    }
 }

@@ -4,7 +4,9 @@
 //! the uniform hemisphere around r, matching the warp), where IEEE pow(0, 0) = 1 would make it
 //! Lambertian over the whole hemisphere of n.
 
+use super::{Lobe, Material, Material8};
 use crate::sampling::{cos_pow, cos_pow_x8, dot, fmadd, sample_phong_lobe, sample_phong_lobe_x8, INV_2PI};
+use crate::scene::desc::BrdfKind;
 use crate::simd::{frame_from_normal, Frame8, Mask8, Vec3x8, F8};
 use glam::Vec3;
 
@@ -54,4 +56,51 @@ pub(super) fn sample(wo: Vec3, u: [f32; 2], s: f32) -> Vec3 {
 pub(super) fn sample_x8(wo: Vec3x8, u: [F8; 2], s: F8, active: Mask8) -> Vec3x8 {
     let r = mirror_x8(wo);
     Frame8::from_normal(r).to_world(sample_phong_lobe_x8(u, s, active).0)
+}
+
+/// The modified Phong lobe (`brdf phong`, the format's default).
+#[derive(Clone, Copy, Debug)]
+pub struct Phong;
+
+impl Lobe for Phong {
+    const BIT: u32 = 1;
+    const NAME: &'static str = "phong";
+    const KIND: BrdfKind = BrdfKind::Phong;
+    fn used_by(m: &crate::scene::desc::Material) -> bool {
+        m.brdf == BrdfKind::Phong && m.specular != Vec3::ZERO
+    }
+    #[inline]
+    fn eval_pdf(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        lobe(wo, wi, m.ks, m.shininess)
+    }
+    #[inline]
+    fn sample(m: &Material, wo: Vec3, u: [f32; 2]) -> Vec3 {
+        sample(wo, u, m.shininess)
+    }
+    #[inline]
+    fn lanes(m: &Material8) -> Mask8 {
+        !m.ggx
+    }
+    #[inline]
+    fn eval_pdf_x8(m: &Material8, wo: Vec3x8, wi: Vec3x8) -> (Vec3x8, F8) {
+        lobe_x8(wo, wi, m.ks, m.shininess)
+    }
+    #[inline]
+    fn sample_x8(m: &Material8, wo: Vec3x8, u: [F8; 2], active: Mask8) -> Vec3x8 {
+        sample_x8(wo, u, m.shininess, active)
+    }
+}
+
+/// The Phong lobe in world space about the normal `n` (what `direct` evaluates, see
+/// `Material8::eval_world`): ks (s+2)/(2 pi) max(0, r . wi)^s with r the mirror of wo about n.
+/// c^s is taken from 1 - c = sin^2 / (1 + c) with sin^2 = |r x wi|^2, as [`lobe_x8`] does, so a lobe
+/// of s = 1e6 keeps its shape near the mirror direction.
+#[inline]
+pub(super) fn world_x8(n: Vec3x8, wo: Vec3x8, wi: Vec3x8, ks: Vec3x8, s: F8) -> Vec3x8 {
+    let r = n.scale(F8::splat(2.0) * n.dot(wo)) - wo;
+    let c = r.dot(wi);
+    let has_spec = c.simd_gt(F8::ZERO);
+    let pow = cos_pow_x8(c, r.cross(wi).length_squared(), s);
+    let spec = pow * (s + F8::splat(2.0)) * F8::splat(0.5 / std::f32::consts::PI);
+    ks.scale(has_spec.select(spec, F8::ZERO))
 }

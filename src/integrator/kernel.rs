@@ -14,8 +14,36 @@
 
 use crate::bsdf::Lobes;
 use crate::scene::build::Scene;
-use crate::scene::desc::{BrdfKind, ImportanceSampling, IntegratorKind, Nee};
+use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use serde_json::{json, Value};
+
+/// Runs `$body` with the type `$L` set to the compiled [`crate::bsdf::LobeSet`] for `$lobes` (a
+/// [`Lobes`]): a specialized kernel where one is compiled, else the general `AllLobes`. One line
+/// per specialized kernel; a new lobe needs none (scenes using it run the general kernel).
+macro_rules! with_lobe_set {
+    ($lobes:expr, $L:ident => $body:expr) => {{
+        use $crate::bsdf::LobeSet as _;
+        match $lobes.0 {
+            b if b == <$crate::bsdf::Diffuse>::BITS => {
+                type $L = $crate::bsdf::Diffuse;
+                $body
+            }
+            b if b == <$crate::bsdf::DiffusePhong>::BITS => {
+                type $L = $crate::bsdf::DiffusePhong;
+                $body
+            }
+            b if b == <$crate::bsdf::DiffuseGgx>::BITS => {
+                type $L = $crate::bsdf::DiffuseGgx;
+                $body
+            }
+            _ => {
+                type $L = $crate::bsdf::AllLobes;
+                $body
+            }
+        }
+    }};
+}
+pub(crate) use with_lobe_set;
 
 /// Which kernel runs: the general one (every lobe compiled in) or one specialized for the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,13 +67,9 @@ impl Kernel {
         if *self == Self::GENERAL {
             return "general".into();
         }
-        let lobes = match (self.lobes.phong, self.lobes.ggx) {
-            (false, false) => "none",
-            (true, false) => "phong",
-            (false, true) => "ggx",
-            (true, true) => "phong+ggx",
-        };
-        format!("{}<lobes={lobes}>", crate::app::integrator_name(integrator))
+        let names = self.lobes.names();
+        let lobes = if names.is_empty() { "none".to_string() } else { names.join("+") };
+        format!("{}<lobes={lobes}>", integrator.name())
     }
 }
 
@@ -53,14 +77,8 @@ impl Kernel {
 pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, strategy: ImportanceSampling) -> Value {
     let d = &scene.desc;
     let mats = &d.materials;
-    let lobes = Lobes::of(mats);
     let mut materials = vec!["diffuse"];
-    if lobes.phong {
-        materials.push("phong");
-    }
-    if mats.iter().any(|m| m.brdf == BrdfKind::Ggx) {
-        materials.push("ggx");
-    }
+    materials.extend(Lobes::of(mats).names());
     if mats.iter().any(|m| m.emission != glam::Vec3::ZERO) {
         materials.push("emission");
     }
@@ -85,7 +103,7 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         },
         "point_lights": d.point_lights.len(),
         "directional_lights": d.directional_lights.len(),
-        "integrator": crate::app::integrator_name(kind),
+        "integrator": kind.name(),
         "nee": if path { Some(format!("{nee:?}").to_lowercase()) } else { None },
         "russian_roulette": path && rr,
         "importance_sampling": if path { Some(format!("{strategy:?}").to_lowercase()) } else { None },

@@ -15,10 +15,11 @@
 //! pixel's spp samples whose strata are shuffled per (pixel, dimension), so dimensions are
 //! stratified independently of one another.
 
-use super::{masked, Counters, Integrator, RayKind, RayLog};
+use super::context::{masked, TileCtx};
+use super::direct::material;
+use super::{Integrator, RayKind};
 use crate::accel::{Hits8, Ray8, RayHit8};
-use crate::bsdf::Material8;
-use crate::render::PixelPacket;
+use crate::bsdf::LobeSet;
 use crate::sampler::permute_x8;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
@@ -64,7 +65,7 @@ impl ShadowLane {
 /// Pads `v` with `dead` up to a multiple of 8 lanes.
 #[inline]
 fn pad8<T: Copy>(v: &mut Vec<T>, dead: T) {
-    while v.len() % 8 != 0 {
+    while !v.len().is_multiple_of(8) {
         v.push(dead);
     }
 }
@@ -99,24 +100,27 @@ impl Integrator {
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
         let n = self.spp;
         let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-        let k = permute_x8(s, n, U8::splat(key_base) ^ pixel * U8::splat(0x9e37_79b1));
+        let k = permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)));
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
     }
+}
 
-    /// Radiance of pixel samples `samples` for each packet of `pks` (a tile) by path tracing, into
-    /// `out` (sample-major: `out[si * pks.len() + p]`). All paths of all these samples form one
-    /// wavefront, so packets stay full even when Russian roulette thins the paths out.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn path_tile<const PHONG: bool, const GGX: bool>(
-        &self,
-        scene: &Scene,
-        pks: &[PixelPacket],
-        samples: std::ops::Range<u32>,
-        out: &mut Vec<Vec3x8>,
-        sc: &mut PathScratch,
-        c: &mut Counters,
-        mut log: Option<&mut RayLog>,
-    ) {
+/// Radiance of pixel samples `samples` for each packet of the tile by path tracing, into `out`
+/// (sample-major: `out[si * pks.len() + p]`). All paths of all these samples form one wavefront,
+/// so packets stay full even when Russian roulette thins the paths out.
+pub(super) fn tile<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    samples: std::ops::Range<u32>,
+    out: &mut Vec<Vec3x8>,
+) {
+    it.path_tile::<L>(ctx, samples, out)
+}
+
+impl Integrator {
+    fn path_tile<L: LobeSet>(&self, ctx: &mut TileCtx, samples: std::ops::Range<u32>, out: &mut Vec<Vec3x8>) {
+        let TileCtx { scene, camera, pks, tracer, scratch } = ctx;
+        let sc = &mut scratch.path;
         let nee = self.nee;
         let n_lights = scene.emitters.len() as u32;
         let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
@@ -127,7 +131,7 @@ impl Integrator {
         // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks).
         for (si, s) in samples.enumerate() {
             for (p, pk) in pks.iter().enumerate() {
-                let (org, dir) = self.camera_rays(scene, pk, s);
+                let (org, dir) = camera.rays(pk, s);
                 let (inside, pix, dirs) = (mask_to_bools(pk.active), pk.pixel.to_array(), dir.to_lanes());
                 for i in 0..8 {
                     let slot = ((si * pks.len() + p) * 8 + i) as u32;
@@ -154,16 +158,9 @@ impl Integrator {
                 let (org, dir, active) = soa_rays(chunk);
                 let mut rh = RayHit8::default();
                 let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
-                if let Some(l) = log.as_deref_mut() {
-                    if v == 1 { &mut l.camera } else { &mut l.bounce }.push((rh, active));
-                }
                 sc.rh.push((rh, active));
             }
-            for (rh, active) in sc.rh.iter_mut() {
-                let traced = scene.accel.intersect8(rh, v == 1, *active);
-                c.packet(if v == 1 { RayKind::Camera } else { RayKind::Bounce }, traced);
-                *active = traced;
-            }
+            tracer.intersect_all(&mut sc.rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
             sc.next.clear();
             sc.shadow_lanes.clear();
             sc.shadow.clear();
@@ -207,7 +204,7 @@ impl Integrator {
                 }
                 let frame = Frame8::from_normal(sh.n);
                 let wo = frame.to_local(sh.wo);
-                let mat = Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx };
+                let mat = material(&sh);
                 let eps = scene.offset_eps(sh.p);
                 let o = sh.n.mul_add(eps, sh.p);
                 // (light choice, lobe choice): drawn only where one of them is used (several
@@ -232,7 +229,7 @@ impl Integrator {
                     let cos_l = -ln.dot(wi);
                     let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
                     if lit.any() {
-                        let (f, pdf_b) = mat.eval_pdf_k::<PHONG, GGX>(self.strategy, wo, frame.to_local(wi), lit);
+                        let (f, pdf_b) = mat.eval_pdf_k::<L>(self.strategy, wo, frame.to_local(wi), lit);
                         // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
                         let g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
                         let w_light = if nee == Nee::Mis {
@@ -263,7 +260,7 @@ impl Integrator {
                 // Continue the path: sample the BSDF, then Russian roulette.
                 if bounce_here {
                     let u2 = self.path_point(pixel, s, dims + 2);
-                    let (wi_l, pdf, f) = mat.sample_k::<PHONG, GGX>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
+                    let (wi_l, pdf, f) = mat.sample_k::<L>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
                     let cos = wi_l.z;
                     let ok = shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO);
                     let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
@@ -271,7 +268,7 @@ impl Integrator {
                     if self.russian_roulette {
                         let (u_rr, _) = self.path_point(pixel, s, dims + 3);
                         let q = nb.max_elem().min(F8::ONE);
-                        alive = alive & u_rr.simd_lt(q);
+                        alive &= u_rr.simd_lt(q);
                         nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
                     }
                     if alive.any() {
@@ -307,12 +304,8 @@ impl Integrator {
                 sc.shadow_contrib.push(Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].contrib)));
                 sc.shadow_slots.push(std::array::from_fn(|i| chunk[i].slot));
             }
-            if let Some(l) = log.as_deref_mut() {
-                l.shadow.extend_from_slice(&sc.shadow);
-            }
             for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
-                let occluded = scene.accel.occluded8(ray, *lit);
-                c.packet(RayKind::Shadow, *lit);
+                let occluded = tracer.occluded(ray, *lit);
                 let visible = *lit & !occluded;
                 add_lanes(&mut sc.radiance, &sc.shadow_slots[j], masked(sc.shadow_contrib[j], visible));
             }

@@ -7,7 +7,8 @@
 //! `maxdepth` is the maximum number of mirror bounces after the camera hit (negative: 64).
 //! Quad lights, if any, are visible emitters only (`le`). Packets keep dead lanes masked.
 
-use super::{masked, Counters, RayKind, RayLog};
+use super::context::{masked, Tracer};
+use super::RayKind;
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::simd::{Mask8, Vec3x8, F8};
@@ -17,13 +18,7 @@ const UNBOUNDED_DEPTH: i32 = 64;
 
 /// Radiance added to the camera hit `sh0` (its emission `emitted + le` is already counted by the
 /// caller): local shading of the camera hit and every mirror bounce, weighted by the product of ks.
-pub(super) fn radiance(
-    scene: &Scene,
-    max_depth: i32,
-    sh0: &SurfaceHit8,
-    c: &mut Counters,
-    mut log: Option<&mut RayLog>,
-) -> Vec3x8 {
+pub fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, tracer: &mut Tracer) -> Vec3x8 {
     let bounces = if max_depth < 0 { UNBOUNDED_DEPTH } else { max_depth };
     let mut l_out = Vec3x8::ZERO;
     let mut sh = *sh0;
@@ -34,7 +29,7 @@ pub(super) fn radiance(
         if alive.none() {
             break;
         }
-        let mut local = local_shading(scene, &sh, alive, c, log.as_deref_mut());
+        let mut local = local_shading(scene, &sh, alive, tracer);
         if depth > 0 {
             local += sh.emitted + sh.le;
         }
@@ -52,14 +47,8 @@ pub(super) fn radiance(
         let org = sh.n.mul_add(scene.offset_eps(sh.p), sh.p);
         let mut rh = RayHit8::default();
         let active = rh.ray.set(org, r, F8::ZERO, F8::splat(f32::INFINITY), alive);
-        if let Some(l) = log.as_deref_mut() {
-            l.bounce.push((rh, active));
-        }
-        let traced = scene.accel.intersect8(&mut rh, false, active);
-        c.packet(RayKind::Bounce, traced);
-        let dir = Vec3x8::new(F8::new(rh.ray.dir_x), F8::new(rh.ray.dir_y), F8::new(rh.ray.dir_z));
-        let org = Vec3x8::new(F8::new(rh.ray.org_x), F8::new(rh.ray.org_y), F8::new(rh.ray.org_z));
-        sh = scene.gather(org, dir, &Hits8::from_rayhit(&rh, traced));
+        let traced = tracer.intersect(&mut rh, RayKind::Bounce, active);
+        sh = scene.gather(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(&rh, traced));
         alive &= sh.valid;
         depth += 1;
     }
@@ -68,28 +57,18 @@ pub(super) fn radiance(
 
 /// Ambient + Blinn-Phong from every point and directional light with shadow rays, on `alive` lanes
 /// (emission excluded); zero elsewhere.
-fn local_shading(
-    scene: &Scene,
-    sh: &SurfaceHit8,
-    alive: Mask8,
-    c: &mut Counters,
-    mut log: Option<&mut RayLog>,
-) -> Vec3x8 {
+fn local_shading(scene: &Scene, sh: &SurfaceHit8, alive: Mask8, tracer: &mut Tracer) -> Vec3x8 {
     let mut acc = masked(sh.ambient, alive);
     let eps = scene.offset_eps(sh.p);
     let o = sh.n.mul_add(eps, sh.p);
-    let mut shade = |wi: Vec3x8, to: Vec3x8, tfar: F8, colour: Vec3x8, c: &mut Counters, log: Option<&mut RayLog>| {
+    let mut shade = |wi: Vec3x8, to: Vec3x8, tfar: F8, colour: Vec3x8, tracer: &mut Tracer| {
         let f = blinn_phong(sh, wi, alive);
         let lit = alive & f.max_elem().simd_gt(F8::ZERO);
         if lit.none() {
             return;
         }
         let (mut ray, lit) = Ray8::new(o, to, F8::ZERO, tfar, lit);
-        if let Some(l) = log {
-            l.shadow.push((ray, lit));
-        }
-        let occluded = scene.accel.occluded8(&mut ray, lit);
-        c.packet(RayKind::Shadow, lit);
+        let occluded = tracer.occluded(&mut ray, lit);
         acc += masked(f.mul_elem(colour), lit & !occluded);
     };
     for pl in &scene.desc.point_lights {
@@ -103,11 +82,11 @@ fn local_shading(
         // Shadow ray from the offset point to the light, stopping just short of it.
         let inv_d = alive.select(F8::ONE / d, F8::ZERO);
         let tfar = F8::ONE - eps * inv_d;
-        shade(wi, pos - o, tfar, colour, c, log.as_deref_mut());
+        shade(wi, pos - o, tfar, colour, tracer);
     }
     for dl in &scene.desc.directional_lights {
         let wi = Vec3x8::splat(dl.direction.normalize_or_zero());
-        shade(wi, wi, F8::splat(f32::INFINITY), Vec3x8::splat(dl.color), c, log.as_deref_mut());
+        shade(wi, wi, F8::splat(f32::INFINITY), Vec3x8::splat(dl.color), tracer);
     }
     acc
 }

@@ -79,6 +79,23 @@ impl Emitter {
         let (u, v) = if self.triangle && u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
         self.ac.mul_add(Vec3::splat(v), self.ab.mul_add(Vec3::splat(u), self.a))
     }
+
+    /// Eight points of this light for unit-square samples `(u, v)` (uniform in area), as a light
+    /// sample of this light alone (`inv_pmf` 1, index 0); bit-identical to the gathered
+    /// [`Emitters::sample_x8`] of the same light.
+    pub fn sample_x8(&self, u: F8, v: F8) -> LightSample8 {
+        let fold = if self.triangle { (u + v).simd_gt(F8::ONE) } else { Mask8::splat(0.0) };
+        let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
+        let s = Vec3x8::splat;
+        LightSample8 {
+            y: s(self.ac).mul_add(v, s(self.ab).mul_add(u, s(self.a))),
+            normal: s(self.normal),
+            radiance: s(self.radiance),
+            area: F8::splat(self.area),
+            inv_pmf: F8::ONE,
+            light: U8::splat(0),
+        }
+    }
 }
 
 /// How one of `n` items is chosen from a uniform number: uniformly, or by a discrete CDF.
@@ -293,7 +310,7 @@ impl Emitters {
     pub fn sample_x8(&self, u_choice: F8, u: F8, v: F8, active: Mask8) -> LightSample8 {
         if let [e] = self.list.as_slice() {
             // One light: nothing to choose (1/pmf = 1 either way) and nothing to gather.
-            return Self::place_one_x8(e, u, v);
+            return e.sample_x8(u, v);
         }
         let (idx, inv_pmf, _) = self.all.pick_x8(u_choice, active);
         self.place_x8(idx, inv_pmf, u, v)
@@ -321,21 +338,6 @@ impl Emitters {
     fn place(&self, i: u32, inv_pmf: f32, u: f32, v: f32) -> LightSample {
         let e = &self.list[i as usize];
         LightSample { y: e.point(u, v), normal: e.normal, radiance: e.radiance, area: e.area, inv_pmf, light: i }
-    }
-
-    /// [`Emitters::place_x8`] for a scene whose only light is `e`, splatted (bit-identical).
-    fn place_one_x8(e: &Emitter, u: F8, v: F8) -> LightSample8 {
-        let fold = if e.triangle { (u + v).simd_gt(F8::ONE) } else { Mask8::splat(0.0) };
-        let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
-        let s = Vec3x8::splat;
-        LightSample8 {
-            y: s(e.ac).mul_add(v, s(e.ab).mul_add(u, s(e.a))),
-            normal: s(e.normal),
-            radiance: s(e.radiance),
-            area: F8::splat(e.area),
-            inv_pmf: F8::ONE,
-            light: U8::splat(0),
-        }
     }
 
     fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {

@@ -22,6 +22,27 @@ pub enum IntegratorKind {
     PathTracer,
 }
 
+impl IntegratorKind {
+    /// Every integrator with its name as the format spells it (`integrator NAME`, `--integrator`):
+    /// the one place the names are written.
+    pub const NAMES: [(&'static str, IntegratorKind); 4] = [
+        ("raytracer", IntegratorKind::RayTracer),
+        ("analyticdirect", IntegratorKind::AnalyticDirect),
+        ("direct", IntegratorKind::Direct),
+        ("pathtracer", IntegratorKind::PathTracer),
+    ];
+
+    /// Name as the format spells it.
+    pub fn name(self) -> &'static str {
+        Self::NAMES.iter().find(|(_, k)| *k == self).map_or("", |(n, _)| n)
+    }
+
+    /// The integrator named `s` (exact spelling).
+    pub fn parse(s: &str) -> Option<Self> {
+        Self::NAMES.iter().find(|(n, _)| *n == s).map(|&(_, k)| k)
+    }
+}
+
 /// `nexteventestimation off|on|mis`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Nee {

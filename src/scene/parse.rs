@@ -399,14 +399,7 @@ impl<'l> Parser<'l> {
                 }
                 self.attenuation = Vec3::from_array(c);
             }
-            "integrator" => {
-                self.desc.integrator = a.keyword(&[
-                    ("raytracer", IntegratorKind::RayTracer),
-                    ("analyticdirect", IntegratorKind::AnalyticDirect),
-                    ("direct", IntegratorKind::Direct),
-                    ("pathtracer", IntegratorKind::PathTracer),
-                ])?
-            }
+            "integrator" => self.desc.integrator = a.keyword(&IntegratorKind::NAMES)?,
             "lightsamples" => {
                 let max = limits.max_light_samples.into();
                 self.desc.light_samples = a.int_in(1, max, "max_light_samples")? as u32;

@@ -1,0 +1,224 @@
+//! [`Material`] and [`Material8`]: the diffuse term plus the specular lobe of each material under the
+//! format's strategies, evaluated and sampled in the local shading frame (see the `bsdf` module docs).
+//! The specular lobes come from a [`LobeSet`]; scalar code and the `eval_pdf`/`sample` entry points
+//! use [`AllLobes`], kernels the set compiled for the scene (`*_k::<L>`).
+
+use super::lobe::{AllLobes, LobeSet};
+use super::{diffuse, phong, BrdfKind, ImportanceSampling, Phong};
+use crate::sampling::{fmadd, sample_uniform_hemisphere, sample_uniform_hemisphere_x8};
+use crate::sampling::{uniform_hemisphere_pdf, uniform_hemisphere_pdf_x8};
+use crate::simd::{and_mask, Mask8, Vec3x8, F8};
+use glam::Vec3;
+
+/// BRDF parameters of one surface: RGB reflectances kd (diffuse) and ks (specular), Phong exponent
+/// `shininess`, GGX `alpha` (used as is, clamped below at `sampling::GGX_ALPHA_MIN`), and the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// diffuse reflectance kd
+    pub kd: Vec3,
+    /// specular reflectance ks (Phong lobe weight, GGX Fresnel at normal incidence)
+    pub ks: Vec3,
+    /// Phong exponent s >= 0
+    pub shininess: f32,
+    /// GGX roughness alpha
+    pub alpha: f32,
+    /// BRDF model
+    pub kind: BrdfKind,
+}
+
+impl From<&crate::scene::desc::Material> for Material {
+    fn from(m: &crate::scene::desc::Material) -> Self {
+        Self { kd: m.diffuse, ks: m.specular, shininess: m.shininess, alpha: m.roughness, kind: m.brdf }
+    }
+}
+
+impl Material {
+    /// Probability t of picking the specular lobe under `importancesampling brdf` (see module docs).
+    #[inline]
+    pub fn specular_probability(&self) -> f32 {
+        let (d, s) = (self.kd.x + self.kd.y + self.kd.z, self.ks.x + self.ks.y + self.ks.z);
+        let t = if d + s > 0.0 { s / (d + s) } else { 0.0 };
+        if self.kind == BrdfKind::Ggx {
+            t.max(0.25)
+        } else {
+            t
+        }
+    }
+
+    /// f(wo, wi) (RGB, per steradian) and the pdf of wi per unit solid angle under `strategy`; local
+    /// shading frame. What an NEE/MIS light sample needs in one call.
+    #[inline]
+    pub fn eval_pdf(&self, strategy: ImportanceSampling, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
+        let (fs, ps) = AllLobes::eval_pdf(self, wo, wi);
+        let f = if wo.z > 0.0 && wi.z > 0.0 { diffuse::eval_plus(self.kd, fs) } else { Vec3::ZERO };
+        let pdf = match strategy {
+            ImportanceSampling::Hemisphere => uniform_hemisphere_pdf(wi),
+            ImportanceSampling::Cosine => diffuse::pdf(wi),
+            ImportanceSampling::Brdf => {
+                let t = self.specular_probability();
+                fmadd(t, ps, (1.0 - t) * diffuse::pdf(wi))
+            }
+        };
+        (f, pdf)
+    }
+
+    /// f(wo, wi), RGB per steradian, local shading frame (0 unless both are above the horizon).
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        self.eval_pdf(ImportanceSampling::Hemisphere, wo, wi).0
+    }
+
+    /// Density per unit solid angle with which `sample(strategy, wo, ..)` draws wi; local shading frame.
+    #[inline]
+    pub fn pdf(&self, strategy: ImportanceSampling, wo: Vec3, wi: Vec3) -> f32 {
+        self.eval_pdf(strategy, wo, wi).1
+    }
+
+    /// Draws wi for `strategy` from u in [0,1]^2 and, for the BRDF mixture, `u_lobe` in [0,1) picking
+    /// the lobe; returns (wi, pdf per unit solid angle, f(wo, wi) RGB), local shading frame. wi is a
+    /// finite unit vector; pdf 0 marks a sample to drop; f is 0 below the horizon.
+    #[inline]
+    pub fn sample(&self, strategy: ImportanceSampling, wo: Vec3, u: [f32; 2], u_lobe: f32) -> (Vec3, f32, Vec3) {
+        let wi = match strategy {
+            ImportanceSampling::Hemisphere => sample_uniform_hemisphere(u).0,
+            ImportanceSampling::Cosine => diffuse::sample(u),
+            ImportanceSampling::Brdf if u_lobe < self.specular_probability() => {
+                AllLobes::sample(self, wo, u).unwrap_or_else(|| diffuse::sample(u))
+            }
+            ImportanceSampling::Brdf => diffuse::sample(u),
+        };
+        let (f, pdf) = self.eval_pdf(strategy, wo, wi);
+        (wi, pdf, f)
+    }
+}
+
+/// Eight materials, one per lane, in the local shading frame of each lane: kd, ks (RGB), shininess,
+/// alpha, and `ggx` set in the lanes whose model is GGX (the others are Phong).
+#[derive(Clone, Copy, Debug)]
+pub struct Material8 {
+    /// diffuse reflectance kd per lane
+    pub kd: Vec3x8,
+    /// specular reflectance ks per lane
+    pub ks: Vec3x8,
+    /// Phong exponent per lane
+    pub shininess: F8,
+    /// GGX alpha per lane
+    pub alpha: F8,
+    /// lanes using GGX (all-ones) rather than Phong (all-zeros)
+    pub ggx: Mask8,
+}
+
+impl Material8 {
+    /// Gathers eight scalar materials into lanes.
+    pub fn from_lanes(m: [Material; 8]) -> Self {
+        Self {
+            kd: Vec3x8::from_lanes(m.map(|m| m.kd)),
+            ks: Vec3x8::from_lanes(m.map(|m| m.ks)),
+            shininess: F8::new(m.map(|m| m.shininess)),
+            alpha: F8::new(m.map(|m| m.alpha)),
+            ggx: crate::simd::mask_from_bools(m.map(|m| m.kind == BrdfKind::Ggx)),
+        }
+    }
+
+    /// Eight-lane [`Material::specular_probability`].
+    #[inline]
+    pub fn specular_probability(&self) -> F8 {
+        let (d, s) = (self.kd.x + self.kd.y + self.kd.z, self.ks.x + self.ks.y + self.ks.z);
+        let t = (d + s).simd_gt(F8::ZERO).select(s / (d + s), F8::ZERO);
+        self.ggx.select(t.max(F8::splat(0.25)), t)
+    }
+
+    /// Eight-lane [`Material::eval_pdf`].
+    #[inline]
+    pub fn eval_pdf(&self, strategy: ImportanceSampling, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> (Vec3x8, F8) {
+        self.eval_pdf_k::<AllLobes>(strategy, wo, wi, active)
+    }
+
+    /// [`Material8::eval_pdf`] compiled for the lobe set `L` a scene has: bit-identical to it on
+    /// lanes that satisfy the [`super::Lobes`] promise of `L`. Only the lobes present among the active
+    /// lanes are evaluated.
+    #[inline]
+    pub fn eval_pdf_k<L: LobeSet>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        wi: Vec3x8,
+        active: Mask8,
+    ) -> (Vec3x8, F8) {
+        let (fs, ps) = L::eval_pdf_x8(self, wo, wi, active, (Vec3x8::ZERO, F8::ZERO));
+        let up = active & wo.z.simd_gt(F8::ZERO) & wi.z.simd_gt(F8::ZERO);
+        let f = Vec3x8::select(up, diffuse::eval_plus_x8(self.kd, fs), Vec3x8::ZERO);
+        let pdf = match strategy {
+            ImportanceSampling::Hemisphere => uniform_hemisphere_pdf_x8(wi, active),
+            ImportanceSampling::Cosine => diffuse::pdf_x8(wi, active),
+            ImportanceSampling::Brdf => {
+                let t = self.specular_probability();
+                and_mask(t.mul_add(ps, (F8::ONE - t) * diffuse::pdf_x8(wi, active)), active)
+            }
+        };
+        (f, pdf)
+    }
+
+    /// Eight-lane [`Material::eval`].
+    #[inline]
+    pub fn eval(&self, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
+        self.eval_pdf(ImportanceSampling::Hemisphere, wo, wi, active).0
+    }
+
+    /// Eight-lane [`Material::pdf`].
+    #[inline]
+    pub fn pdf(&self, strategy: ImportanceSampling, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> F8 {
+        self.eval_pdf(strategy, wo, wi, active).1
+    }
+
+    /// Eight-lane [`Material::sample`]: (wi, pdf, f) per lane.
+    #[inline]
+    pub fn sample(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        u: [F8; 2],
+        u_lobe: F8,
+        active: Mask8,
+    ) -> (Vec3x8, F8, Vec3x8) {
+        self.sample_k::<AllLobes>(strategy, wo, u, u_lobe, active)
+    }
+
+    /// [`Material8::sample`] compiled for the lobe set `L` a scene has: bit-identical to it on lanes
+    /// that satisfy the [`super::Lobes`] promise of `L`.
+    #[inline]
+    pub fn sample_k<L: LobeSet>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        u: [F8; 2],
+        u_lobe: F8,
+        active: Mask8,
+    ) -> (Vec3x8, F8, Vec3x8) {
+        let wi = match strategy {
+            ImportanceSampling::Hemisphere => sample_uniform_hemisphere_x8(u, active).0,
+            ImportanceSampling::Cosine => diffuse::sample_x8(u, active),
+            ImportanceSampling::Brdf => {
+                let spec = active & u_lobe.simd_lt(self.specular_probability());
+                L::sample_x8(self, wo, u, spec, diffuse::sample_x8(u, active & !spec))
+            }
+        };
+        let (f, pdf) = self.eval_pdf_k::<L>(strategy, wo, wi, active);
+        (wi, pdf, f)
+    }
+
+    /// f(wo, wi) in world space about the shading normal `n` (unit vectors, wo towards the viewer):
+    /// kd/pi plus, when `L` has the Phong lobe and some lane has ks > 0, the Phong lobe about the
+    /// world mirror direction on every lane; zero on inactive lanes. This is `direct`'s BRDF (hw2's
+    /// materials are Phong; the horizon test is the caller's, from its cosines). It equals
+    /// [`Material8::eval`] up to rounding (the frame change); it is kept in world space because
+    /// `direct`'s images are defined by it bit for bit.
+    #[inline]
+    pub fn eval_world<L: LobeSet>(&self, n: Vec3x8, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
+        let mut f = diffuse::eval_world_x8(self.kd);
+        if L::has::<Phong>() && self.ks.max_elem().simd_gt(F8::ZERO).any() {
+            f += phong::world_x8(n, wo, wi, self.ks, self.shininess);
+        }
+        Vec3x8::select(active, f, Vec3x8::ZERO)
+    }
+}

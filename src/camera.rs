@@ -1,0 +1,82 @@
+//! Camera rays of a tile: the pixels of one 4x2 packet ([`PixelPacket`]), the packets covering a
+//! tile ([`tile_packets`]), and [`Camera`], which turns a packet and a pixel sample index into
+//! primary rays (pixel jitter from the pixel sampler, then the scene's pinhole lens).
+//!
+//! Layer: above `scene` and `sampler`, below `integrator` and `render` (both import it).
+
+use crate::sampler::PointSet;
+use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
+
+/// Sampler dimension of the camera (pixel) jitter.
+pub const DIM_CAMERA: u32 = 0;
+/// Packet footprint: 4 pixels wide, 2 tall.
+pub const PACKET_W: u32 = 4;
+/// Packet footprint height.
+pub const PACKET_H: u32 = 2;
+
+/// The pixels of one 4x2 packet: linear pixel ids, pixel coordinates and the in-image mask.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelPacket {
+    /// linear pixel index y * width + x (0 for lanes outside the image)
+    pub pixel: U8,
+    /// pixel x
+    pub x: F8,
+    /// pixel y
+    pub y: F8,
+    /// lanes inside the image
+    pub active: Mask8,
+}
+
+impl PixelPacket {
+    /// Packet whose top-left pixel is (x0, y0), clipped to a `width` x `height` image.
+    pub fn new(x0: u32, y0: u32, width: u32, height: u32) -> Self {
+        let mut pix = [0u32; 8];
+        let mut inside = [false; 8];
+        let mut xs = [0u32; 8];
+        let mut ys = [0u32; 8];
+        for i in 0..8u32 {
+            let (x, y) = (x0 + i % PACKET_W, y0 + i / PACKET_W);
+            xs[i as usize] = x;
+            ys[i as usize] = y;
+            if x < width && y < height {
+                inside[i as usize] = true;
+                pix[i as usize] = y * width + x;
+            }
+        }
+        Self {
+            pixel: U8::new(pix),
+            x: u8_to_f8(U8::new(xs)),
+            y: u8_to_f8(U8::new(ys)),
+            active: mask_from_bools(inside),
+        }
+    }
+}
+
+/// The 4x2 packets covering the `tw` x `th` tile at (x0, y0) of a `w` x `h` image, row by row.
+pub fn tile_packets(x0: u32, y0: u32, tw: u32, th: u32, w: u32, h: u32) -> Vec<PixelPacket> {
+    (0..th.div_ceil(PACKET_H))
+        .flat_map(|py| (0..tw.div_ceil(PACKET_W)).map(move |px| (px, py)))
+        .map(|(px, py)| PixelPacket::new(x0 + px * PACKET_W, y0 + py * PACKET_H, w, h))
+        .collect()
+}
+
+/// Primary ray generation: the scene's pinhole lens with the pixel jitter of a pixel sampler.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera<'a> {
+    /// the scene's pinhole camera
+    pub lens: &'a crate::scene::build::Camera,
+    /// pixel sample layout (over the spp samples of a pixel)
+    pub pixel_set: &'a PointSet,
+    /// base seed
+    pub seed: u64,
+}
+
+impl Camera<'_> {
+    /// Camera rays of packet `pk` for pixel sample `s`: origins and unit directions.
+    #[inline]
+    pub fn rays(&self, pk: &PixelPacket, s: u32) -> (Vec3x8, Vec3x8) {
+        let (jx, jy) = self.pixel_set.point_x8(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(s), self.seed);
+        let dir = self.lens.dirs8(pk.x + jx, pk.y + jy);
+        (Vec3x8::splat(self.lens.eye), dir)
+    }
+}

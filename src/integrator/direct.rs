@@ -1,0 +1,131 @@
+//! `direct` (hw2): direct lighting from every area light by light sampling with shadow rays.
+//!
+//! The emitters are visited in one loop, one sampling group at a time: each quad light is its own
+//! group (sampler dimension `DIM_LIGHT_BASE + index`, a point uniform in area), and the emissive
+//! triangles form one more group after the quads (dimension `DIM_LIGHT_BASE + #quads`; each sample
+//! picks a triangle by power and a point on it, see `light::emitters`). Each group adds the mean
+//! over the `lightsamples` samples of L f cos(th_i) cos(th_l) / (d^2 pdf_area) where the shadow ray
+//! is clear. A quad group's radiance and area are constant, so they scale its sum once at the end.
+//! f is `bsdf::Material8::eval_world`, the world-space form of the path tracer's material code.
+
+use super::context::{masked, Scratch, TileCtx, Tracer};
+use super::{Integrator, DIM_LIGHT_BASE};
+use crate::accel::Ray8;
+use crate::bsdf::{LobeSet, Material8};
+use crate::light::emitters::{Emitter, LightSample8};
+use crate::scene::build::{Scene, SurfaceHit8};
+use crate::simd::{Mask8, Vec3x8, F8, U8};
+
+/// One sampling group of `direct`.
+#[derive(Clone, Copy)]
+enum Group<'a> {
+    /// one quad light
+    Quad(&'a Emitter),
+    /// all emissive triangles, chosen by power
+    Triangles,
+}
+
+impl Group<'_> {
+    /// A point on the group's light(s) for the unit-square sample (u, v).
+    #[inline]
+    fn sample(self, scene: &Scene, u: F8, v: F8, active: Mask8) -> LightSample8 {
+        match self {
+            Group::Quad(e) => e.sample_x8(u, v),
+            Group::Triangles => scene.emitters.sample_triangles_x8(u, v, active),
+        }
+    }
+}
+
+/// The groups of `scene` in sampler-dimension order: the quad lights, then the triangles if any.
+fn groups(scene: &Scene) -> impl Iterator<Item = Group<'_>> {
+    let quads = scene.emitters.list[..scene.emitters.n_quads].iter().map(Group::Quad);
+    quads.chain((scene.emitters.n_triangles() > 0).then_some(Group::Triangles))
+}
+
+/// Adds direct lighting at the camera hits of the tile (`ctx.scratch.hits`) for pixel sample `s`
+/// to `out`.
+pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
+    let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
+    let n_light = it.light_set.n();
+    let inv_n = F8::splat(1.0 / n_light as f32);
+    let sample_idx = U8::splat(s);
+    // Lights shade nothing themselves (black, one-sided emitters).
+    sc.shade.clear();
+    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
+    sc.eps.clear();
+    sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
+    for (gi, group) in groups(scene).enumerate() {
+        let dim = DIM_LIGHT_BASE + gi as u32;
+        sc.acc.clear();
+        sc.acc.resize(pks.len(), Vec3x8::ZERO);
+        sc.streams.clear();
+        sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
+        for k in 0..n_light {
+            sc.shadow.clear();
+            sc.contrib.clear();
+            sc.owner.clear();
+            for i in 0..pks.len() {
+                let (sh, shade) = (&sc.hits[i], sc.shade[i]);
+                if shade.none() {
+                    continue;
+                }
+                let (u, v) = sc.streams[i].point(k);
+                let ls = group.sample(scene, u, v, shade);
+                let to = ls.y - sh.p;
+                let d2 = to.length_squared();
+                let inv_d = F8::ONE / d2.sqrt();
+                let wi = to.scale(inv_d);
+                let cos_i = sh.n.dot(wi);
+                let cos_l = -ls.normal.dot(wi);
+                let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                if lit.none() {
+                    continue;
+                }
+                // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
+                let f = material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit);
+                let g = cos_i * cos_l * inv_d * inv_d;
+                sc.contrib.push(match group {
+                    Group::Quad(_) => f.scale(g),
+                    Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
+                });
+                // Shadow packet from the offset point towards the light sample, stopping short.
+                let o = sh.n.mul_add(sc.eps[i], sh.p);
+                let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
+                let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
+                sc.shadow.push((ray, lit));
+                sc.owner.push(i as u32);
+            }
+            // A quad's sum is scaled once below; the triangles' terms are complete.
+            let Scratch { shadow, contrib, owner, acc, .. } = &mut **sc;
+            let target = if let Group::Quad(_) = group { &mut acc[..] } else { &mut *out };
+            trace_shadow_batch(tracer, shadow, contrib, owner, target);
+        }
+        if let Group::Quad(light) = group {
+            let scale = Vec3x8::splat(light.radiance).scale(inv_n * F8::splat(light.area));
+            for (o, acc) in out.iter_mut().zip(&sc.acc) {
+                *o += acc.mul_elem(scale);
+            }
+        }
+    }
+}
+
+/// The material of a hit record.
+#[inline]
+pub(super) fn material(sh: &SurfaceHit8) -> Material8 {
+    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx }
+}
+
+/// Traces a batch of shadow packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the
+/// lanes of packet j whose shadow ray reached the light.
+fn trace_shadow_batch(
+    tracer: &mut Tracer,
+    shadow: &mut [(Ray8, Mask8)],
+    contrib: &[Vec3x8],
+    owner: &[u32],
+    acc: &mut [Vec3x8],
+) {
+    for (j, (ray, lit)) in shadow.iter_mut().enumerate() {
+        let occluded = tracer.occluded(ray, *lit);
+        acc[owner[j] as usize] += masked(contrib[j], *lit & !occluded);
+    }
+}
