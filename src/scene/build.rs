@@ -134,27 +134,14 @@ pub struct Scene {
 }
 
 /// Errors building a scene.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum BuildError {
     /// Embree refused something.
-    Accel(accel::AccelError),
+    #[error("{0}")]
+    Accel(#[from] accel::AccelError),
     /// The scene lacks something the renderer needs.
+    #[error("{0}")]
     Invalid(String),
-}
-
-impl std::fmt::Display for BuildError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            BuildError::Accel(e) => write!(f, "{e}"),
-            BuildError::Invalid(s) => write!(f, "{s}"),
-        }
-    }
-}
-impl std::error::Error for BuildError {}
-impl From<accel::AccelError> for BuildError {
-    fn from(e: accel::AccelError) -> Self {
-        BuildError::Accel(e)
-    }
 }
 
 impl Scene {
