@@ -62,7 +62,7 @@ pub struct Hit8 {
 
 /// Ray and hit of 8 rays, Embree 4.4 `RTCRayHit8` layout (672 bytes).
 #[repr(C, align(32))]
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct RayHit8 {
     /// rays
     pub ray: Ray8,
@@ -140,12 +140,6 @@ impl Default for Hit8 {
             inst_id: [[INVALID_ID; 8]],
             inst_prim_id: [[INVALID_ID; 8]],
         }
-    }
-}
-
-impl Default for RayHit8 {
-    fn default() -> Self {
-        Self { ray: Ray8::default(), hit: Hit8::default() }
     }
 }
 

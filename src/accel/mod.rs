@@ -13,6 +13,7 @@
 //!   whose primitive i is the unit sphere under that map (no instancing; f64 object-space
 //!   intersection, accurate at extreme scales; slower than sphere points);
 //! - geometries from [`GEOM_FIRST_INSTANCE`] on: instances (hits report `inst_id`).
+//!
 //! Geometry kinds must be added in this order; a kind may be skipped.
 //!
 //! Files: `ffi.rs` the packet structs with their layout asserts and the query arguments;

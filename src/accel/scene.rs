@@ -15,6 +15,8 @@ pub struct SceneBuilder<'d> {
     device: &'d Device,
     scene: sys::RTCScene,
     children: Vec<sys::RTCScene>,
+    // Boxed: Embree holds a pointer to each Vec (its header), which must not move as this Vec grows.
+    #[allow(clippy::vec_box)]
     user_data: Vec<Box<Vec<Ellipsoid>>>,
     next_id: u32,
     quality: sys::RTCBuildQuality,
@@ -25,6 +27,7 @@ pub struct Scene {
     raw: sys::RTCScene,
     children: Vec<sys::RTCScene>,
     // Read by the ellipsoid callbacks; dropped after `raw` is released (see Drop).
+    #[allow(clippy::vec_box)]
     _user_data: Vec<Box<Vec<Ellipsoid>>>,
 }
 

@@ -47,7 +47,7 @@ impl Ellipsoid {
         let oo: [f64; 3] = std::array::from_fn(|i| m[i][0] * o[0] + m[i][1] * o[1] + m[i][2] * o[2] + m[i][3]);
         let dd: [f64; 3] = std::array::from_fn(|i| m[i][0] * d[0] + m[i][1] * d[1] + m[i][2] * d[2]);
         let a = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             return None;
         }
         // Numerically robust form: the discriminant from the distance of the closest approach.

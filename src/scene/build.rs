@@ -356,7 +356,7 @@ fn as_sphere(m: &Mat4) -> Option<Vec4> {
     let l = Mat3::from_mat4(*m);
     let g = l.transpose() * l; // = r^2 I for a similarity
     let r2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
-    if !(r2 > 0.0) || !r2.is_finite() {
+    if r2.is_nan() || r2 <= 0.0 || !r2.is_finite() {
         return None;
     }
     let off = (g - Mat3::from_diagonal(Vec3::splat(r2))).to_cols_array().iter().fold(0f32, |a, v| a.max(v.abs()));
