@@ -35,7 +35,7 @@ fn scenes() -> Vec<(&'static str, RenderOptions)> {
 }
 
 fn kernels(c: &mut Criterion) {
-    strata::simd::set_ftz_daz();
+    strata::accel::set_ftz_daz();
     let pool = strata::render::thread_pool(1).unwrap();
     let mut table = Vec::new();
     for (name, opts) in scenes() {

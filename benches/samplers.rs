@@ -175,7 +175,7 @@ fn techniques() -> Vec<(&'static str, String, RenderOptions, u32)> {
 }
 
 fn equal_time(c: &mut Criterion) {
-    strata::simd::set_ftz_daz();
+    strata::accel::set_ftz_daz();
     let pool = strata::render::thread_pool(1).unwrap();
     let techs = techniques();
     let prepared: Vec<_> = techs

@@ -53,7 +53,7 @@ fn scenes() -> Vec<(String, RenderOptions)> {
 }
 
 fn throughput(c: &mut Criterion) {
-    strata::simd::set_ftz_daz();
+    strata::accel::set_ftz_daz();
     let pool = strata::render::thread_pool(1).unwrap();
     let mut table = Vec::new();
     for (name, opts) in scenes() {

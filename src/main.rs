@@ -233,7 +233,7 @@ impl RenderArgs {
 
 /// Checks one `--limit NAME=VALUE` (the assignment is applied again in [`limits_of`]).
 fn parse_limit(s: &str) -> Result<String, String> {
-    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string())
+    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string()).map_err(|e| e.to_string())
 }
 
 /// The default limits with every (already checked) `--limit` applied in order.

@@ -48,7 +48,7 @@ pub struct RayRates {
 /// Renders samples `0..spp` single-threaded and times it, then replays every packet the renderer
 /// traced through Embree alone and times that. FTZ/DAZ are set on the calling thread for both.
 pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
-    crate::simd::set_ftz_daz();
+    crate::accel::set_ftz_daz();
     let pool = render::thread_pool(1).expect("one-thread pool");
     // The packets the renderer traces, logged, for the replays through Embree alone.
     let log = log_rays(scene, integrator, spp);

@@ -48,7 +48,7 @@ pub enum RenderError {
 
 /// Builds a rayon pool of `threads` workers (0 = all cores), each with FTZ/DAZ set.
 pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, RenderError> {
-    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::simd::set_ftz_daz()).build()?)
+    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).start_handler(|_| crate::accel::set_ftz_daz()).build()?)
 }
 
 /// Renders samples `samples.start..samples.end` of every pixel into `film`, which accumulates:

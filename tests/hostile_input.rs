@@ -352,10 +352,10 @@ fn resource_caps_name_the_limit_and_how_to_raise_it() {
         assert!(parse(text, &raised).is_ok(), "{text:?} after --limit {name}=1000");
     }
     let mut l = Limits::default();
-    assert!(l.set("max_spp").unwrap_err().contains("NAME=VALUE"));
-    assert!(l.set("max_sppp=3").unwrap_err().contains("max_spp"), "unknown names list the known ones");
-    assert!(l.set("max_spp=-1").unwrap_err().contains("non-negative integer"));
-    assert!(l.set("max_side=4294967296").unwrap_err().contains("at most 4294967295"));
+    assert!(l.set("max_spp").unwrap_err().to_string().contains("NAME=VALUE"));
+    assert!(l.set("max_sppp=3").unwrap_err().to_string().contains("max_spp"), "unknown names list the known ones");
+    assert!(l.set("max_spp=-1").unwrap_err().to_string().contains("non-negative integer"));
+    assert!(l.set("max_side=4294967296").unwrap_err().to_string().contains("at most 4294967295"));
 }
 
 /// The CLI's `--limit` raises the caps of the scene file and of the `--spp` / `--size` /

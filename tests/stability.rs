@@ -41,7 +41,7 @@ fn render(o: &RenderOptions) -> Img {
 
 /// Block means and their variances, blocks of `b` x `b` pixels (the image must tile exactly).
 fn blocks(img: &Img, b: usize) -> Vec<([f64; 3], [f64; 3])> {
-    assert!(img.w % b == 0 && img.h % b == 0);
+    assert!(img.w.is_multiple_of(b) && img.h.is_multiple_of(b));
     let n = (b * b) as f64;
     let mut out = vec![];
     for by in 0..img.h / b {

@@ -134,27 +134,14 @@ pub struct Scene {
 }
 
 /// Errors building a scene.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum BuildError {
     /// Embree refused something.
-    Accel(accel::AccelError),
+    #[error("{0}")]
+    Accel(#[from] accel::AccelError),
     /// The scene lacks something the renderer needs.
+    #[error("{0}")]
     Invalid(String),
-}
-
-impl std::fmt::Display for BuildError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            BuildError::Accel(e) => write!(f, "{e}"),
-            BuildError::Invalid(s) => write!(f, "{s}"),
-        }
-    }
-}
-impl std::error::Error for BuildError {}
-impl From<accel::AccelError> for BuildError {
-    fn from(e: accel::AccelError) -> Self {
-        BuildError::Accel(e)
-    }
 }
 
 impl Scene {
@@ -369,7 +356,7 @@ fn as_sphere(m: &Mat4) -> Option<Vec4> {
     let l = Mat3::from_mat4(*m);
     let g = l.transpose() * l; // = r^2 I for a similarity
     let r2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
-    if !(r2 > 0.0) || !r2.is_finite() {
+    if r2.is_nan() || r2 <= 0.0 || !r2.is_finite() {
         return None;
     }
     let off = (g - Mat3::from_diagonal(Vec3::splat(r2))).to_cols_array().iter().fold(0f32, |a, v| a.max(v.abs()));

@@ -1,5 +1,7 @@
 //! Scene description, parsing and building.
 pub mod build;
 pub mod desc;
+pub mod error;
+pub mod limits;
 pub mod obj;
 pub mod parse;

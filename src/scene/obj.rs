@@ -20,7 +20,8 @@
 //! Nothing here panics on bad input (a panic inside `tobj` would be caught and reported).
 
 use crate::scene::desc::{CameraDesc, ImportanceSampling, IntegratorKind, Material, Nee, SceneDesc};
-use crate::scene::parse::{Limits, SceneError};
+use crate::scene::error::{LineError, SceneError};
+use crate::scene::limits::Limits;
 use glam::Vec3;
 use std::cell::RefCell;
 use std::io::Write;
@@ -84,7 +85,7 @@ pub fn bounds(points: impl Iterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
 }
 
 fn err(file: &Path, line: usize, message: impl Into<String>) -> SceneError {
-    SceneError { file: file.to_path_buf(), line, message: message.into() }
+    SceneError::new(file, line, message)
 }
 
 /// Loads `path` and its material libraries (relative to its directory).
@@ -193,16 +194,18 @@ fn commands(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
 pub fn locate_obj_error(text: &str) -> Option<(usize, String)> {
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     for (line, cmd, args) in commands(text) {
-        let floats = |min: usize, max: usize, what: &str| -> Result<(), String> {
+        let floats = |min: usize, max: usize, what: &str| -> Result<(), LineError> {
             if args.len() < min || args.len() > max {
                 let want = if min == max { format!("{min}") } else { format!("{min} to {max}") };
-                return Err(format!("'{cmd}' expects {want} numbers ({what}), got {}", args.len()));
+                return Err(format!("'{cmd}' expects {want} numbers ({what}), got {}", args.len()).into());
             }
             for (i, a) in args.iter().enumerate() {
                 match a.parse::<f32>() {
                     Ok(v) if v.is_finite() => {}
                     _ => {
-                        return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)))
+                        return Err(
+                            format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)).into()
+                        )
                     }
                 }
             }
@@ -216,20 +219,20 @@ pub fn locate_obj_error(text: &str) -> Option<(usize, String)> {
             _ => Ok(()),
         };
         if let Err(m) = r {
-            return Some((line, m));
+            return Some((line, m.0));
         }
     }
     None
 }
 
-fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), String> {
+fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), LineError> {
     if args.len() < 3 {
-        return Err(format!("face 'f' needs at least 3 vertices, got {}", args.len()));
+        return Err(format!("face 'f' needs at least 3 vertices, got {}", args.len()).into());
     }
     for (j, a) in args.iter().enumerate() {
         let parts: Vec<&str> = a.split('/').collect();
         if parts.len() > 3 {
-            return Err(format!("face vertex {}: '{}' is not i, i/t, i//n or i/t/n", j + 1, short(a)));
+            return Err(format!("face vertex {}: '{}' is not i, i/t, i//n or i/t/n", j + 1, short(a)).into());
         }
         for (p, (&s, (n, what))) in
             parts.iter().zip([(nv, "vertex"), (nt, "texture coordinate"), (nn, "normal")]).enumerate()
@@ -240,7 +243,7 @@ fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), String> {
             let i: i64 = s.parse().map_err(|_| format!("face vertex {}: '{}' is not an index", j + 1, short(a)))?;
             let ok = if i > 0 { i <= n } else { i < 0 && -i <= n };
             if !ok {
-                return Err(format!("face vertex {}: {what} index {i} out of range ({n} defined so far)", j + 1));
+                return Err(format!("face vertex {}: {what} index {i} out of range ({n} defined so far)", j + 1).into());
             }
         }
     }
@@ -253,9 +256,11 @@ fn face(args: &[&str], nv: i64, nt: i64, nn: i64) -> Result<(), String> {
 pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
     let mut seen_newmtl = false;
     for (line, cmd, args) in commands(text) {
-        let numbers = |n: usize, non_negative: bool| -> Result<(), String> {
+        let numbers = |n: usize, non_negative: bool| -> Result<(), LineError> {
             if args.len() != n {
-                return Err(format!("'{cmd}' expects {n} number{}, got {}", if n == 1 { "" } else { "s" }, args.len()));
+                return Err(
+                    format!("'{cmd}' expects {n} number{}, got {}", if n == 1 { "" } else { "s" }, args.len()).into()
+                );
             }
             for (i, a) in args.iter().enumerate() {
                 match a.parse::<f32>() {
@@ -265,10 +270,13 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
                             "'{cmd}' argument {}: expected a finite number >= 0, got '{}'",
                             i + 1,
                             short(a)
-                        ))
+                        )
+                        .into())
                     }
                     _ => {
-                        return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)))
+                        return Err(
+                            format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)).into()
+                        )
                     }
                 }
             }
@@ -278,13 +286,13 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
             "newmtl" => {
                 seen_newmtl = true;
                 if args.is_empty() {
-                    Err("'newmtl' expects a material name".to_string())
+                    Err("'newmtl' expects a material name".into())
                 } else {
                     Ok(())
                 }
             }
             "Ka" | "Kd" | "Ks" | "Ke" | "Tf" | "Ns" | "Ni" | "d" | "Tr" if !seen_newmtl => {
-                Err(format!("'{cmd}' before any 'newmtl'"))
+                Err(format!("'{cmd}' before any 'newmtl'").into())
             }
             "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => numbers(3, true),
             "Ns" => numbers(1, true),
@@ -292,7 +300,7 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
             _ => Ok(()),
         };
         if let Err(m) = r {
-            return Some((line, m));
+            return Some((line, m.0));
         }
     }
     None
@@ -357,7 +365,7 @@ pub fn scene_from_obj(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneEr
             d.materials.len() as u32 - 1
         }))
     })
-    .map_err(|m| err(path, 0, m))?;
+    .map_err(|m| m.at(path, 0))?;
     Ok(desc)
 }
 
@@ -366,10 +374,10 @@ pub fn scene_from_obj(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneEr
 pub fn place(
     mesh: &ObjMesh,
     current: &Material,
-    to_world: impl Fn(Vec3) -> Result<Vec3, String>,
+    to_world: impl Fn(Vec3) -> Result<Vec3, LineError>,
     desc: &mut SceneDesc,
-    intern: &mut dyn FnMut(Material, &mut SceneDesc) -> Result<u32, String>,
-) -> Result<(), String> {
+    intern: &mut dyn FnMut(Material, &mut SceneDesc) -> Result<u32, LineError>,
+) -> Result<(), LineError> {
     use crate::scene::desc::{EmissiveTriangleDesc, TriangleDesc};
     // One resolved material index per MTL material (and one for "none"), computed on first use.
     let mut resolved: Vec<Option<u32>> = vec![None; mesh.materials.len() + 1];

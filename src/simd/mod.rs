@@ -248,10 +248,6 @@ pub fn frame_from_normal(n: Vec3) -> (Vec3, Vec3) {
     (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
-/// Sets flush-to-zero and denormals-are-zero on the calling thread (lives in `accel`, which holds
-/// all of strata's `unsafe`).
-pub use crate::accel::set_ftz_daz;
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,136 @@
+//! Tests of the Embree layer: FFI layouts (canaries), lane masks, shadow intervals, error reporting.
+
+use super::*;
+use crate::simd::{mask_all, mask_to_bools};
+use crate::simd::{Vec3x8, F8};
+use embree4_sys as sys;
+use glam::{Mat4, Vec3, Vec4};
+
+#[repr(C, align(32))]
+struct Canaried<T> {
+    value: T,
+    canary: [u32; 64],
+}
+const CANARY: u32 = 0xDEAD_BEEF;
+
+fn build(dev: &Device, with_instance: bool) -> Scene {
+    let mut b = SceneBuilder::new(dev).unwrap();
+    // A quad at z = 5 spanning [-1,1]^2, two triangles.
+    let v =
+        [Vec3::new(-1.0, -1.0, 5.0), Vec3::new(1.0, -1.0, 5.0), Vec3::new(1.0, 1.0, 5.0), Vec3::new(-1.0, 1.0, 5.0)];
+    b.add_triangles(&v, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    // A sphere point of radius 0.5 at (3, 0, 5); a user-geometry sphere of radius 0.5 at
+    // (3, 3, 5) and an ellipsoid (0.5, 0.25, 0.5) at (0, 3, 5).
+    b.add_spheres(&[Vec4::new(3.0, 0.0, 5.0, 0.5)]).unwrap();
+    let sphere = Mat4::from_translation(Vec3::new(3.0, 3.0, 5.0)) * Mat4::from_scale(Vec3::splat(0.5));
+    let ellipsoid = Mat4::from_translation(Vec3::new(0.0, 3.0, 5.0)) * Mat4::from_scale(Vec3::new(0.5, 0.25, 0.5));
+    b.add_ellipsoids(&[sphere, ellipsoid]).unwrap();
+    if with_instance {
+        // The quad again, instanced: scaled by 0.5 and moved to (-3, 0, 0) (so at z = 2.5).
+        let m = Mat4::from_translation(Vec3::new(-3.0, 0.0, 0.0)) * Mat4::from_scale(Vec3::splat(0.5));
+        assert_eq!(b.add_mesh_instance(&v, &[[0, 1, 2], [0, 2, 3]], &m).unwrap(), GEOM_FIRST_INSTANCE);
+    }
+    let s = b.commit().unwrap();
+    dev.take_errors().unwrap();
+    s
+}
+
+fn packet(xs: [f32; 8], ys: [f32; 8]) -> (Vec3x8, Vec3x8) {
+    let org = Vec3x8::new(F8::new(xs), F8::new(ys), F8::ZERO);
+    (org, Vec3x8::splat(Vec3::Z))
+}
+
+/// Embree 4.4 writes instPrimID after the 4.2-era hit struct: canary words after our structs
+/// must survive hits on plain and instanced geometry, for intersect and occluded.
+#[test]
+fn abi_canaries_survive_plain_and_instanced_hits() {
+    let dev = Device::new().unwrap();
+    let scene = build(&dev, true);
+    let xs = [0.0, 3.0, 3.0, 0.0, -3.0, -3.1, 10.0, 0.0];
+    let ys = [0.0, 3.0, 0.0, 3.1, 0.0, 0.05, 0.0, -0.9];
+    let (org, dir) = packet(xs, ys);
+    let mut c = Canaried { value: RayHit8::default(), canary: [CANARY; 64] };
+    c.value.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
+    let traced = scene.intersect8(&mut c.value, false, mask_all());
+    assert!(c.canary.iter().all(|&w| w == CANARY), "Embree wrote past RayHit8");
+    let h = Hits8::from_rayhit(&c.value, traced);
+    assert_eq!(mask_to_bools(h.hit), [true, true, true, true, true, true, false, true]);
+    let geom = h.geom.to_array();
+    let inst = h.inst.to_array();
+    assert_eq!([geom[0], geom[7]], [GEOM_TRIANGLES; 2]);
+    assert_eq!(geom[2], GEOM_SPHERES);
+    assert_eq!([geom[1], geom[3]], [GEOM_ELLIPSOIDS; 2]);
+    assert_eq!([h.prim.to_array()[1], h.prim.to_array()[3]], [0, 1]);
+    assert_eq!(&inst[4..6], &[GEOM_FIRST_INSTANCE; 2]);
+    assert_eq!(&geom[4..6], &[0, 0]);
+    assert_eq!(inst[0], INVALID_ID);
+    let t = h.t.to_array();
+    assert!((t[0] - 5.0).abs() < 1e-5);
+    assert!((t[2] - 4.5).abs() < 1e-5, "sphere point front at z = 4.5: {}", t[2]);
+    assert!((t[1] - 4.5).abs() < 1e-5, "user sphere front at z = 4.5: {}", t[1]);
+    // ellipsoid at (0, 3): z half-axis 0.5; at y offset 0.1 of a 0.25 half-axis, z = 5 - 0.5 sqrt(1 - 0.16).
+    assert!((t[3] - (5.0 - 0.5 * 0.84f32.sqrt())).abs() < 1e-5, "ellipsoid: {}", t[3]);
+    assert!((t[4] - 2.5).abs() < 1e-5, "instanced quad at z = 2.5: {}", t[4]);
+    // The 4.4-only field lands inside our struct: Embree writes it (0 for a plain instance hit)
+    // over the INVALID_ID that intersect8 put there.
+    assert_eq!(c.value.hit.inst_prim_id[0][4], 0);
+
+    let mut r = Canaried { value: Ray8::default(), canary: [CANARY; 64] };
+    r.value.set(org, dir, F8::ZERO, F8::splat(100.0), mask_all());
+    let occ = scene.occluded8(&mut r.value, mask_all());
+    assert!(r.canary.iter().all(|&w| w == CANARY), "Embree wrote past Ray8");
+    assert_eq!(mask_to_bools(occ), [true, true, true, true, true, true, false, true]);
+    dev.take_errors().unwrap();
+}
+
+#[test]
+fn inactive_and_nan_lanes_are_not_traced() {
+    let dev = Device::new().unwrap();
+    let scene = build(&dev, false);
+    let mut xs = [0.0; 8];
+    xs[3] = f32::NAN;
+    let (org, dir) = packet(xs, [0.0; 8]);
+    let mut rh = RayHit8::default();
+    let active = crate::simd::mask_first(6);
+    rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
+    // A NaN smuggled in after set() must still be dropped by intersect8.
+    rh.ray.org_x[3] = f32::NAN;
+    let traced = scene.intersect8(&mut rh, true, active);
+    assert_eq!(mask_to_bools(traced), [true, true, true, false, true, true, false, false]);
+    let h = Hits8::from_rayhit(&rh, traced);
+    assert_eq!(mask_to_bools(h.hit), [true, true, true, false, true, true, false, false]);
+    assert!(h.t.to_array()[..3].iter().all(|t| (t - 5.0).abs() < 1e-5));
+    dev.take_errors().unwrap();
+}
+
+#[test]
+fn tfar_limits_shadow_rays() {
+    let dev = Device::new().unwrap();
+    let scene = build(&dev, false);
+    let (org, dir) = packet([0.0; 8], [0.0; 8]);
+    let mut r = Ray8::default();
+    let tf = F8::new([4.9, 5.1, 4.9, 5.1, 100.0, 0.1, 4.99, 5.01]);
+    r.set(org, dir, F8::ZERO, tf, mask_all());
+    let occ = scene.occluded8(&mut r, mask_all());
+    assert_eq!(mask_to_bools(occ), [false, true, false, true, true, false, false, true]);
+}
+
+#[test]
+fn embree_errors_become_rust_errors() {
+    let dev = Device::new().unwrap();
+    let mut b = SceneBuilder::new(&dev).unwrap();
+    let err = b.add_triangles(&[Vec3::ZERO], &[[0, 1, 2]]).unwrap_err();
+    assert!(err.0.contains("out of range"), "{err}");
+    dev.take_errors().unwrap();
+    // Setting a buffer type a triangle mesh does not have is an Embree error, reported through
+    // the callback and turned into an Err.
+    // SAFETY: a fresh geometry of a live device, given an invalid buffer on purpose, released.
+    unsafe {
+        let g = sys::rtcNewGeometry(dev.raw, sys::RTCGeometryType::TRIANGLE);
+        sys::rtcSetNewGeometryBuffer(g, sys::RTCBufferType::GRID, 0, sys::RTCFormat::UINT3, 12, 1);
+        sys::rtcReleaseGeometry(g);
+    }
+    let err = dev.take_errors().unwrap_err();
+    assert!(!err.0.is_empty(), "{err}");
+    dev.take_errors().unwrap();
+}

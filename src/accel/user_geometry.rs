@@ -1,0 +1,157 @@
+//! The ellipsoid user geometry: the unit sphere under any invertible affine map, intersected in f64
+//! object space one lane at a time by Embree's callbacks (bounds, intersect, occluded).
+
+use super::ffi::RayQueryContext;
+use embree4_sys as sys;
+use glam::Mat4;
+use std::ffi::c_void;
+
+/// One ellipsoid: the unit sphere under an affine map, stored as the world-to-object map in f64.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Ellipsoid {
+    /// world-to-object linear part (row-major 3x3) and translation
+    inv: [[f64; 4]; 3],
+    lower: [f32; 3],
+    upper: [f32; 3],
+}
+
+impl Ellipsoid {
+    /// The unit sphere under `m`, or None if `m` is singular.
+    pub(super) fn new(m: &Mat4) -> Option<Self> {
+        let md = glam::DMat4::from_cols_array(&m.to_cols_array().map(f64::from));
+        let det = md.determinant();
+        if !det.is_finite() || det.abs() < 1e-300 {
+            return None;
+        }
+        let inv = md.inverse();
+        let r = |i: usize| {
+            let row = inv.row(i);
+            [row.x, row.y, row.z, row.w]
+        };
+        // Bounds of the image of the unit ball: centre +- the row norms of the linear part.
+        let (mut lower, mut upper) = ([0f32; 3], [0f32; 3]);
+        for i in 0..3 {
+            let row = md.row(i);
+            let ext = (row.x * row.x + row.y * row.y + row.z * row.z).sqrt() * (1.0 + 1e-6);
+            lower[i] = (row.w - ext) as f32;
+            upper[i] = (row.w + ext) as f32;
+        }
+        Some(Self { inv: [r(0), r(1), r(2)], lower, upper })
+    }
+
+    /// Nearest root t in (tnear, tfar) of |o' + t d'| = 1 in object space, if any.
+    #[inline]
+    fn hit(&self, o: [f32; 3], d: [f32; 3], tnear: f32, tfar: f32) -> Option<f32> {
+        let m = &self.inv;
+        let (o, d) = (o.map(f64::from), d.map(f64::from));
+        let oo: [f64; 3] = std::array::from_fn(|i| m[i][0] * o[0] + m[i][1] * o[1] + m[i][2] * o[2] + m[i][3]);
+        let dd: [f64; 3] = std::array::from_fn(|i| m[i][0] * d[0] + m[i][1] * d[1] + m[i][2] * d[2]);
+        let a = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+        if a.is_nan() || a <= 0.0 {
+            return None;
+        }
+        // Numerically robust form: the discriminant from the distance of the closest approach.
+        let b = -(oo[0] * dd[0] + oo[1] * dd[1] + oo[2] * dd[2]) / a; // t of the closest approach
+        let f: [f64; 3] = std::array::from_fn(|i| oo[i] + b * dd[i]);
+        let disc = 1.0 - (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        if disc < 0.0 {
+            return None;
+        }
+        let h = (disc / a).sqrt();
+        let (t0, t1) = (b - h, b + h);
+        let (tn, tf) = (f64::from(tnear), f64::from(tfar));
+        let t = if t0 > tn && t0 < tf {
+            t0
+        } else if t1 > tn && t1 < tf {
+            t1
+        } else {
+            return None;
+        };
+        Some(t as f32).filter(|t| *t > tnear && *t < tfar)
+    }
+}
+
+pub(super) unsafe extern "C" fn ellipsoid_bounds(args: *const sys::RTCBoundsFunctionArguments) {
+    // SAFETY: Embree passes valid arguments; the user pointer is the Vec<Ellipsoid> set in
+    // add_ellipsoids and primID < its length (the primitive count we declared).
+    unsafe {
+        let a = &*args;
+        let prims = &*(a.geometryUserPtr as *const Vec<Ellipsoid>);
+        let e = &prims[a.primID as usize];
+        let b = &mut *a.bounds_o;
+        (b.lower_x, b.lower_y, b.lower_z) = (e.lower[0], e.lower[1], e.lower[2]);
+        (b.upper_x, b.upper_y, b.upper_z) = (e.upper[0], e.upper[1], e.upper[2]);
+    }
+}
+
+/// Float at 4-byte word `field * n + lane` of an Embree SoA ray/hit block of width `n`.
+#[inline]
+unsafe fn soa(base: *mut u32, n: usize, field: usize, lane: usize) -> *mut u32 {
+    // SAFETY: the caller guarantees base points to an RTCRayHitN/RTCRayN of width n with at least
+    // `field + 1` fields.
+    unsafe { base.add(field * n + lane) }
+}
+
+/// Runs the ellipsoid `prim` against every valid lane of an Embree SoA ray block of width `n` and
+/// calls `on_hit(lane, t)` for each lane it hits inside (tnear, tfar).
+///
+/// # Safety
+/// `valid` must hold `n` ints and `base` point to an RTCRayN (or the ray part of an RTCRayHitN) of
+/// width `n`; `user` must be the Vec<Ellipsoid> set in add_ellipsoids with `prim` < its length.
+unsafe fn each_ellipsoid_hit(
+    valid: *const i32,
+    user: *mut c_void,
+    prim: u32,
+    base: *mut u32,
+    n: usize,
+    mut on_hit: impl FnMut(usize, f32),
+) {
+    // SAFETY: guaranteed by the caller (see the function's contract).
+    unsafe {
+        let prims = &*(user as *const Vec<Ellipsoid>);
+        let e = &prims[prim as usize];
+        let f = |field: usize, lane: usize| f32::from_bits(*soa(base, n, field, lane));
+        for lane in 0..n {
+            if *valid.add(lane) != -1 {
+                continue;
+            }
+            let o = [f(0, lane), f(1, lane), f(2, lane)];
+            let d = [f(4, lane), f(5, lane), f(6, lane)];
+            if let Some(t) = e.hit(o, d, f(3, lane), f(8, lane)) {
+                on_hit(lane, t);
+            }
+        }
+    }
+}
+
+pub(super) unsafe extern "C" fn ellipsoid_intersect(args: *const sys::RTCIntersectFunctionNArguments) {
+    // SAFETY: Embree passes `valid` with N ints, `rayhit` as an RTCRayHitN of width N in the 4.4
+    // layout (12 ray fields then 9 hit fields, one instance level), the user pointer set in
+    // add_ellipsoids, and primID < the primitive count.
+    unsafe {
+        let a = &*args;
+        let (n, base) = (a.N as usize, a.rayhit as *mut u32);
+        let ctx = &*(a.context as *const RayQueryContext);
+        each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, t| {
+            *soa(base, n, 8, lane) = t.to_bits();
+            for field in 12..17 {
+                *soa(base, n, field, lane) = 0; // Ng and u, v: strata computes its own normals
+            }
+            *soa(base, n, 17, lane) = a.primID;
+            *soa(base, n, 18, lane) = a.geomID;
+            *soa(base, n, 19, lane) = ctx.inst_id[0];
+            *soa(base, n, 20, lane) = ctx.inst_prim_id[0];
+        });
+    }
+}
+
+pub(super) unsafe extern "C" fn ellipsoid_occluded(args: *const sys::RTCOccludedFunctionNArguments) {
+    // SAFETY: as in ellipsoid_intersect, with `ray` an RTCRayN of width N (12 fields).
+    unsafe {
+        let a = &*args;
+        let (n, base) = (a.N as usize, a.ray as *mut u32);
+        each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, _| {
+            *soa(base, n, 8, lane) = f32::NEG_INFINITY.to_bits();
+        });
+    }
+}
