@@ -1,9 +1,7 @@
 //! strata: a SIMD packet ray tracer on Embree 4, built to compare sampling techniques.
 pub mod accel;
-pub mod app;
 pub mod bsdf;
 pub mod checkpoint;
-pub mod experiments;
 pub mod film;
 pub mod integrator;
 pub mod lab;
@@ -14,4 +12,5 @@ pub mod report;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod session;
 pub mod simd;

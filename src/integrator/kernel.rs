@@ -45,7 +45,7 @@ impl Kernel {
             (false, true) => "ggx",
             (true, true) => "phong+ggx",
         };
-        format!("{}<lobes={lobes}>", crate::app::integrator_name(integrator))
+        format!("{}<lobes={lobes}>", integrator.name())
     }
 }
 
@@ -85,7 +85,7 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         },
         "point_lights": d.point_lights.len(),
         "directional_lights": d.directional_lights.len(),
-        "integrator": crate::app::integrator_name(kind),
+        "integrator": kind.name(),
         "nee": if path { Some(format!("{nee:?}").to_lowercase()) } else { None },
         "russian_roulette": path && rr,
         "importance_sampling": if path { Some(format!("{strategy:?}").to_lowercase()) } else { None },
