@@ -7,9 +7,9 @@
 //! `blocks * width * height * 6` f64 (block-major; per pixel sum R, G, B, sum of squares R, G, B),
 //! then a u64 checksum of every byte before it. Written atomically ([`crate::film::write_atomic`]).
 //!
-//! - [`format`]: the file layout, [`read`] and [`write`];
-//! - [`identity`]: the [`Header`] of a render, what makes two headers one render, EXR metadata;
-//! - [`merge`]: `strata merge` of finished `--samples` parts.
+//! - [`format`] — the file layout, [`read`] and [`write`];
+//! - [`identity`] — the [`Header`] of a render, what makes two headers one render, EXR metadata;
+//! - [`merge`] — `strata merge` of finished `--samples` parts.
 
 pub mod format;
 pub mod identity;

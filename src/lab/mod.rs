@@ -1,7 +1,7 @@
 //! The lab: experiments over the renderer, built on the session layer and `report/`.
 //!
-//! - [`compare`]: `strata compare` (variants against a reference, equal spp or equal time);
-//! - [`experiments`]: `strata experiments` (the seed experiments of the course report).
+//! - [`compare`] — `strata compare` (variants against a reference, equal spp or equal time);
+//! - [`experiments`] — `strata experiments` (the seed experiments of the course report).
 
 pub mod compare;
 pub mod experiments;

@@ -2,14 +2,14 @@
 //! as library functions (the binary, tests and benches share them). `main.rs` only parses the
 //! command line into [`RenderOptions`] and calls these.
 //!
-//! - [`options`]: [`RenderOptions`] and defaults;
-//! - [`scene`]: scene loading with the overrides, [`prepare`] (scene and integrator), scene hash;
-//! - [`pass`]: the pass loop ([`render_to_film`]) with checkpoints, resume, budget, signals;
-//! - [`progress`]: the progress bar (`indicatif`) or plain lines;
-//! - [`output`]: output naming, EXR metadata, [`run_render`];
-//! - [`stats`]: the `--stats` JSON and the summary line;
-//! - [`rays`]: `strata rays`;
-//! - [`error`]: [`SessionError`].
+//! - [`options`] — [`RenderOptions`] and defaults;
+//! - [`scene`] — scene loading with the overrides, [`prepare`] (scene and integrator), scene hash;
+//! - [`pass`] — the pass loop ([`render_to_film`]) with checkpoints, resume, budget, signals;
+//! - [`progress`] — the progress bar (`indicatif`) or plain lines;
+//! - [`output`] — output naming, EXR metadata, [`run_render`];
+//! - [`stats`] — the `--stats` JSON and the summary line;
+//! - [`rays`] — `strata rays`;
+//! - [`error`] — [`SessionError`].
 
 pub mod error;
 pub mod options;
