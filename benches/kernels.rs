@@ -7,9 +7,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::path::PathBuf;
-use strata::app::RenderOptions;
 use strata::film::Film;
 use strata::scene::desc::IntegratorKind;
+use strata::session::RenderOptions;
 
 fn scenes() -> Vec<(&'static str, RenderOptions)> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
@@ -39,8 +39,8 @@ fn kernels(c: &mut Criterion) {
     let pool = strata::render::thread_pool(1).unwrap();
     let mut table = Vec::new();
     for (name, opts) in scenes() {
-        let (scene, spec) = strata::app::prepare(&opts).unwrap();
-        let (_, gen) = strata::app::prepare(&RenderOptions { general_kernel: true, ..opts.clone() }).unwrap();
+        let (scene, spec) = strata::session::prepare(&opts).unwrap();
+        let (_, gen) = strata::session::prepare(&RenderOptions { general_kernel: true, ..opts.clone() }).unwrap();
         let run = |it: &strata::integrator::Integrator| {
             let mut film = Film::new(scene.desc.width, scene.desc.height);
             strata::render::render(&scene, it, &mut film, 0..it.spp, &pool)

@@ -16,11 +16,11 @@ use glam::Vec3;
 use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-use strata::app::RenderOptions;
 use strata::film::Film;
 use strata::sampler::{PointSet, SamplerKind};
 use strata::sampling as warp;
 use strata::scene::desc::{ImportanceSampling, IntegratorKind};
+use strata::session::RenderOptions;
 use strata::simd::{Mask8, Vec3x8, F8, U8};
 
 const POINTS: u32 = 4096;
@@ -181,7 +181,7 @@ fn equal_time(c: &mut Criterion) {
     let prepared: Vec<_> = techs
         .iter()
         .map(|(_, _, opts, spp)| {
-            let (scene, integ) = strata::app::prepare(opts).unwrap();
+            let (scene, integ) = strata::session::prepare(opts).unwrap();
             (scene, integ.resampled(Some(*spp)))
         })
         .collect();
@@ -215,7 +215,7 @@ fn equal_time(c: &mut Criterion) {
     // Variance and MSE from K = 8 runs against a reference.
     println!("\ntable       technique      seconds     variance   var x s     MSE        MSE x s    (var x s) / first");
     let mut first: Option<(&str, f64)> = None;
-    let mut reference: Option<(&str, strata::experiments::Reference)> = None;
+    let mut reference: Option<(&str, strata::lab::experiments::Reference)> = None;
     for ((table, name, opts, spp), &secs) in techs.iter().zip(&secs) {
         if reference.as_ref().map(|r| r.0) != Some(*table) {
             let r = if *spp == 1 {
@@ -225,7 +225,7 @@ fn equal_time(c: &mut Criterion) {
                     threads: 0,
                     ..opts.clone()
                 };
-                strata::experiments::reference_two_halves(&o)
+                strata::lab::experiments::reference_two_halves(&o)
             } else {
                 let o = RenderOptions {
                     importance_sampling: Some(ImportanceSampling::Brdf),
@@ -233,13 +233,13 @@ fn equal_time(c: &mut Criterion) {
                     threads: 0,
                     ..opts.clone()
                 };
-                strata::experiments::reference_spp(&o)
+                strata::lab::experiments::reference_spp(&o)
             };
             reference = Some((table, r.unwrap()));
         }
         let r = &reference.as_ref().unwrap().1;
-        let (imgs, _) = strata::experiments::runs(opts, *spp, 8).unwrap();
-        let st = strata::experiments::stats(&imgs, &r.rgb, &r.var, r.gamma, secs, *spp);
+        let (imgs, _) = strata::lab::experiments::runs(opts, *spp, 8).unwrap();
+        let st = strata::lab::experiments::stats(&imgs, &r.rgb, &r.var, r.gamma, secs, *spp);
         let vs = st.variance * secs;
         if first.map(|f| f.0) != Some(*table) {
             first = Some((table, vs));

@@ -12,9 +12,9 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use std::path::PathBuf;
-use strata::app::RenderOptions;
 use strata::film::Film;
 use strata::measure;
+use strata::session::RenderOptions;
 
 fn scenes() -> Vec<(String, RenderOptions)> {
     let own = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/cornell_diffuse_path.test"));
@@ -57,7 +57,7 @@ fn throughput(c: &mut Criterion) {
     let pool = strata::render::thread_pool(1).unwrap();
     let mut table = Vec::new();
     for (name, opts) in scenes() {
-        let (scene, integ) = strata::app::prepare(&opts).unwrap();
+        let (scene, integ) = strata::session::prepare(&opts).unwrap();
         let log = measure::log_rays(&scene, &integ, integ.spp);
         let lanes = |m: &strata::simd::Mask8| u64::from(m.to_bitmask().count_ones());
         let cam: u64 = log.camera.iter().map(|(_, m)| lanes(m)).sum();

@@ -1,10 +1,8 @@
 //! strata: a SIMD packet ray tracer on Embree 4, built to compare sampling techniques.
 pub mod accel;
-pub mod app;
 pub mod bsdf;
 pub mod camera;
 pub mod checkpoint;
-pub mod experiments;
 pub mod film;
 pub mod integrator;
 pub mod lab;
@@ -15,4 +13,5 @@ pub mod report;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod session;
 pub mod simd;

@@ -3,8 +3,9 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use strata::app::{self, RenderOptions};
 use strata::sampler::SamplerKind;
+use strata::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
+use strata::session::{self, RenderOptions};
 
 #[derive(Parser)]
 #[command(name = "strata", version, about = "SIMD packet ray tracer on Embree 4 for sampling experiments")]
@@ -118,7 +119,7 @@ struct RenderArgs {
     scene: Option<PathBuf>,
     /// Camera "ex ey ez cx cy cz ux uy uz fovy" (the format's camera arguments), replacing the
     /// scene's (for an .obj, the default one framing its bounds).
-    #[arg(long, value_parser = app::parse_camera, allow_hyphen_values = true)]
+    #[arg(long, value_parser = session::parse_camera, allow_hyphen_values = true)]
     camera: Option<strata::scene::desc::CameraDesc>,
     /// Samples per pixel (default: the scene's spp).
     #[arg(long)]
@@ -144,13 +145,13 @@ struct RenderArgs {
     pixel_sampler: Option<SamplerKind>,
     /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
     #[arg(long, value_parser = parse_integrator)]
-    integrator: Option<strata::scene::desc::IntegratorKind>,
+    integrator: Option<IntegratorKind>,
     /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
     #[arg(long, value_parser = parse_importance_sampling)]
-    importance_sampling: Option<strata::scene::desc::ImportanceSampling>,
+    importance_sampling: Option<ImportanceSampling>,
     /// Path tracer next event estimation: off, on, mis (default: the scene's nexteventestimation).
     #[arg(long, value_parser = parse_nee)]
-    nee: Option<strata::scene::desc::Nee>,
+    nee: Option<Nee>,
     /// Path tracer Russian roulette: on, off (default: the scene's russianroulette).
     #[arg(long, value_parser = parse_on_off)]
     russian_roulette: Option<bool>,
@@ -179,7 +180,7 @@ struct RenderArgs {
     #[arg(long)]
     checkpoint: Option<PathBuf>,
     /// Seconds between checkpoints (0: after every pass).
-    #[arg(long, default_value_t = app::DEFAULT_CHECKPOINT_EVERY)]
+    #[arg(long, default_value_t = session::DEFAULT_CHECKPOINT_EVERY)]
     checkpoint_every: f64,
     /// Continue the render held in this checkpoint (refused if the scene or an option differs);
     /// it keeps being checkpointed there unless --checkpoint says otherwise.
@@ -274,13 +275,13 @@ fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
         .ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton, sobol, pmj02)"))
 }
 
-fn parse_integrator(s: &str) -> Result<strata::scene::desc::IntegratorKind, String> {
-    app::parse_integrator(s)
+fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+    IntegratorKind::parse(s)
         .ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
 }
 
-fn parse_nee(s: &str) -> Result<strata::scene::desc::Nee, String> {
-    app::parse_nee(s).ok_or_else(|| format!("unknown next event estimation `{s}` (off, on, mis)"))
+fn parse_nee(s: &str) -> Result<Nee, String> {
+    Nee::parse(s).ok_or_else(|| format!("unknown next event estimation `{s}` (off, on, mis)"))
 }
 
 fn parse_on_off(s: &str) -> Result<bool, String> {
@@ -291,9 +292,8 @@ fn parse_on_off(s: &str) -> Result<bool, String> {
     }
 }
 
-fn parse_importance_sampling(s: &str) -> Result<strata::scene::desc::ImportanceSampling, String> {
-    app::parse_importance_sampling(s)
-        .ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, String> {
+    ImportanceSampling::parse(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
 }
 
 fn main() -> ExitCode {
@@ -302,11 +302,11 @@ fn main() -> ExitCode {
         Cmd::Render(args) | Cmd::Reference(args) => {
             let quiet = args.quiet;
             let mut opts = args.options();
-            match app::stop_on_signals() {
+            match session::stop_on_signals() {
                 Ok(flag) => opts.stop = Some(flag),
                 Err(e) => eprintln!("strata: {e}; Ctrl-C will not checkpoint"),
             }
-            match app::run_render(&opts) {
+            match session::run_render(&opts) {
                 Ok(o) if o.interrupted => {
                     let ck = o.checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
                     eprintln!(
@@ -317,26 +317,28 @@ fn main() -> ExitCode {
                 }
                 Ok(o) => {
                     if !quiet {
-                        println!("{}", app::summary(&o));
+                        println!("{}", session::summary(&o));
                     }
                     Ok(())
                 }
-                Err(e) => Err(e),
+                Err(e) => Err(e.to_string()),
             }
         }
-        Cmd::Merge { parts, out, quiet } => app::run_merge(&parts, &out).map(|m| {
-            if !quiet {
-                println!(
-                    "merged {} parts: {} spp ({}..{}), {:.3} CPU seconds -> {}.exr/.png",
-                    m.header.parts.len(),
-                    m.header.samples[1] - m.header.samples[0],
-                    m.header.samples[0],
-                    m.header.samples[1],
-                    m.header.cpu_seconds,
-                    m.out.display()
-                );
-            }
-        }),
+        Cmd::Merge { parts, out, quiet } => {
+            strata::checkpoint::run_merge(&parts, &out).map_err(|e| e.to_string()).map(|m| {
+                if !quiet {
+                    println!(
+                        "merged {} parts: {} spp ({}..{}), {:.3} CPU seconds -> {}.exr/.png",
+                        m.header.parts.len(),
+                        m.header.samples[1] - m.header.samples[0],
+                        m.header.samples[0],
+                        m.header.samples[1],
+                        m.header.cpu_seconds,
+                        m.out.display()
+                    );
+                }
+            })
+        }
         Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
             run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
         }
@@ -355,8 +357,8 @@ fn main() -> ExitCode {
                 .map_err(|e| format!("{}: {e}", out.display()))
         }
         Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
-            let corpus = corpus.unwrap_or_else(strata::experiments::default_corpus);
-            let cfg = strata::experiments::Config {
+            let corpus = corpus.unwrap_or_else(strata::lab::experiments::default_corpus);
+            let cfg = strata::lab::experiments::Config {
                 corpus,
                 out: out.clone(),
                 runs,
@@ -367,18 +369,20 @@ fn main() -> ExitCode {
                 verbose: true,
                 sheet_factor,
             };
-            strata::experiments::run(&cfg).map(|md| {
+            strata::lab::experiments::run(&cfg).map_err(|e| e.to_string()).map(|md| {
                 println!("{md}");
                 println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
             })
         }
-        Cmd::Rays { args, json } => app::run_rays(&args.options()).map(|(rates, name)| {
-            if json {
-                println!("{}", serde_json::to_string_pretty(&rates).unwrap_or_default());
-            } else {
-                println!("{}", app::rates_table(&name, &rates));
-            }
-        }),
+        Cmd::Rays { args, json } => {
+            session::run_rays(&args.options()).map_err(|e| e.to_string()).map(|(rates, name)| {
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&rates).unwrap_or_default());
+                } else {
+                    println!("{}", session::rates_table(&name, &rates));
+                }
+            })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -423,13 +427,13 @@ fn run_compare(
         (None, Some(_)) => return Err("--spp-ladder: expected positive spp values".into()),
         (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
     };
-    let rows = strata::lab::compare(&variants, reference, runs, &mode)?;
+    let rows = strata::lab::compare(&variants, reference, runs, &mode).map_err(|e| e.to_string())?;
     let title = format!(
         "{} vs {}",
         scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
         reference.display()
     );
-    let md = strata::lab::write_outputs(&rows, out, &title)?;
+    let md = strata::lab::write_outputs(&rows, out, &title).map_err(|e| e.to_string())?;
     println!("{md}");
     println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", out.display());
     Ok(())

@@ -12,6 +12,7 @@ use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::Vec3x8;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Tile side in pixels.
@@ -61,6 +62,18 @@ pub fn render(
     samples: std::ops::Range<u32>,
     pool: &rayon::ThreadPool,
 ) -> RenderStats {
+    render_counted(scene, integrator, film, samples, pool, &AtomicU64::new(0))
+}
+
+/// [`render`], adding 1 to `tiles_done` as each tile finishes (a progress bar polls it).
+pub fn render_counted(
+    scene: &Scene,
+    integrator: &Integrator,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+    pool: &rayon::ThreadPool,
+    tiles_done: &AtomicU64,
+) -> RenderStats {
     let have = film.samples();
     assert!(
         have.is_empty() || have.end == samples.start,
@@ -83,6 +96,7 @@ pub fn render(
                 let mut counters = Counters::default();
                 let mut r = TileResult::from_film(film_in, tx * TILE, ty * TILE);
                 render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
+                tiles_done.fetch_add(1, Ordering::Relaxed);
                 (r, counters, t0.elapsed().as_secs_f64())
             })
             .collect()

@@ -171,9 +171,9 @@ fn stratified_beats_random_at_equal_samples() {
 /// Same input, same seed: bit-identical accumulation whatever the thread count.
 #[test]
 fn bit_identical_across_thread_counts() {
-    let base = strata::app::RenderOptions { size: Some((72, 56)), spp: Some(3), seed: 7, ..Default::default() };
+    let base = strata::session::RenderOptions { size: Some((72, 56)), spp: Some(3), seed: 7, ..Default::default() };
     let films: Vec<_> =
-        [1usize, 2, 3].iter().map(|&t| film(&strata::app::RenderOptions { threads: t, ..base.clone() })).collect();
+        [1usize, 2, 3].iter().map(|&t| film(&strata::session::RenderOptions { threads: t, ..base.clone() })).collect();
     for f in &films[1..] {
         assert_eq!(f.count, films[0].count);
         let bits = |f: &strata::film::Film| {
@@ -182,7 +182,7 @@ fn bit_identical_across_thread_counts() {
         assert_eq!(bits(f), bits(&films[0]));
     }
     // A different seed changes the image (the test can fail).
-    let other = film(&strata::app::RenderOptions { threads: 2, seed: 8, ..base });
+    let other = film(&strata::session::RenderOptions { threads: 2, seed: 8, ..base });
     assert_ne!(other.sum, films[0].sum);
 }
 
@@ -193,7 +193,7 @@ fn every_hw2_scene_renders() {
     for name in ["analytic", "direct9", "direct3x3", "sphere", "cornell", "dragon"] {
         let mut o = opts(c.join(format!("hw2/{name}.test")), 64, 48, 1);
         o.light_samples = Some(4);
-        let out = strata::app::render_to_film(&o).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let out = strata::session::render_to_film(&o).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(out.stats.counters.nonfinite, 0, "{name}");
         let m = means(&out.film);
         assert!(m.iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)), "{name}");
@@ -207,9 +207,14 @@ fn every_hw2_scene_renders() {
 /// bits of 0..7 (progressive rendering and, later, resume depend on it).
 #[test]
 fn passes_are_bit_identical_to_one_render() {
-    let o =
-        strata::app::RenderOptions { size: Some((40, 24)), spp: Some(7), seed: 5, threads: 2, ..Default::default() };
-    let (scene, integ) = strata::app::prepare(&o).unwrap();
+    let o = strata::session::RenderOptions {
+        size: Some((40, 24)),
+        spp: Some(7),
+        seed: 5,
+        threads: 2,
+        ..Default::default()
+    };
+    let (scene, integ) = strata::session::prepare(&o).unwrap();
     let pool = strata::render::thread_pool(2).unwrap();
     let mut one = strata::film::Film::new(40, 24);
     strata::render::render(&scene, &integ, &mut one, 0..7, &pool);

@@ -9,7 +9,7 @@ mod common;
 fn tiny_experiments_write_tables_sheets_and_plots() {
     let Some(corpus) = common::corpus() else { return };
     let out = std::env::temp_dir().join(format!("strata-experiments-{}", std::process::id()));
-    let cfg = strata::experiments::Config {
+    let cfg = strata::lab::experiments::Config {
         corpus,
         out: out.clone(),
         runs: 4,
@@ -20,7 +20,7 @@ fn tiny_experiments_write_tables_sheets_and_plots() {
         verbose: false,
         sheet_factor: 1,
     };
-    let md = strata::experiments::run(&cfg).expect("experiments run");
+    let md = strata::lab::experiments::run(&cfg).expect("experiments run");
     for f in
         ["results.md", "results.json", "direct.svg", "direct-sphere.png", "direct-cornell.png", "direct-dragon.png"]
     {

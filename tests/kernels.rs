@@ -5,7 +5,7 @@ mod common;
 
 use common::{corpus, opts};
 use std::path::PathBuf;
-use strata::app::{render_to_film, stats_json, RenderOptions};
+use strata::session::{render_to_film, stats_json, RenderOptions};
 
 fn own(name: &str) -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes")).join(name)
@@ -21,7 +21,7 @@ fn same_bits(o: &RenderOptions) -> (String, String) {
     assert!(spec.film.mean().iter().flatten().any(|&v| v > 0.0), "{name}: black image proves nothing");
     assert_eq!(bits(spec.film.mean()), bits(gen.film.mean()), "{name}: mean differs between kernels");
     assert_eq!(bits(spec.film.variance_of_mean()), bits(gen.film.variance_of_mean()), "{name}: variance differs");
-    let k = |r: &strata::app::RenderOutput| stats_json(r)["kernel"].as_str().expect("kernel key").to_string();
+    let k = |r: &strata::session::RenderOutput| stats_json(r)["kernel"].as_str().expect("kernel key").to_string();
     (k(&spec), k(&gen))
 }
 

@@ -8,9 +8,9 @@ mod common;
 use common::*;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
-use strata::app::RenderOptions;
 use strata::scene::obj;
 use strata::scene::parse::{parse_file, Limits};
+use strata::session::RenderOptions;
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
@@ -333,7 +333,7 @@ fn emissive_triangle_renders_are_thread_count_independent() {
 #[test]
 fn whole_scene_obj_renders_with_its_emissive_patch() {
     let o = RenderOptions { seed: 1, ..opts(own("cornell_box.obj"), 48, 36, 4) };
-    let out = strata::app::render_to_film(&o).unwrap();
+    let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(out.stats.counters.nonfinite, 0);
     assert_eq!(out.scene.emitters.n_triangles(), 2);
     assert_eq!(out.scene.emitters.n_quads, 0);
@@ -376,11 +376,11 @@ fn default_camera_frames_the_bounds() {
         assert!(max_ndc > 0.4, "{w}x{h}: the model fills too little ({max_ndc})");
     }
     // --camera replaces it.
-    let c = strata::app::parse_camera("0 1 5 0 1 0 0 1 0 30").unwrap();
+    let c = strata::session::parse_camera("0 1 5 0 1 0 0 1 0 30").unwrap();
     let o = RenderOptions { camera: Some(c), ..opts(own("cornell_box.obj"), 8, 8, 1) };
-    assert_eq!(strata::app::load_scene(&o).unwrap().camera, Some(c));
-    assert!(strata::app::parse_camera("0 1 5 0 1 5 0 1 0 30").unwrap_err().contains("coincide"));
-    assert!(strata::app::parse_camera("0 1 5").is_err());
+    assert_eq!(strata::session::load_scene(&o).unwrap().camera, Some(c));
+    assert!(strata::session::parse_camera("0 1 5 0 1 5 0 1 0 30").unwrap_err().to_string().contains("coincide"));
+    assert!(strata::session::parse_camera("0 1 5").is_err());
 }
 
 #[test]

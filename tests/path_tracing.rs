@@ -7,7 +7,7 @@ mod common;
 
 use common::*;
 use std::path::PathBuf;
-use strata::app::RenderOptions;
+use strata::session::RenderOptions;
 
 /// The built-in Cornell box (scenes/cornell.test) with the given settings replacing its own.
 fn variant(name: &str, settings: &[&str]) -> PathBuf {
@@ -21,7 +21,7 @@ fn variant(name: &str, settings: &[&str]) -> PathBuf {
         "lightsamples",
         "lightstratify",
     ];
-    let mut text: String = strata::app::DEFAULT_SCENE
+    let mut text: String = strata::session::DEFAULT_SCENE
         .lines()
         .filter(|l| !keys.iter().any(|k| l.trim_start().starts_with(k)))
         .map(|l| format!("{l}\n"))
@@ -44,7 +44,7 @@ struct Est {
 
 fn estimate(name: &str, settings: &[&str], spp: u32, seed: u64) -> Est {
     let o = RenderOptions { seed, ..opts(variant(name, settings), 24, 24, spp) };
-    let out = strata::app::render_to_film(&o).unwrap();
+    let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(out.stats.counters.nonfinite, 0, "{name}");
     Est { mean: means(&out.film), var: var_of_mean(&out.film) }
 }
@@ -153,7 +153,7 @@ fn course_path_tracing_scenes_are_finite_and_packets_full() {
         "hw4/dragon",
     ] {
         let o = opts(c.join(format!("{name}.test")), 64, 48, 2);
-        let out = strata::app::render_to_film(&o).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let out = strata::session::render_to_film(&o).unwrap_or_else(|e| panic!("{name}: {e}"));
         let cnt = out.stats.counters;
         assert_eq!(cnt.nonfinite, 0, "{name}: non-finite samples");
         assert!(means(&out.film).iter().all(|p| p.iter().all(|v| v.is_finite() && *v >= 0.0)), "{name}");
@@ -199,17 +199,18 @@ fn path_tracing_is_bit_identical_across_thread_counts() {
 #[test]
 fn clamp_bounds_every_sample_and_reports_bias() {
     let scene = variant("clamp", &["integrator pathtracer", "nexteventestimation on", "maxdepth 3"]);
-    let free = strata::app::render_to_film(&opts(scene.clone(), 24, 24, 8)).unwrap();
-    let clamped = strata::app::render_to_film(&RenderOptions { clamp: Some(0.5), ..opts(scene, 24, 24, 8) }).unwrap();
+    let free = strata::session::render_to_film(&opts(scene.clone(), 24, 24, 8)).unwrap();
+    let clamped =
+        strata::session::render_to_film(&RenderOptions { clamp: Some(0.5), ..opts(scene, 24, 24, 8) }).unwrap();
     let (mf, mc) = (means(&free.film), means(&clamped.film));
     let top = |m: &[[f64; 3]]| m.iter().flatten().fold(0f64, |a, &v| a.max(v));
     assert!(top(&mf) > 0.5, "the unclamped image must exceed the clamp for the test to mean anything");
     assert!(top(&mc) <= 0.5 + 1e-6, "clamped pixel mean {} above 0.5", top(&mc));
     let sum = |m: &[[f64; 3]]| m.iter().flatten().sum::<f64>();
     assert!(sum(&mc) < sum(&mf), "clamping must darken");
-    let j = strata::app::stats_json(&clamped);
+    let j = strata::session::stats_json(&clamped);
     assert_eq!(j["biased"], serde_json::json!(true));
     assert_eq!(j["clamp"], serde_json::json!(0.5));
-    assert!(strata::app::summary(&clamped).contains("biased"));
-    assert_eq!(strata::app::stats_json(&free)["biased"], serde_json::json!(false));
+    assert!(strata::session::summary(&clamped).contains("biased"));
+    assert_eq!(strata::session::stats_json(&free)["biased"], serde_json::json!(false));
 }

@@ -13,8 +13,8 @@ mod common;
 
 use common::*;
 use std::path::{Path, PathBuf};
-use strata::app::{self, RenderOptions};
 use strata::scene::desc::IntegratorKind;
+use strata::session::{self as app, RenderOptions};
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name)
@@ -326,7 +326,10 @@ fn degenerate_lights_and_cameras_are_errors_with_file_and_line() {
     for (i, (from, to, word)) in cases.into_iter().enumerate() {
         let line = line_of(from.split_whitespace().next().unwrap());
         let p = write_scene(&dir, &format!("bad{i}.test"), &text.replace(from, to));
-        let e = app::render_to_film(&opts_for(p.clone(), IntegratorKind::PathTracer, 0)).err().expect("an error");
+        let e = app::render_to_film(&opts_for(p.clone(), IntegratorKind::PathTracer, 0))
+            .err()
+            .expect("an error")
+            .to_string();
         let want = format!("{}:{line}: ", p.display());
         assert!(e.starts_with(&want) && e.contains(word), "`{to}`: error `{e}`, want `{want}...{word}...`");
     }
@@ -348,19 +351,21 @@ fn failed_renders_keep_existing_outputs_and_leave_no_temporaries() {
     let (exr, png) = (std::fs::read(dir.join("img.exr")).unwrap(), std::fs::read(dir.join("img.png")).unwrap());
     // A scene that fails to parse: nothing is touched.
     let bad = write_scene(&dir, "bad.test", "size 16 16\ncamera 0 0 1 0 0 0 0 1 0 45\nvertex 0 0\n");
-    let e = app::run_render(&RenderOptions { scene: Some(bad), ..base.clone() }).err().expect("parse error");
+    let e =
+        app::run_render(&RenderOptions { scene: Some(bad), ..base.clone() }).err().expect("parse error").to_string();
     assert!(e.contains("bad.test:3:"), "{e}");
     // The EXR's final name is taken by a directory: the EXR write fails and the PNG is not written.
     std::fs::rename(dir.join("img.exr"), dir.join("old.exr")).unwrap();
     std::fs::create_dir(dir.join("img.exr")).unwrap();
-    let e = app::run_render(&RenderOptions { seed: 9, ..base.clone() }).err().expect("write error");
+    let e = app::run_render(&RenderOptions { seed: 9, ..base.clone() }).err().expect("write error").to_string();
     assert!(e.contains("img.exr"), "{e}");
     assert_eq!(std::fs::read(dir.join("img.png")).unwrap(), png, "the old PNG survives");
     assert_eq!(std::fs::read(dir.join("old.exr")).unwrap(), exr);
     // The output's parent is a regular file.
     let e = app::run_render(&RenderOptions { out: Some(dir.join("old.exr").join("x")), ..base.clone() })
         .err()
-        .expect("bad parent");
+        .expect("bad parent")
+        .to_string();
     assert!(e.contains("x.exr"), "{e}");
     let names: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();

@@ -9,8 +9,8 @@ use common::*;
 use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Instant;
-use strata::app::RenderOptions;
 use strata::sampler::SamplerKind;
+use strata::session::RenderOptions;
 
 #[test]
 fn every_hw1_scene_renders_finite_and_fast() {
@@ -30,7 +30,7 @@ fn every_hw1_scene_renders_finite_and_fast() {
     let start = Instant::now();
     for p in &names {
         let o = opts(p.clone(), 64, 48, 1);
-        let out = strata::app::render_to_film(&o).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        let out = strata::session::render_to_film(&o).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
         assert_eq!(out.stats.counters.nonfinite, 0, "{}: non-finite samples", p.display());
         let img = means(&out.film);
         assert!(img.iter().all(|v| v.iter().all(|c| c.is_finite() && *c >= 0.0)), "{}", p.display());
@@ -221,7 +221,7 @@ fn hand_built_scene_matches_f64_reference() {
         threads: 2,
         ..Default::default()
     };
-    let out = strata::app::render_to_film(&o).unwrap();
+    let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(out.stats.counters.nonfinite, 0);
     let img = means(&out.film);
     let tris = triangles();
@@ -285,7 +285,7 @@ fn maxdepth_limits_mirror_recursion() {
             threads: 1,
             ..Default::default()
         };
-        let out = strata::app::render_to_film(&o).unwrap();
+        let out = strata::session::render_to_film(&o).unwrap();
         if depth == 0 {
             assert_eq!(out.stats.counters.bounce, 0, "maxdepth 0 traces no mirror rays");
         } else {

@@ -11,6 +11,7 @@
 pub mod contact;
 pub mod metrics;
 pub mod plot;
+pub mod runs;
 pub mod table;
 
 pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, RunStats};

@@ -22,27 +22,6 @@ pub enum IntegratorKind {
     PathTracer,
 }
 
-impl IntegratorKind {
-    /// Every integrator with its name as the format spells it (`integrator NAME`, `--integrator`):
-    /// the one place the names are written.
-    pub const NAMES: [(&'static str, IntegratorKind); 4] = [
-        ("raytracer", IntegratorKind::RayTracer),
-        ("analyticdirect", IntegratorKind::AnalyticDirect),
-        ("direct", IntegratorKind::Direct),
-        ("pathtracer", IntegratorKind::PathTracer),
-    ];
-
-    /// Name as the format spells it.
-    pub fn name(self) -> &'static str {
-        Self::NAMES.iter().find(|(_, k)| *k == self).map_or("", |(n, _)| n)
-    }
-
-    /// The integrator named `s` (exact spelling).
-    pub fn parse(s: &str) -> Option<Self> {
-        Self::NAMES.iter().find(|(n, _)| *n == s).map(|&(_, k)| k)
-    }
-}
-
 /// `nexteventestimation off|on|mis`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Nee {
@@ -66,6 +45,41 @@ pub enum ImportanceSampling {
     /// Mixture of the BRDF's lobes.
     Brdf,
 }
+
+/// Implements the format's spelling of a keyword enum: `NAMES` (name, value) in the order the
+/// format lists them, `name()` and an exact-match `parse()`. The one place these names are spelled.
+macro_rules! spelled {
+    ($t:ty, $what:literal, [$(($name:literal, $v:ident)),* $(,)?]) => {
+        impl $t {
+            #[doc = concat!("Every ", $what, " with its name as the format spells it.")]
+            pub const NAMES: &'static [(&'static str, $t)] = &[$(($name, <$t>::$v)),*];
+
+            #[doc = concat!("The ", $what, "'s name as the format spells it.")]
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(<$t>::$v => $name),*
+                }
+            }
+
+            #[doc = concat!("Parses a ", $what, " name (exact spelling).")]
+            pub fn parse(s: &str) -> Option<Self> {
+                Self::NAMES.iter().find(|(n, _)| *n == s).map(|&(_, v)| v)
+            }
+        }
+    };
+}
+
+spelled!(
+    IntegratorKind,
+    "integrator",
+    [("raytracer", RayTracer), ("analyticdirect", AnalyticDirect), ("direct", Direct), ("pathtracer", PathTracer)]
+);
+spelled!(Nee, "next event estimation mode", [("off", Off), ("on", On), ("mis", Mis)]);
+spelled!(
+    ImportanceSampling,
+    "direction sampling strategy",
+    [("hemisphere", Hemisphere), ("cosine", Cosine), ("brdf", Brdf)]
+);
 
 /// `brdf phong|ggx`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -2,8 +2,8 @@
 #![allow(dead_code)]
 
 use std::path::PathBuf;
-use strata::app::RenderOptions;
 use strata::film::Film;
+use strata::session::RenderOptions;
 
 /// The CSE168 corpus beside the checkout (`../shared/cse168`), or None with a printed reason.
 pub fn corpus() -> Option<PathBuf> {
@@ -25,7 +25,7 @@ pub fn opts(scene: PathBuf, w: u32, h: u32, spp: u32) -> RenderOptions {
 
 /// Renders to a film (no files written).
 pub fn film(o: &RenderOptions) -> Film {
-    strata::app::render_to_film(o).unwrap_or_else(|e| panic!("render failed: {e}")).film
+    strata::session::render_to_film(o).unwrap_or_else(|e| panic!("render failed: {e}")).film
 }
 
 /// Per-pixel channel means as f64.

@@ -196,23 +196,15 @@ impl<'l> Parser<'l> {
                 }
                 self.attenuation = Vec3::from_array(c);
             }
-            "integrator" => self.desc.integrator = a.keyword(&IntegratorKind::NAMES)?,
+            "integrator" => self.desc.integrator = a.keyword(IntegratorKind::NAMES)?,
             "lightsamples" => {
                 let max = limits.max_light_samples.into();
                 self.desc.light_samples = a.int_in(1, max, "max_light_samples")? as u32;
             }
             "lightstratify" => self.desc.light_stratify = a.keyword(&on_off)?,
-            "nexteventestimation" => {
-                self.desc.nee = a.keyword(&[("off", Nee::Off), ("on", Nee::On), ("mis", Nee::Mis)])?
-            }
+            "nexteventestimation" => self.desc.nee = a.keyword(Nee::NAMES)?,
             "russianroulette" => self.desc.russian_roulette = a.keyword(&on_off)?,
-            "importancesampling" => {
-                self.desc.importance_sampling = a.keyword(&[
-                    ("hemisphere", ImportanceSampling::Hemisphere),
-                    ("cosine", ImportanceSampling::Cosine),
-                    ("brdf", ImportanceSampling::Brdf),
-                ])?
-            }
+            "importancesampling" => self.desc.importance_sampling = a.keyword(ImportanceSampling::NAMES)?,
             other => {
                 let mut message = format!("unknown command '{}'", show(other));
                 if let Some(known) = COMMANDS.iter().find(|c| c.eq_ignore_ascii_case(other)) {

@@ -2,10 +2,11 @@
 //! equal spp (a ladder) or equal time (a budget); writes CSV, JSON, a Markdown table and a
 //! log-log plot of RMSE against seconds.
 
-use crate::app::{self, RenderOptions};
+use super::{io_err, LabError};
 use crate::film::{self, Film};
 use crate::render;
 use crate::report::{self, Row, RunStats, Series};
+use crate::session::{self, RenderOptions};
 use std::path::{Path, PathBuf};
 
 /// One technique: a name and the render options that define it.
@@ -28,21 +29,24 @@ pub enum Mode {
 
 /// Runs every variant `runs` times (seeds 1..=runs, independent streams) under `mode`, compares
 /// with the reference image and returns one row per (variant, ladder step).
-pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, String> {
-    let img = film::read_exr(reference).map_err(|e| format!("{}: {e}", reference.display()))?;
+pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, LabError> {
+    let img = film::read_exr(reference).map_err(io_err(reference))?;
     if runs < 2 {
-        return Err("--runs must be at least 2 (bias and variance need independent runs)".into());
+        return Err(LabError::TooFewRuns { why: " (bias and variance need independent runs)" });
     }
     let mut rows = Vec::new();
     for v in variants {
-        let (scene, integ) = app::prepare(&v.opts)?;
+        let (scene, integ) = session::prepare(&v.opts)?;
         if (scene.desc.width, scene.desc.height) != (img.width, img.height) {
-            return Err(format!(
-                "variant {}: image {}x{} but the reference is {}x{} (use --size)",
-                v.name, scene.desc.width, scene.desc.height, img.width, img.height
-            ));
+            return Err(LabError::SizeMismatch {
+                variant: v.name.clone(),
+                w: scene.desc.width,
+                h: scene.desc.height,
+                rw: img.width,
+                rh: img.height,
+            });
         }
-        let pool = render::thread_pool(v.opts.threads).map_err(|e| e.to_string())?;
+        let pool = render::thread_pool(v.opts.threads)?;
         let steps: Vec<Option<u32>> = match mode {
             Mode::Ladder(l) => l.iter().map(|&s| Some(s)).collect(),
             Mode::Budget(_) => vec![None],
@@ -76,10 +80,9 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
                 spps += f64::from(spp);
                 images.push(film.mean());
             }
-            let stats = RunStats::from_runs(&images, &img.rgb).map_err(|e| format!("variant {}: {e}", v.name))?;
-            rows.push(
-                Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats).map_err(|e| e.to_string())?,
-            );
+            let stats = RunStats::from_runs(&images, &img.rgb)
+                .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
+            rows.push(Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?);
         }
     }
     Ok(rows)
@@ -87,10 +90,10 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
 
 /// Writes rows.csv, rows.json, table.md and error.svg (RMSE against seconds, slope -1/2 guide)
 /// into `dir`; returns the Markdown table.
-pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, LabError> {
+    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
     let md = report::to_markdown(rows);
-    let json = serde_json::to_string_pretty(&report::to_json(rows)).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string_pretty(&report::to_json(rows))?;
     let mut series: Vec<Series> = Vec::new();
     for r in rows {
         let p = (r.seconds, r.mse.sqrt());
@@ -104,7 +107,7 @@ pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, St
         [("rows.csv", report::to_csv(rows)), ("rows.json", json), ("table.md", md.clone()), ("error.svg", svg)]
     {
         let p: PathBuf = dir.join(name);
-        film::write_atomic(&p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
+        film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
     }
     Ok(md)
 }

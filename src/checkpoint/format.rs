@@ -1,15 +1,7 @@
-//! Checkpoint and part files: the accumulated state of a render (its dyadic blocks, see `film`),
-//! with what identifies the render (scene hash, every option that affects the image), so that a
-//! run can be resumed and shards of one render merged bit-identically.
-//!
-//! Layout (version 1), all integers little-endian:
-//! `b"STRATACK"`, u32 version, u64 header length, the header as UTF-8 JSON ([`Header`]), then
-//! `blocks * width * height * 6` f64 (block-major; per pixel sum R, G, B, sum of squares R, G, B),
-//! then a u64 checksum of every byte before it. Written atomically ([`crate::film::write_atomic`]).
+//! The checkpoint file format (version 1): see the [module doc](super).
 
+use super::{fnv1a, CheckpointError, Header};
 use crate::film::{self, Block, Film, Moments};
-use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use std::path::Path;
 
 /// File magic.
@@ -18,83 +10,6 @@ pub const MAGIC: &[u8; 8] = b"STRATACK";
 pub const VERSION: u32 = 1;
 /// Refuse headers larger than this (a corrupt length must not allocate gigabytes).
 const MAX_HEADER: u64 = 64 << 20;
-
-/// What a checkpoint records besides the moments.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Header {
-    /// strata version that wrote it (part of the identity: sample values may change across versions)
-    pub strata_version: String,
-    /// scene file as named on the command line (informative)
-    pub scene: String,
-    /// hash of the scene file's bytes ([`hash_bytes`], hex)
-    pub scene_hash: String,
-    /// every option that affects the image, resolved (spp, seed, samplers, integrator, ...)
-    pub options: BTreeMap<String, serde_json::Value>,
-    /// image width
-    pub width: u32,
-    /// image height
-    pub height: u32,
-    /// the sample range this run was asked for (`--samples`, else 0..spp)
-    pub target: [u32; 2],
-    /// the sample range held
-    pub samples: [u32; 2],
-    /// the dyadic blocks of `samples`, as (k, j)
-    pub blocks: Vec<[u32; 2]>,
-    /// CPU seconds of the worker threads rendering tiles (summed over sessions and parts)
-    pub cpu_seconds: f64,
-    /// wall-clock seconds of rendering (summed over sessions)
-    pub render_seconds: f64,
-    /// rays traced
-    pub rays: u64,
-    /// the files a merged state came from, with their ranges (empty for a render)
-    pub parts: Vec<String>,
-}
-
-impl Header {
-    /// Why a checkpoint with header `self` cannot continue or join a render with header `want`
-    /// (other scene, version, size or options), or None if it can; `label` names `want` in the
-    /// message (e.g. "this render").
-    pub fn mismatch(&self, want: &Header, label: &str) -> Option<String> {
-        if self.scene_hash != want.scene_hash {
-            return Some(format!(
-                "it is of another scene ({} hash {}; {label}: {} hash {})",
-                self.scene, self.scene_hash, want.scene, want.scene_hash
-            ));
-        }
-        if self.strata_version != want.strata_version {
-            return Some(format!(
-                "it was written by strata {} ({label}: {})",
-                self.strata_version, want.strata_version
-            ));
-        }
-        if (self.width, self.height) != (want.width, want.height) {
-            return Some(format!("it is {}x{} ({label}: {}x{})", self.width, self.height, want.width, want.height));
-        }
-        let keys: std::collections::BTreeSet<&String> = self.options.keys().chain(want.options.keys()).collect();
-        let diffs: Vec<String> = keys
-            .into_iter()
-            .filter(|k| self.options.get(*k) != want.options.get(*k))
-            .map(|k| {
-                let show = |v: Option<&serde_json::Value>| v.map_or("(unset)".to_string(), |v| v.to_string());
-                format!("{k} {} ({label}: {})", show(self.options.get(k)), show(want.options.get(k)))
-            })
-            .collect();
-        (!diffs.is_empty()).then(|| format!("it was rendered with other options: {}", diffs.join(", ")))
-    }
-}
-
-/// FNV-1a, 64 bit, of `bytes`, as 16 hex digits: the scene hash.
-pub fn hash_bytes(bytes: &[u8]) -> String {
-    format!("{:016x}", fnv1a(0xcbf2_9ce4_8422_2325, bytes))
-}
-
-fn fnv1a(mut h: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
 
 /// Checksum of a file body: FNV-1a over 8-byte words (fast enough for GB-sized states), then over
 /// the tail bytes.
@@ -140,14 +55,14 @@ pub fn to_bytes(header: &Header, film: &Film) -> Vec<u8> {
 }
 
 /// Writes a checkpoint atomically (temporary file, fsync, rename).
-pub fn write(path: &Path, header: &Header, film: &Film) -> Result<(), String> {
+pub fn write(path: &Path, header: &Header, film: &Film) -> Result<(), CheckpointError> {
     film::write_atomic(path, &to_bytes(header, film))
-        .map_err(|e| format!("{}: cannot write checkpoint: {e}", path.display()))
+        .map_err(|source| CheckpointError::Write { path: path.to_path_buf(), source })
 }
 
 /// Parses checkpoint bytes; `name` labels errors.
-pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), String> {
-    let bad = |msg: String| format!("{name}: not a usable strata checkpoint: {msg}");
+pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), CheckpointError> {
+    let bad = |why: String| CheckpointError::Unusable { name: name.to_string(), why };
     if bytes.len() < 8 || &bytes[..8] != MAGIC {
         return Err(bad("wrong magic (not a strata checkpoint file)".into()));
     }
@@ -198,18 +113,19 @@ pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), String> {
     if lo > hi {
         return Err(bad(format!("bad sample range {lo}..{hi}")));
     }
-    let film = Film::from_parts(header.width, header.height, lo..hi, blocks, data).map_err(bad)?;
+    let film = Film::from_parts(header.width, header.height, lo..hi, blocks, data).map_err(|e| bad(e.to_string()))?;
     Ok((header, film))
 }
 
 /// Reads a checkpoint written by [`write`], checking magic, version, size and checksum.
-pub fn read(path: &Path) -> Result<(Header, Film), String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read checkpoint: {e}", path.display()))?;
+pub fn read(path: &Path) -> Result<(Header, Film), CheckpointError> {
+    let bytes = std::fs::read(path).map_err(|source| CheckpointError::Read { path: path.to_path_buf(), source })?;
     from_bytes(&bytes, &path.display().to_string())
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::hash_bytes;
     use super::*;
 
     fn film(r: std::ops::Range<u32>) -> Film {
@@ -265,7 +181,7 @@ mod tests {
     fn truncated_or_corrupt_files_are_clear_errors() {
         let bytes = to_bytes(&header(), &film(0..9));
         for cut in [0, 5, 12, 27, 40, bytes.len() / 2, bytes.len() - 9, bytes.len() - 1] {
-            let e = from_bytes(&bytes[..cut], "t.ckpt").unwrap_err();
+            let e = from_bytes(&bytes[..cut], "t.ckpt").unwrap_err().to_string();
             assert!(e.starts_with("t.ckpt: "), "{e}");
             assert!(e.contains("truncated") || e.contains("magic") || e.contains("corrupt"), "cut {cut}: {e}");
         }
@@ -277,8 +193,8 @@ mod tests {
         }
         let mut b = bytes.clone();
         b[8] = 9;
-        assert!(from_bytes(&b, "v").unwrap_err().contains("version 9"));
-        assert!(from_bytes(b"PNG....", "p").unwrap_err().contains("magic"));
+        assert!(from_bytes(&b, "v").unwrap_err().to_string().contains("version 9"));
+        assert!(from_bytes(b"PNG....", "p").unwrap_err().to_string().contains("magic"));
     }
 
     #[test]

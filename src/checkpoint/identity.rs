@@ -1,0 +1,137 @@
+//! The identity of a render (scene hash, version, size, every option that affects the image) as
+//! a checkpoint [`Header`], and the EXR metadata written from one.
+
+use crate::film::Metadata;
+use crate::integrator::Integrator;
+use crate::scene::build::Scene;
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::collections::BTreeMap;
+
+/// What a checkpoint records besides the moments.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// strata version that wrote it (part of the identity: sample values may change across versions)
+    pub strata_version: String,
+    /// scene file as named on the command line (informative)
+    pub scene: String,
+    /// hash of the scene file's bytes ([`hash_bytes`], hex)
+    pub scene_hash: String,
+    /// every option that affects the image, resolved (spp, seed, samplers, integrator, ...)
+    pub options: BTreeMap<String, serde_json::Value>,
+    /// image width
+    pub width: u32,
+    /// image height
+    pub height: u32,
+    /// the sample range this run was asked for (`--samples`, else 0..spp)
+    pub target: [u32; 2],
+    /// the sample range held
+    pub samples: [u32; 2],
+    /// the dyadic blocks of `samples`, as (k, j)
+    pub blocks: Vec<[u32; 2]>,
+    /// CPU seconds of the worker threads rendering tiles (summed over sessions and parts)
+    pub cpu_seconds: f64,
+    /// wall-clock seconds of rendering (summed over sessions)
+    pub render_seconds: f64,
+    /// rays traced
+    pub rays: u64,
+    /// the files a merged state came from, with their ranges (empty for a render)
+    pub parts: Vec<String>,
+}
+
+impl Header {
+    /// Why a checkpoint with header `self` cannot continue or join a render with header `want`
+    /// (other scene, version, size or options), or None if it can; `label` names `want` in the
+    /// message (e.g. "this render").
+    pub fn mismatch(&self, want: &Header, label: &str) -> Option<String> {
+        if self.scene_hash != want.scene_hash {
+            return Some(format!(
+                "it is of another scene ({} hash {}; {label}: {} hash {})",
+                self.scene, self.scene_hash, want.scene, want.scene_hash
+            ));
+        }
+        if self.strata_version != want.strata_version {
+            return Some(format!(
+                "it was written by strata {} ({label}: {})",
+                self.strata_version, want.strata_version
+            ));
+        }
+        if (self.width, self.height) != (want.width, want.height) {
+            return Some(format!("it is {}x{} ({label}: {}x{})", self.width, self.height, want.width, want.height));
+        }
+        let keys: std::collections::BTreeSet<&String> = self.options.keys().chain(want.options.keys()).collect();
+        let diffs: Vec<String> = keys
+            .into_iter()
+            .filter(|k| self.options.get(*k) != want.options.get(*k))
+            .map(|k| {
+                let show = |v: Option<&serde_json::Value>| v.map_or("(unset)".to_string(), |v| v.to_string());
+                format!("{k} {} ({label}: {})", show(self.options.get(k)), show(want.options.get(k)))
+            })
+            .collect();
+        (!diffs.is_empty()).then(|| format!("it was rendered with other options: {}", diffs.join(", ")))
+    }
+}
+
+/// The identity of a render of `scene` with `it` (scene file hash `file_hash`, `time_budget`: the
+/// spp is not fixed in advance) with empty ranges and totals.
+pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bool) -> Header {
+    let d = &scene.desc;
+    let options: BTreeMap<String, serde_json::Value> = [
+        ("integrator", json!(d.integrator.name())),
+        ("spp", json!(it.spp)),
+        ("seed", json!(it.seed)),
+        ("pixel_sampler", json!(it.pixel_set.kind().name())),
+        ("light_sampler", json!(it.light_set.kind().name())),
+        ("light_samples", json!(it.light_set.n())),
+        ("layout", json!(if time_budget { "time-budget" } else { "spp" })),
+        ("gamma", json!(d.gamma)),
+        ("clamp", json!(it.clamp)),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    Header {
+        strata_version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: d.source.display().to_string(),
+        // The file's bytes and the parsed content (which covers included OBJ and MTL files).
+        scene_hash: format!("{file_hash}-{:016x}", d.content_hash()),
+        options,
+        width: d.width,
+        height: d.height,
+        target: [0, 0],
+        samples: [0, 0],
+        blocks: Vec::new(),
+        cpu_seconds: 0.0,
+        render_seconds: 0.0,
+        rays: 0,
+        parts: Vec::new(),
+    }
+}
+
+/// EXR metadata of a render or merge state: version, scene and its hash, integrator, samplers,
+/// seed, spp held, sample range, total render and CPU seconds, rays, and the parts it came from.
+pub fn header_metadata(h: &Header) -> Metadata {
+    let opt =
+        |k: &str| h.options.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
+    let mut m: Metadata = vec![
+        ("strata.version".into(), h.strata_version.clone()),
+        ("strata.scene".into(), h.scene.clone()),
+        ("strata.scene_hash".into(), h.scene_hash.clone()),
+        ("strata.integrator".into(), opt("integrator")),
+        ("strata.spp".into(), (h.samples[1] - h.samples[0]).to_string()),
+        ("strata.samples".into(), format!("{}..{}", h.samples[0], h.samples[1])),
+        ("strata.seed".into(), opt("seed")),
+        ("strata.pixel_sampler".into(), opt("pixel_sampler")),
+        ("strata.light_sampler".into(), opt("light_sampler")),
+        ("strata.light_samples".into(), opt("light_samples")),
+        ("strata.layout".into(), opt("layout")),
+        ("strata.render_seconds".into(), format!("{:.6}", h.render_seconds)),
+        ("strata.cpu_seconds".into(), format!("{:.6}", h.cpu_seconds)),
+        ("strata.rays".into(), h.rays.to_string()),
+    ];
+    if !h.parts.is_empty() {
+        m.push(("strata.parts".into(), h.parts.join("; ")));
+        m.push(("strata.part_count".into(), h.parts.len().to_string()));
+    }
+    m
+}

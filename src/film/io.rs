@@ -1,0 +1,192 @@
+//! Image files: linear f32 EXR with an optional variance layer and text metadata, an 8-bit gamma
+//! PNG preview, output names, and the atomic file writer they share.
+
+use std::fs::{self, File};
+use std::io::{self, Cursor, Write};
+use std::path::{Path, PathBuf};
+
+/// Key/value metadata written into the EXR header as text attributes (spp, seconds, sampler, seed,
+/// version, ...). Keys must be unique, non-empty, without NUL and not a standard EXR attribute name.
+pub type Metadata = Vec<(String, String)>;
+
+/// An EXR image as read back by [`read_exr`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Linear RGB, row-major, top row first.
+    pub rgb: Vec<[f32; 3]>,
+    /// The "variance" layer (channels `variance.R/G/B`), if the file has all three.
+    pub variance: Option<Vec<[f32; 3]>>,
+    /// All text attributes that are not standard EXR attributes, sorted by key.
+    pub meta: Metadata,
+}
+
+/// Channel names of one RGB triple, in pixel order.
+const RGB: [&str; 3] = ["R", "G", "B"];
+/// Channel-name prefix of the variance layer.
+const VARIANCE_PREFIX: &str = "variance.";
+
+/// Writes a linear full-float (f32) RGB EXR, ZIP-compressed (lossless) scan lines, with an optional
+/// layer "variance" (channels `variance.R/G/B`, e.g. the per-pixel variance of the mean) and `meta`
+/// as string attributes (UTF-8 bytes). Atomic, see [`write_atomic`].
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    variance: Option<&[[f32; 3]]>,
+    meta: &Metadata,
+) -> io::Result<()> {
+    use exr::prelude::*;
+    let bad = |msg: String| io::Error::new(io::ErrorKind::InvalidInput, format!("EXR {}: {msg}", path.display()));
+    let n = width as usize * height as usize;
+    if n == 0 {
+        return Err(bad(format!("empty image {width}x{height}")));
+    }
+    for (what, len) in std::iter::once(("rgb", rgb.len())).chain(variance.map(|v| ("variance", v.len()))) {
+        if len != n {
+            return Err(bad(format!("{what} has {len} pixels, expected {width}x{height}")));
+        }
+    }
+    let mut channels = SmallVec::<[AnyChannel<FlatSamples>; 4]>::new();
+    for (prefix, px) in std::iter::once(("", rgb)).chain(variance.map(|v| (VARIANCE_PREFIX, v))) {
+        for (c, name) in RGB.iter().enumerate() {
+            let samples = FlatSamples::F32(px.iter().map(|p| p[c]).collect());
+            channels.push(AnyChannel::new(format!("{prefix}{name}").as_str(), samples));
+        }
+    }
+    let mut attributes = LayerAttributes::default();
+    for (key, value) in meta {
+        if key.is_empty() || key.contains('\0') {
+            return Err(bad(format!("invalid metadata key {key:?}")));
+        }
+        let value = AttributeValue::Text(Text::from_bytes_unchecked(value.as_bytes().into()));
+        if attributes.other.insert(Text::from_bytes_unchecked(key.as_bytes().into()), value).is_some() {
+            return Err(bad(format!("duplicate metadata key {key:?}")));
+        }
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels),
+    );
+    let mut bytes = Cursor::new(Vec::new());
+    Image::from_layer(layer).write().to_buffered(&mut bytes).map_err(|e| exr_error(e, path))?;
+    write_atomic(path, bytes.get_ref())
+}
+
+/// Reads back an EXR written by [`write_exr`] (any EXR whose first layer has R, G and B channels):
+/// size, RGB, the variance layer if present, and the text attributes.
+pub fn read_exr(path: &Path) -> io::Result<ExrImage> {
+    use exr::prelude::*;
+    let image = read_first_flat_layer_from_file(path).map_err(|e| exr_error(e, path))?;
+    let layer = image.layer_data;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let channel = |name: String| -> Option<Vec<f32>> {
+        let ch = layer.channel_data.list.iter().find(|c| c.name.as_slice() == name.as_bytes())?;
+        Some(ch.sample_data.values_as_f32().collect())
+    };
+    let triple = |prefix: &str| -> Option<Vec<[f32; 3]>> {
+        let [r, g, b] = RGB.map(|name| channel(format!("{prefix}{name}")));
+        let (r, g, b) = (r?, g?, b?);
+        Some((0..width * height).map(|i| [r[i], g[i], b[i]]).collect())
+    };
+    let rgb = triple("").ok_or_else(|| {
+        io::Error::new(io::ErrorKind::InvalidData, format!("EXR {}: no R, G, B channels", path.display()))
+    })?;
+    let text = |t: &Text| String::from_utf8_lossy(t.as_slice()).into_owned();
+    let mut meta: Metadata = layer
+        .attributes
+        .other
+        .iter()
+        .filter_map(|(k, v)| match v {
+            AttributeValue::Text(v) => Some((text(k), text(v))),
+            _ => None,
+        })
+        .collect();
+    meta.sort();
+    Ok(ExrImage { width: width as u32, height: height as u32, rgb, variance: triple(VARIANCE_PREFIX), meta })
+}
+
+/// An `exr` error as an `io::Error` naming the file (I/O errors keep their kind).
+fn exr_error(e: exr::error::Error, path: &Path) -> io::Error {
+    let kind = match &e {
+        exr::error::Error::Io(io) => io.kind(),
+        _ => io::ErrorKind::InvalidData,
+    };
+    io::Error::new(kind, format!("EXR {}: {e}", path.display()))
+}
+
+/// The tone mapping of [`write_png`]: `v^(1/gamma)` clamped to [0, 1], times 255, rounded;
+/// non-finite or negative values map to 0.
+pub fn to_u8(v: f32, gamma: f32) -> u8 {
+    if !v.is_finite() || v <= 0.0 {
+        return 0;
+    }
+    (v.powf(1.0 / gamma).min(1.0) * 255.0).round() as u8
+}
+
+/// Writes an 8-bit RGB PNG preview (no sRGB curve, just [`to_u8`] with `gamma`). Atomic, see
+/// [`write_atomic`].
+pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]], gamma: f32) -> io::Result<()> {
+    if rgb.len() != width as usize * height as usize {
+        let msg = format!("PNG {}: {} pixels, expected {width}x{height}", path.display(), rgb.len());
+        return Err(io::Error::new(io::ErrorKind::InvalidInput, msg));
+    }
+    let data: Vec<u8> = rgb.iter().flat_map(|p| p.map(|v| to_u8(v, gamma))).collect();
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(&data)?;
+    writer.finish()?;
+    write_atomic(path, &bytes)
+}
+
+/// Writes `bytes` to `path` atomically: to `<path>.tmp-<pid>` (created or truncated), fsync, rename
+/// over `path`, then fsync the directory (best effort). On failure the temporary file is removed and
+/// an existing file at `path` is left untouched. Two threads of one process must not write the same
+/// `path` at the same time (they would share the temporary name).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(format!(".tmp-{}", std::process::id()));
+    let tmp = PathBuf::from(tmp);
+    let mut file = File::create(&tmp)?;
+    let result = file.write_all(bytes).and_then(|()| file.sync_all()).and_then(|()| {
+        drop(file);
+        fs::rename(&tmp, path)
+    });
+    if let Err(e) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(e);
+    }
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// `o` without a trailing `.exr` or `.png` (the stem an output path names).
+pub fn stem_of(o: &Path) -> PathBuf {
+    let s = o.to_string_lossy();
+    for ext in [".exr", ".png"] {
+        if let Some(stripped) = s.strip_suffix(ext) {
+            return PathBuf::from(stripped);
+        }
+    }
+    o.to_path_buf()
+}
+
+/// `stem` with `.ext` appended (`out` + `exr` = `out.exr`, keeping any dots in the stem).
+pub fn with_ext(stem: &Path, ext: &str) -> PathBuf {
+    let mut s = stem.as_os_str().to_owned();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}

@@ -1,0 +1,110 @@
+//! The session layer's error: what `strata render`, `reference` and `rays` report (the CLI prints
+//! it after `strata: `). Errors of the layers below are wrapped with their messages unchanged.
+
+use crate::checkpoint::CheckpointError;
+use std::path::PathBuf;
+
+/// Why a render session could not run or write its outputs.
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    /// The scene could not be parsed or built (the scene layer's message).
+    #[error("{0}")]
+    Scene(String),
+    /// The scene file could not be read for its hash.
+    #[error("{}: cannot read scene file: {source}", path.display())]
+    SceneRead {
+        /// the scene file
+        path: PathBuf,
+        /// the I/O error
+        source: std::io::Error,
+    },
+    /// `--camera` does not parse.
+    #[error("{0}")]
+    Camera(String),
+    /// `--size` with a zero side.
+    #[error("--size {w}x{h}: width and height must be positive")]
+    SizeNotPositive {
+        /// width asked
+        w: u32,
+        /// height asked
+        h: u32,
+    },
+    /// A command-line value above a resource cap (`--size`, `--spp`, `--light-samples`).
+    #[error("--{flag} {value} exceeds the limit of {max}{unit} ({hint})")]
+    OverLimit {
+        /// the flag without dashes
+        flag: &'static str,
+        /// the value as given
+        value: String,
+        /// the cap
+        max: u64,
+        /// unit after the cap ("" or " pixels per side", " pixels")
+        unit: &'static str,
+        /// how to raise the cap
+        hint: String,
+    },
+    /// `--max-depth` outside its range.
+    #[error("--max-depth {depth} is outside -1..={max} ({hint})")]
+    MaxDepth {
+        /// depth asked
+        depth: i32,
+        /// the cap
+        max: i32,
+        /// how to raise the cap
+        hint: String,
+    },
+    /// `--time-budget` not a positive number.
+    #[error("--time-budget {0}: expected a positive number of seconds")]
+    TimeBudget(f64),
+    /// `--checkpoint-every` negative or not finite.
+    #[error("--checkpoint-every {0}: expected a number of seconds >= 0")]
+    CheckpointEvery(f64),
+    /// `--samples A..B` outside the spp.
+    #[error("--samples {a}..{b}: expected A < B <= spp ({cap})")]
+    Samples {
+        /// start asked
+        a: u32,
+        /// end asked
+        b: u32,
+        /// the spp cap
+        cap: u32,
+    },
+    /// `--resume` of a checkpoint of another render.
+    #[error("{}: cannot resume: {why}", path.display())]
+    ResumeMismatch {
+        /// the checkpoint
+        path: PathBuf,
+        /// what differs
+        why: String,
+    },
+    /// `--resume` of a checkpoint whose samples do not start the requested range.
+    #[error("{}: cannot resume: it holds samples {}..{}, which do not start the requested range {}..{}", path.display(), have[0], have[1], target[0], target[1])]
+    ResumeRange {
+        /// the checkpoint
+        path: PathBuf,
+        /// the samples it holds
+        have: [u32; 2],
+        /// the range asked for
+        target: [u32; 2],
+    },
+    /// Reading or writing a checkpoint.
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    /// The worker pool could not start.
+    #[error(transparent)]
+    ThreadPool(#[from] crate::render::RenderError),
+    /// An output file (image, stats) could not be written.
+    #[error("{}: {source}", path.display())]
+    Output {
+        /// the file
+        path: PathBuf,
+        /// the I/O error
+        source: std::io::Error,
+    },
+    /// The stats JSON did not serialize.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// A signal handler could not be installed.
+    #[error("signal handler: {0}")]
+    Signal(std::io::Error),
+}

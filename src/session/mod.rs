@@ -1,0 +1,29 @@
+//! The front end's session layer: what one `strata render` / `reference` / `rays` invocation does,
+//! as library functions (the binary, tests and benches share them). `main.rs` only parses the
+//! command line into [`RenderOptions`] and calls these.
+//!
+//! - [`options`] — [`RenderOptions`] and defaults;
+//! - [`scene`] — scene loading with the overrides, [`prepare`] (scene and integrator), scene hash;
+//! - [`pass`] — the pass loop ([`render_to_film`]) with checkpoints, resume, budget, signals;
+//! - [`progress`] — the progress bar (`indicatif`) or plain lines;
+//! - [`output`] — output naming, EXR metadata, [`run_render`];
+//! - [`stats`] — the `--stats` JSON and the summary line;
+//! - [`rays`] — `strata rays`;
+//! - [`error`] — [`SessionError`].
+
+pub mod error;
+pub mod options;
+pub mod output;
+pub mod pass;
+pub mod progress;
+pub mod rays;
+pub mod scene;
+pub mod stats;
+
+pub use error::SessionError;
+pub use options::{RenderOptions, DEFAULT_CHECKPOINT_EVERY, DEFAULT_SCENE};
+pub use output::{metadata, output_stem, run_render};
+pub use pass::{render_to_film, stop_on_signals, RenderOutput};
+pub use rays::{rates_table, run_rays};
+pub use scene::{is_obj, load_scene, parse_camera, prepare, scene_hash};
+pub use stats::{stats_json, summary};

@@ -1,0 +1,73 @@
+//! The options of `strata render` (and of `reference`, `rays`, `compare` variants), and defaults.
+
+use crate::sampler::SamplerKind;
+use crate::scene::desc::{CameraDesc, ImportanceSampling, IntegratorKind, Nee};
+use crate::scene::parse::Limits;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// The built-in default scene (a Cornell box written for strata).
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/cornell.test");
+
+/// Default seconds between two checkpoints.
+pub const DEFAULT_CHECKPOINT_EVERY: f64 = 300.0;
+
+/// Options of `strata render`.
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions {
+    /// scene file; None renders the built-in Cornell box
+    pub scene: Option<PathBuf>,
+    /// samples per pixel (default: the scene's `spp`)
+    pub spp: Option<u32>,
+    /// image size override, keeping the camera
+    pub size: Option<(u32, u32)>,
+    /// base seed
+    pub seed: u64,
+    /// worker threads (0 = all cores)
+    pub threads: usize,
+    /// light sample layout (default: the scene's `lightstratify`)
+    pub light_sampler: Option<SamplerKind>,
+    /// light samples per light (default: the scene's `lightsamples`)
+    pub light_samples: Option<u32>,
+    /// pixel sample layout (default stratified)
+    pub pixel_sampler: Option<SamplerKind>,
+    /// output stem: writes OUT.exr and OUT.png (default: the scene's `output` name)
+    pub out: Option<PathBuf>,
+    /// JSON statistics file
+    pub stats: Option<PathBuf>,
+    /// integrator override
+    pub integrator: Option<IntegratorKind>,
+    /// print progress (spp done, Mrays/s, ETA) on stderr while rendering
+    pub progress: bool,
+    /// run the general kernel instead of the one specialized for the scene's features
+    pub general_kernel: bool,
+    /// path tracer: clamp each pixel sample's largest channel to this value (biased; None = off)
+    pub clamp: Option<f32>,
+    /// checkpoint file: the accumulated state is written there every `checkpoint_every` seconds
+    /// and at the end (default with `--samples` or on interruption: OUT.ckpt)
+    pub checkpoint: Option<PathBuf>,
+    /// seconds between checkpoints (default [`DEFAULT_CHECKPOINT_EVERY`]; 0 = after every pass)
+    pub checkpoint_every: Option<f64>,
+    /// continue the render held in this checkpoint (same scene and options, else refused)
+    pub resume: Option<PathBuf>,
+    /// render only sample indices A..B of the spp (a shard for `strata merge`)
+    pub samples: Option<(u32, u32)>,
+    /// render whole passes until this many seconds are spent (independent pixel and path layouts;
+    /// `--spp`, if given, caps the samples)
+    pub time_budget: Option<f64>,
+    /// set (e.g. by SIGINT/SIGTERM) to stop after the current pass, checkpoint and write the image
+    pub stop: Option<Arc<AtomicBool>>,
+    /// camera override (`--camera`), for `.obj` and `.test` scenes alike
+    pub camera: Option<CameraDesc>,
+    /// path tracer: direction sampling override (default: the scene's `importancesampling`)
+    pub importance_sampling: Option<ImportanceSampling>,
+    /// path tracer: next event estimation override (default: the scene's `nexteventestimation`)
+    pub nee: Option<Nee>,
+    /// path tracer: Russian roulette override (default: the scene's `russianroulette`)
+    pub russian_roulette: Option<bool>,
+    /// maximum depth override, -1 = unbounded (default: the scene's `maxdepth`)
+    pub max_depth: Option<i32>,
+    /// resource caps (`--limit NAME=VALUE`), applied to the scene file and to the overrides
+    pub limits: Limits,
+}

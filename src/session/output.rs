@@ -1,0 +1,50 @@
+//! The outputs of `strata render`: the output stem, EXR metadata, OUT.exr (with a variance layer),
+//! OUT.png and the `--stats` file.
+
+use super::stats::stats_json;
+use super::{render_to_film, RenderOptions, RenderOutput, SessionError};
+use crate::checkpoint::header_metadata;
+use crate::film::{self, stem_of, with_ext, Metadata};
+use crate::scene::desc::SceneDesc;
+use std::path::{Path, PathBuf};
+
+/// Output stem: `-o OUT`, else the scene's `output` file name without extension (directories
+/// stripped: a scene file never chooses where we write), else "strata".
+pub fn output_stem(opts: &RenderOptions, desc: &SceneDesc) -> PathBuf {
+    if let Some(o) = &opts.out {
+        return stem_of(o);
+    }
+    desc.output
+        .as_deref()
+        .and_then(|n| Path::new(n).file_stem())
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("strata"))
+}
+
+/// Metadata written into the EXR header of a render ([`header_metadata`] and the thread count).
+pub fn metadata(out: &RenderOutput) -> Metadata {
+    let mut m = header_metadata(&out.header);
+    m.push(("strata.threads".into(), out.stats.threads.to_string()));
+    m
+}
+
+/// `strata render`: render, write OUT.exr (with a variance layer) and OUT.png, and the stats JSON.
+pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
+    let mut out = render_to_film(opts)?;
+    let stem = output_stem(opts, &out.scene.desc);
+    let (w, h) = (out.film.width, out.film.height);
+    let mean = out.film.mean();
+    let var = out.film.variance_of_mean();
+    let exr = with_ext(&stem, "exr");
+    film::write_exr(&exr, w, h, &mean, Some(&var), &metadata(&out))
+        .map_err(|source| SessionError::Output { path: exr.clone(), source })?;
+    let png = with_ext(&stem, "png");
+    film::write_png(&png, w, h, &mean, out.scene.desc.gamma)
+        .map_err(|source| SessionError::Output { path: png.clone(), source })?;
+    out.out = Some(stem);
+    if let Some(p) = &opts.stats {
+        let text = serde_json::to_string_pretty(&stats_json(&out))?;
+        film::write_atomic(p, text.as_bytes()).map_err(|source| SessionError::Output { path: p.clone(), source })?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,156 @@
+//! The pass loop of a render session: the sample range in passes of about [`PASS_SECONDS`],
+//! resuming a checkpoint, writing one periodically and at the end, stopping on a signal or when
+//! a time budget is spent.
+
+use super::progress::Progress;
+use super::scene::{prepare, scene_hash};
+use super::{output_stem, RenderOptions, SessionError, DEFAULT_CHECKPOINT_EVERY};
+use crate::checkpoint::{self, Header};
+use crate::film::{with_ext, Film};
+use crate::integrator::Integrator;
+use crate::render::{self, RenderStats};
+use crate::scene::build::Scene;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Aimed wall-clock seconds of one pass (passes only schedule the work: the image is the same
+/// whatever their sizes; shorter passes make checkpoints and Ctrl-C more timely).
+pub const PASS_SECONDS: f64 = 2.0;
+
+/// Everything a render produced.
+pub struct RenderOutput {
+    /// the scene as built
+    pub scene: Scene,
+    /// the integrator settings used
+    pub integrator: Integrator,
+    /// accumulated samples
+    pub film: Film,
+    /// timing and counters
+    pub stats: RenderStats,
+    /// the output stem written to, if any
+    pub out: Option<PathBuf>,
+    /// identity and totals over every session of this render (as in its checkpoint)
+    pub header: Header,
+    /// the checkpoint written last, if any
+    pub checkpoint: Option<PathBuf>,
+    /// stopped by the `stop` flag (a signal) before the sample range was done
+    pub interrupted: bool,
+}
+
+/// Renders without writing images: scene build, integrator set-up, the sample range in passes
+/// (resuming `opts.resume`, writing `opts.checkpoint` periodically and at the end, stopping
+/// early on `opts.stop` or when `opts.time_budget` is spent).
+pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
+    let (scene, mut integrator) = prepare(opts)?;
+    if let Some(b) = opts.time_budget {
+        if !(b > 0.0 && b.is_finite()) {
+            return Err(SessionError::TimeBudget(b));
+        }
+        // The number of samples is not known in advance: layouts that need it become independent.
+        integrator = integrator.resampled(None);
+    }
+    let every = opts.checkpoint_every.unwrap_or(DEFAULT_CHECKPOINT_EVERY);
+    if !(every >= 0.0 && every.is_finite()) {
+        return Err(SessionError::CheckpointEvery(every));
+    }
+    let cap = if opts.time_budget.is_some() { opts.spp.unwrap_or(u32::MAX) } else { integrator.spp };
+    let target = match opts.samples {
+        Some((a, b)) if a < b && b <= cap => a..b,
+        Some((a, b)) => return Err(SessionError::Samples { a, b, cap }),
+        None => 0..cap,
+    };
+    let mut header = checkpoint::identity(&scene_hash(opts)?, &scene, &integrator, opts.time_budget.is_some());
+    header.target = [target.start, target.end];
+    let mut film = Film::new(scene.desc.width, scene.desc.height);
+    if let Some(path) = &opts.resume {
+        let (h, f) = checkpoint::read(path)?;
+        if let Some(why) = h.mismatch(&header, "this render") {
+            return Err(SessionError::ResumeMismatch { path: path.clone(), why });
+        }
+        let have = f.samples();
+        if !have.is_empty() && (have.start != target.start || have.end > target.end) {
+            return Err(SessionError::ResumeRange {
+                path: path.clone(),
+                have: [have.start, have.end],
+                target: [target.start, target.end],
+            });
+        }
+        (header.cpu_seconds, header.render_seconds, header.rays) = (h.cpu_seconds, h.render_seconds, h.rays);
+        film = f;
+    }
+    let ckpt_path = opts.checkpoint.clone().or_else(|| opts.resume.clone());
+    let pool = render::thread_pool(opts.threads)?;
+    let (w, h) = (scene.desc.width, scene.desc.height);
+    let tiles = u64::from(w.div_ceil(render::TILE)) * u64::from(h.div_ceil(render::TILE));
+    let mut progress = Progress::new(opts.progress, &target, film.samples().len() as u32, opts.time_budget, tiles);
+    let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
+    let started = Instant::now();
+    let mut last_ckpt = Instant::now();
+    let mut s = if film.samples().is_empty() { target.start } else { film.samples().end };
+    let mut pass = render::SAMPLE_BATCH;
+    let mut interrupted = false;
+    while s < target.end {
+        if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
+            interrupted = true;
+            break;
+        }
+        let mut n = pass.min(target.end - s);
+        if let Some(b) = opts.time_budget {
+            let left = b - started.elapsed().as_secs_f64();
+            if left <= 0.0 {
+                break;
+            }
+            // Whole passes that fit in what is left of the budget (at least one sample).
+            if let Some(per) = progress.secs_per_spp() {
+                n = n.min(((left / per) as u32).max(1));
+            }
+        }
+        let st = progress.watch(n, started, |tiles_done| {
+            render::render_counted(&scene, &integrator, &mut film, s..s + n, &pool, tiles_done)
+        });
+        s += n;
+        stats.seconds += st.seconds;
+        stats.cpu_seconds += st.cpu_seconds;
+        stats.counters.merge(&st.counters);
+        header.cpu_seconds += st.cpu_seconds;
+        header.render_seconds += st.seconds;
+        header.rays += st.counters.total_rays();
+        progress.pass(n, &st, started.elapsed().as_secs_f64());
+        // Next pass: about PASS_SECONDS, growing at most 4x, whole wavefront batches when large.
+        let per = st.seconds / f64::from(n);
+        let want = ((PASS_SECONDS / per.max(1e-9)) as u32).clamp(1, pass.saturating_mul(4));
+        pass = if want >= render::SAMPLE_BATCH { want / render::SAMPLE_BATCH * render::SAMPLE_BATCH } else { want };
+        if let Some(p) = &ckpt_path {
+            if s < target.end && last_ckpt.elapsed().as_secs_f64() >= every {
+                checkpoint::write(p, &header, &film)?;
+                last_ckpt = Instant::now();
+            }
+        }
+    }
+    progress.finish();
+    let stem = output_stem(opts, &scene.desc);
+    let final_ckpt = match ckpt_path {
+        Some(p) => Some(p),
+        None if interrupted || opts.samples.is_some() => Some(with_ext(&stem, "ckpt")),
+        None => None,
+    };
+    if let Some(p) = &final_ckpt {
+        checkpoint::write(p, &header, &film)?;
+    }
+    header = checkpoint::header_for(header, &film);
+    Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted })
+}
+
+/// Sets the returned flag on SIGINT or SIGTERM (a render checks it between passes, then writes a
+/// checkpoint and the image); a second signal while the flag is set exits at once.
+pub fn stop_on_signals() -> Result<Arc<AtomicBool>, SessionError> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        signal_hook::flag::register_conditional_shutdown(sig, 130, Arc::clone(&flag)).map_err(SessionError::Signal)?;
+        signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(SessionError::Signal)?;
+    }
+    Ok(flag)
+}

@@ -1,0 +1,114 @@
+//! Scene loading with the command-line overrides applied, and the scene and integrator of a
+//! render built from its options.
+
+use super::{RenderOptions, SessionError, DEFAULT_SCENE};
+use crate::checkpoint;
+use crate::integrator::kernel::Kernel;
+use crate::integrator::Integrator;
+use crate::scene::build::Scene;
+use crate::scene::desc::{CameraDesc, SceneDesc};
+use crate::scene::parse::{self, Limits};
+use std::path::Path;
+
+/// A `--flag` value over the resource cap `field` of `limits`.
+fn over(flag: &'static str, value: String, max: u64, unit: &'static str, field: &str) -> SessionError {
+    SessionError::OverLimit { flag, value, max, unit, hint: parse::limit_hint(field) }
+}
+
+/// Parses the scene named in `opts` (or the built-in one) and applies the size override.
+pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
+    let limits = opts.limits;
+    let scene_err = |e: &dyn std::fmt::Display| SessionError::Scene(e.to_string());
+    let mut desc = match &opts.scene {
+        Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits).map_err(|e| scene_err(&e))?,
+        Some(p) => parse::parse_file(p, &limits).map_err(|e| scene_err(&e))?,
+        None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits).map_err(|e| scene_err(&e))?,
+    };
+    if let Some((w, h)) = opts.size {
+        if w == 0 || h == 0 {
+            return Err(SessionError::SizeNotPositive { w, h });
+        }
+        if w.max(h) > limits.max_side {
+            return Err(over("size", format!("{w}x{h}"), limits.max_side.into(), " pixels per side", "max_side"));
+        }
+        if u64::from(w) * u64::from(h) > limits.max_pixels {
+            return Err(over("size", format!("{w}x{h}"), limits.max_pixels, " pixels", "max_pixels"));
+        }
+        desc.width = w;
+        desc.height = h;
+    }
+    if let Some(k) = opts.integrator {
+        desc.integrator = k;
+    }
+    if let Some(c) = opts.camera {
+        desc.camera = Some(c);
+    }
+    if let Some(s) = opts.importance_sampling {
+        desc.importance_sampling = s;
+    }
+    if let Some(n) = opts.nee {
+        desc.nee = n;
+    }
+    if let Some(r) = opts.russian_roulette {
+        desc.russian_roulette = r;
+    }
+    if let Some(d) = opts.max_depth {
+        if d < -1 || i64::from(d) > i64::from(limits.max_depth) {
+            let hint = parse::limit_hint("max_depth");
+            return Err(SessionError::MaxDepth { depth: d, max: limits.max_depth, hint });
+        }
+        desc.max_depth = d;
+    }
+    Ok(desc)
+}
+
+/// A scene path naming a Wavefront OBJ (extension `.obj`, any case) rather than a `.test` file.
+pub fn is_obj(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+}
+
+/// `--camera "ex ey ez cx cy cz ux uy uz fovy"` (the format's `camera` arguments), checked as the
+/// `.test` parser checks them.
+pub fn parse_camera(s: &str) -> Result<CameraDesc, SessionError> {
+    let text = format!("camera {}", s.replace(',', " "));
+    parse::parse_str(&text, Path::new("--camera"), &Limits::default())
+        .map_err(|e| SessionError::Camera(e.message))?
+        .camera
+        .ok_or_else(|| SessionError::Camera("--camera expects 10 numbers".to_string()))
+}
+
+/// Parses, checks and builds the scene and the integrator of `opts`.
+pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError> {
+    let desc = load_scene(opts)?;
+    let spp = opts.spp.unwrap_or(desc.spp).max(1);
+    if spp > opts.limits.max_spp {
+        return Err(over("spp", spp.to_string(), opts.limits.max_spp.into(), "", "max_spp"));
+    }
+    if let Some(n) = opts.light_samples.filter(|&n| n > opts.limits.max_light_samples) {
+        return Err(over(
+            "light-samples",
+            n.to_string(),
+            opts.limits.max_light_samples.into(),
+            "",
+            "max_light_samples",
+        ));
+    }
+    let scene = Scene::build(desc).map_err(|e| SessionError::Scene(e.to_string()))?;
+    let mut integrator =
+        Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    if opts.general_kernel {
+        integrator.kernel = Kernel::GENERAL;
+    }
+    integrator.clamp = opts.clamp;
+    Ok((scene, integrator))
+}
+
+/// Hash of the scene's bytes (the file as read, or the built-in scene's text).
+pub fn scene_hash(opts: &RenderOptions) -> Result<String, SessionError> {
+    Ok(match &opts.scene {
+        Some(p) => checkpoint::hash_bytes(
+            &std::fs::read(p).map_err(|source| SessionError::SceneRead { path: p.clone(), source })?,
+        ),
+        None => checkpoint::hash_bytes(DEFAULT_SCENE.as_bytes()),
+    })
+}

@@ -1,0 +1,88 @@
+//! The statistics of a render, in one place: the `--stats` JSON and the one-line summary.
+
+use super::RenderOutput;
+use crate::integrator::kernel::features_json;
+use crate::scene::desc::IntegratorKind;
+use serde_json::json;
+
+/// The `--stats` JSON.
+pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
+    let d = &out.scene.desc;
+    let c = &out.stats.counters;
+    json!({
+        "scene": d.source.display().to_string(),
+        "integrator": d.integrator.name(),
+        "seconds": out.stats.seconds,
+        "spp": out.film.samples().len(),
+        "samples": [out.header.samples[0], out.header.samples[1]],
+        "cpu_seconds": out.stats.cpu_seconds,
+        "total_render_seconds": out.header.render_seconds,
+        "total_cpu_seconds": out.header.cpu_seconds,
+        "interrupted": out.interrupted,
+        "checkpoint": out.checkpoint.as_ref().map(|p| p.display().to_string()),
+        "layout": out.header.options.get("layout"),
+        "width": d.width,
+        "height": d.height,
+        "seed": out.integrator.seed,
+        "threads": out.stats.threads,
+        "pixel_sampler": out.integrator.pixel_set.kind().name(),
+        "light_sampler": out.integrator.light_set.kind().name(),
+        "light_samples": out.integrator.light_set.n(),
+        "rays": { "camera": c.camera, "shadow": c.shadow, "bounce": c.bounce, "total": c.total_rays() },
+        "mrays_per_sec": out.stats.mrays_per_sec(),
+        "packets": { "camera": c.camera_packets, "bounce": c.bounce_packets, "shadow": c.shadow_packets },
+        "occupancy": c.occupancy(),
+        "occupancy_by_kind": { "bounce": c.bounce_occupancy(), "shadow": c.shadow_occupancy() },
+        "mean_path_length": c.mean_path_length(),
+        "max_depth": out.integrator.max_depth,
+        "nee": out.integrator.nee.name(),
+        "russian_roulette": out.integrator.russian_roulette,
+        "importance_sampling": out.integrator.strategy.name(),
+        "nonfinite_samples": c.nonfinite,
+        "clamp": out.integrator.clamp,
+        "biased": out.integrator.clamp.is_some(),
+        "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
+        "kernel": out.integrator.kernel.name(d.integrator),
+        "version": env!("CARGO_PKG_VERSION"),
+    })
+}
+
+/// One-line summary printed after a render.
+pub fn summary(out: &RenderOutput) -> String {
+    let d = &out.scene.desc;
+    let c = &out.stats.counters;
+    let it = &out.integrator;
+    // The settings that matter for this integrator only.
+    let technique = match d.integrator {
+        IntegratorKind::Direct => format!(" (light {} x{})", it.light_set.kind().name(), it.light_set.n()),
+        IntegratorKind::PathTracer => {
+            format!(
+                " (nee {}, {} sampling, rr {}, maxdepth {})",
+                it.nee.name(),
+                it.strategy.name(),
+                if it.russian_roulette { "on" } else { "off" },
+                it.max_depth
+            ) + &it.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default()
+        }
+        _ => String::new(),
+    };
+    format!(
+        "{} {}x{} {} spp {}{}, kernel {}: {:.3} s, {:.2} Mrays/s (camera {}, bounce {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
+        d.source.display(),
+        d.width,
+        d.height,
+        out.film.samples().len(),
+        d.integrator.name(),
+        technique,
+        it.kernel.name(d.integrator),
+        out.stats.seconds,
+        out.stats.mrays_per_sec(),
+        c.camera,
+        c.bounce,
+        c.shadow,
+        100.0 * c.occupancy(),
+        out.stats.threads,
+        c.nonfinite,
+        out.out.as_ref().map(|p| format!(" -> {}.exr/.png", p.display())).unwrap_or_default()
+    )
+}
