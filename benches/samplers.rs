@@ -63,7 +63,7 @@ fn samplers(c: &mut Criterion) {
 }
 
 fn uniforms() -> (Vec<[f32; 2]>, Vec<[F8; 2]>) {
-    let set = PointSet::new(SamplerKind::Independent, 1);
+    let set = PointSet::new(SamplerKind::INDEPENDENT, 1);
     let u: Vec<[f32; 2]> = (0..POINTS).map(|i| set.point(i, 0, 0, 0, 1)).collect();
     let u8: Vec<[F8; 2]> = u
         .chunks(8)
@@ -147,7 +147,7 @@ fn techniques() -> Vec<(&'static str, String, RenderOptions, u32)> {
         RenderOptions { integrator: Some(IntegratorKind::Direct), ..base.clone() }
     };
     let direct = RenderOptions {
-        pixel_sampler: Some(SamplerKind::GridCenter),
+        pixel_sampler: Some(SamplerKind::GRID_CENTER),
         light_samples: Some(9),
         size: Some((128, 128)),
         ..direct
@@ -220,7 +220,7 @@ fn equal_time(c: &mut Criterion) {
         if reference.as_ref().map(|r| r.0) != Some(*table) {
             let r = if *spp == 1 {
                 let o = RenderOptions {
-                    light_sampler: Some(SamplerKind::Stratified),
+                    light_sampler: Some(SamplerKind::STRATIFIED),
                     light_samples: Some(1024),
                     threads: 0,
                     ..opts.clone()
