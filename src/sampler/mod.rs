@@ -37,6 +37,7 @@ mod independent;
 pub mod pmj;
 pub mod sobol;
 mod stratified;
+mod zsobol;
 
 pub use grid::strata_shape;
 pub use halton::radical_inverse;
@@ -72,6 +73,7 @@ pub const SAMPLERS: &[SamplerInfo] = &[
     SamplerInfo::new("sobol", &[], "Owen-scrambled Sobol'", &sobol::Sobol).period(1 << 32),
     SamplerInfo::new("pmj02", &["pmj"], "progressive multi-jittered (0,2)", &pmj::Pmj02)
         .period(pmj::TABLE_POINTS as u64),
+    SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &zsobol::ZSobol),
 ];
 
 /// One registered sampler: its names, what it declares about itself, and its layout.
