@@ -58,6 +58,20 @@ fn samplers(c: &mut Criterion) {
                 acc
             })
         });
+        g.bench_function(format!("{}/stream_x8", kind.name()), |b| {
+            b.iter(|| {
+                let mut acc = F8::splat(0.0);
+                // One stream = 8 pixels (lanes) x the 16 points of their sets, as light sampling does.
+                for i in 0..POINTS / 128 {
+                    let st = set.stream_x8(black_box(lane + U8::splat(i * 8)), U8::splat(0), 3, 7);
+                    for k in 0..16 {
+                        let (x, y) = st.point(k);
+                        acc += x + y;
+                    }
+                }
+                acc
+            })
+        });
     }
     g.finish();
 }

@@ -549,3 +549,45 @@ fn independent_points_are_uniform() {
     println!("chi-square 2D {c2:.1}, 1D {c1:.1}, critical {crit:.1}");
     assert!(c2 < crit && c1 < crit, "chi2 {c2} {c1} >= {crit}");
 }
+
+#[test]
+fn registry_names_are_unique_and_parse_to_their_kind() {
+    let mut spellings = Vec::new();
+    for kind in SamplerKind::ALL {
+        let info = kind.info();
+        assert_eq!(SamplerKind::named(info.name), kind);
+        for name in std::iter::once(&info.name).chain(info.aliases) {
+            assert_eq!(*name, name.trim().to_ascii_lowercase(), "registry spellings are lower case");
+            assert_eq!(SamplerKind::parse(&name.to_ascii_uppercase()), Some(kind), "{name}");
+            spellings.push(*name);
+        }
+        assert!(!info.description.is_empty());
+        assert!(SamplerKind::help_list().contains(info.name));
+    }
+    let count = spellings.len();
+    spellings.sort_unstable();
+    spellings.dedup();
+    assert_eq!(spellings.len(), count, "a spelling is registered twice");
+    assert!(SamplerKind::help_list().starts_with("independent (random), stratified, grid-center (biased), halton"));
+}
+
+/// Every unbiased registered layout: the points of 16384 pixels (one per pixel, k = pixel mod 16 of
+/// a 16-point set) are uniform over 16 x 16 cells by chi-square.
+#[test]
+fn every_unbiased_layout_is_uniform() {
+    let crit = chi2_crit_9999(255.0);
+    for kind in SamplerKind::ALL.into_iter().filter(|k| !k.is_biased()) {
+        for width in [0, 100] {
+            let set = PointSet::for_image(kind, 16, width);
+            let mut hist = vec![0u32; 256];
+            for p in 0..16_384 {
+                let [x, y] = set.point(p, 1, 5, p % 16, 31);
+                hist[(cell(y, 16) * 16 + cell(x, 16)) as usize] += 1;
+            }
+            let e = 64.0;
+            let chi2: f64 = hist.iter().map(|&c| (f64::from(c) - e).powi(2) / e).sum();
+            println!("{}: chi-square {chi2:.1} (critical {crit:.1})", kind.name());
+            assert!(chi2 < crit, "{kind:?} width {width}: chi2 {chi2} >= {crit}");
+        }
+    }
+}
