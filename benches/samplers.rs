@@ -58,12 +58,26 @@ fn samplers(c: &mut Criterion) {
                 acc
             })
         });
+        g.bench_function(format!("{}/stream_x8", kind.name()), |b| {
+            b.iter(|| {
+                let mut acc = F8::splat(0.0);
+                // One stream = 8 pixels (lanes) x the 16 points of their sets, as light sampling does.
+                for i in 0..POINTS / 128 {
+                    let st = set.stream_x8(black_box(lane + U8::splat(i * 8)), U8::splat(0), 3, 7);
+                    for k in 0..16 {
+                        let (x, y) = st.point(k);
+                        acc += x + y;
+                    }
+                }
+                acc
+            })
+        });
     }
     g.finish();
 }
 
 fn uniforms() -> (Vec<[f32; 2]>, Vec<[F8; 2]>) {
-    let set = PointSet::new(SamplerKind::Independent, 1);
+    let set = PointSet::new(SamplerKind::INDEPENDENT, 1);
     let u: Vec<[f32; 2]> = (0..POINTS).map(|i| set.point(i, 0, 0, 0, 1)).collect();
     let u8: Vec<[F8; 2]> = u
         .chunks(8)
@@ -147,7 +161,7 @@ fn techniques() -> Vec<(&'static str, String, RenderOptions, u32)> {
         RenderOptions { integrator: Some(IntegratorKind::Direct), ..base.clone() }
     };
     let direct = RenderOptions {
-        pixel_sampler: Some(SamplerKind::GridCenter),
+        pixel_sampler: Some(SamplerKind::GRID_CENTER),
         light_samples: Some(9),
         size: Some((128, 128)),
         ..direct
@@ -220,7 +234,7 @@ fn equal_time(c: &mut Criterion) {
         if reference.as_ref().map(|r| r.0) != Some(*table) {
             let r = if *spp == 1 {
                 let o = RenderOptions {
-                    light_sampler: Some(SamplerKind::Stratified),
+                    light_sampler: Some(SamplerKind::STRATIFIED),
                     light_samples: Some(1024),
                     threads: 0,
                     ..opts.clone()

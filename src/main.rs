@@ -133,15 +133,18 @@ struct RenderArgs {
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     threads: usize,
-    /// Light sample layout: independent (random), stratified, grid-center (biased), halton, sobol, pmj02.
-    #[arg(long, value_parser = parse_sampler)]
+    // Light sample layout; the help lists the sampler registry.
+    #[arg(long, value_parser = parse_sampler, help = format!("Light sample layout: {}", SamplerKind::help_list()))]
     light_sampler: Option<SamplerKind>,
     /// Light samples per light (default: the scene's lightsamples).
     #[arg(long)]
     light_samples: Option<u32>,
-    /// Pixel sample layout over a pixel's spp samples (default stratified; grid-center with
-    /// --spp 1 puts the sample at the pixel centre).
-    #[arg(long, value_parser = parse_sampler)]
+    // Pixel sample layout; the help lists the sampler registry.
+    #[arg(long, value_parser = parse_sampler, help = format!(
+        "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
+         puts the sample at the pixel centre)",
+        SamplerKind::help_list()
+    ))]
     pixel_sampler: Option<SamplerKind>,
     /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
     #[arg(long, value_parser = parse_integrator)]
@@ -271,8 +274,7 @@ fn parse_range(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
-    SamplerKind::parse(s)
-        .ok_or_else(|| format!("unknown sampler `{s}` (independent, stratified, grid-center, halton, sobol, pmj02)"))
+    SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` ({})", SamplerKind::names()))
 }
 
 fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {

@@ -18,7 +18,7 @@ fn analyticdirect_matches_independent_quadrature() {
     let path = c.join("hw2/analytic.test");
     let (w, h) = (160u32, 120u32);
     let mut o = opts(path.clone(), w, h, 1);
-    o.pixel_sampler = Some(SamplerKind::GridCenter);
+    o.pixel_sampler = Some(SamplerKind::GRID_CENTER);
     let img = means(&film(&o));
     let desc = parse_file(&path, &Limits::default()).unwrap();
     assert_eq!(desc.integrator, IntegratorKind::AnalyticDirect);
@@ -162,7 +162,7 @@ fn stratified_beats_random_at_equal_samples() {
             / (3 * d.len()) as f64
     };
     let (random, strat, halton) =
-        (mse(SamplerKind::Independent), mse(SamplerKind::Stratified), mse(SamplerKind::Halton));
+        (mse(SamplerKind::INDEPENDENT), mse(SamplerKind::STRATIFIED), mse(SamplerKind::HALTON));
     eprintln!("MSE against exact: independent {random:.3e}, stratified {strat:.3e} (ratio {:.2}), halton {halton:.3e} (ratio {:.2})", random / strat, random / halton);
     assert!(random / strat > 3.0, "stratified should beat random by 3x: {random} vs {strat}");
     assert!(random / halton > 3.0, "halton should beat random by 3x: {random} vs {halton}");

@@ -217,7 +217,7 @@ fn hand_built_scene_matches_f64_reference() {
     let o = RenderOptions {
         scene: Some(path),
         spp: Some(1),
-        pixel_sampler: Some(SamplerKind::GridCenter),
+        pixel_sampler: Some(SamplerKind::GRID_CENTER),
         threads: 2,
         ..Default::default()
     };
@@ -281,7 +281,7 @@ fn maxdepth_limits_mirror_recursion() {
         let o = RenderOptions {
             scene: Some(path),
             spp: Some(1),
-            pixel_sampler: Some(SamplerKind::GridCenter),
+            pixel_sampler: Some(SamplerKind::GRID_CENTER),
             threads: 1,
             ..Default::default()
         };

@@ -79,14 +79,14 @@ impl Integrator {
         let d = &scene.desc;
         let n_light = light_samples.unwrap_or(d.light_samples).max(1);
         let light_kind =
-            light_sampler.unwrap_or(if d.light_stratify { SamplerKind::Stratified } else { SamplerKind::Independent });
+            light_sampler.unwrap_or(if d.light_stratify { SamplerKind::STRATIFIED } else { SamplerKind::INDEPENDENT });
         Self {
             kind: d.integrator,
             spp: spp.max(1),
             seed,
-            pixel_set: PointSet::new(pixel_sampler.unwrap_or(SamplerKind::Stratified), spp.max(1)),
-            light_set: PointSet::new(light_kind, n_light),
-            path_set: GridTable::new(PointSet::new(SamplerKind::Stratified, spp.max(1))),
+            pixel_set: PointSet::for_image(pixel_sampler.unwrap_or(SamplerKind::STRATIFIED), spp.max(1), d.width),
+            light_set: PointSet::for_image(light_kind, n_light, d.width),
+            path_set: GridTable::new(PointSet::new(SamplerKind::STRATIFIED, spp.max(1))),
             nee: d.nee,
             russian_roulette: d.russian_roulette,
             strategy: d.importance_sampling,
@@ -104,13 +104,13 @@ impl Integrator {
         match spp {
             Some(n) => {
                 it.spp = n.max(1);
-                it.pixel_set = PointSet::new(self.pixel_set.kind(), it.spp);
+                it.pixel_set = self.pixel_set.with_n(it.spp);
                 it.path_set = GridTable::new(PointSet::new(self.path_set.set().kind(), it.spp));
             }
             None => {
                 it.spp = u32::MAX;
-                it.pixel_set = PointSet::new(SamplerKind::Independent, 1);
-                it.path_set = GridTable::new(PointSet::new(SamplerKind::Independent, 1));
+                it.pixel_set = PointSet::new(SamplerKind::INDEPENDENT, 1);
+                it.path_set = GridTable::new(PointSet::new(SamplerKind::INDEPENDENT, 1));
             }
         }
         it

@@ -146,10 +146,10 @@ fn log(cfg: &Config, msg: &str) {
 /// The direct-lighting experiment: returns its rows and writes `direct-*.png` and `direct.svg`.
 pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
     let kinds = [
-        ("random", SamplerKind::Independent),
-        ("stratified", SamplerKind::Stratified),
-        ("grid-center", SamplerKind::GridCenter),
-        ("halton", SamplerKind::Halton),
+        ("random", SamplerKind::INDEPENDENT),
+        ("stratified", SamplerKind::STRATIFIED),
+        ("grid-center", SamplerKind::GRID_CENTER),
+        ("halton", SamplerKind::HALTON),
     ];
     let mut rows = Vec::new();
     let mut series: Vec<Series> = Vec::new();
@@ -160,12 +160,12 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
     ] {
         let base = RenderOptions {
             spp: Some(1),
-            pixel_sampler: Some(SamplerKind::GridCenter),
+            pixel_sampler: Some(SamplerKind::GRID_CENTER),
             ..scene_opts(cfg, rel, aspect)
         };
         log(cfg, &format!("direct {name}: reference 2 x {} stratified light samples", cfg.ref_light_samples));
         let reference = reference_two_halves(&RenderOptions {
-            light_sampler: Some(SamplerKind::Stratified),
+            light_sampler: Some(SamplerKind::STRATIFIED),
             light_samples: Some(cfg.ref_light_samples),
             ..base.clone()
         })?;
@@ -253,8 +253,8 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             scene: "hw3 cornellNEE",
             reference: is(&nee, ImportanceSampling::Cosine),
             variants: [
-                ("random", px(&nee, SamplerKind::Independent)),
-                ("stratified", px(&nee, SamplerKind::Stratified)),
+                ("random", px(&nee, SamplerKind::INDEPENDENT)),
+                ("stratified", px(&nee, SamplerKind::STRATIFIED)),
             ],
             spp: 4,
             ladder: &[1, 4, 16],
@@ -265,8 +265,8 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             scene: "hw3 cornellNEE",
             reference: is(&nee, ImportanceSampling::Cosine),
             variants: [
-                ("random", px(&nee, SamplerKind::Independent)),
-                ("stratified", px(&nee, SamplerKind::Stratified)),
+                ("random", px(&nee, SamplerKind::INDEPENDENT)),
+                ("stratified", px(&nee, SamplerKind::STRATIFIED)),
             ],
             spp: 5,
             ladder: &[5],

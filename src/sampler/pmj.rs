@@ -39,7 +39,9 @@
 
 use std::sync::OnceLock;
 
-use super::sobol::{combine, fmix, stream_key, Words};
+use super::hash::{combine, combine_key, fmix};
+use super::lanes::Lanes;
+use super::layout::{Layout, SetShape};
 use crate::simd::{F8, U8};
 
 /// Points per table: the period of every pmj02 stream (a power of two, 2^12).
@@ -51,6 +53,17 @@ const LOG_POINTS: u32 = 12;
 const LOG_TABLES: u32 = 6;
 const TAG_PMJ: u32 = 0x50b0_1003;
 const TAG_TABLE: u32 = 0x50b0_1004;
+
+/// Progressive multi-jittered (0,2) sequence (table-based, XOR-scrambled) at `sample * n + k`.
+#[derive(Clone, Copy, Debug)]
+pub struct Pmj02;
+
+impl Layout for Pmj02 {
+    #[inline]
+    fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
+        pmj02(pixel, sample, dim, k, set.n(), seed)
+    }
+}
 
 /// Point k of the n-point pmj02 set of stream (pixel, sample, dim) under seed: sequence point
 /// `(sample * n + k) mod 4096` (wrapping; n == 0 acts as 1). Any inputs; both coordinates in
@@ -66,8 +79,8 @@ pub fn pmj02_2d_x8(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) ->
     pmj02(pixel, sample, dim, k, n, seed)
 }
 
-fn pmj02<L: Words>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
-    let key = combine(L::splat(stream_key(TAG_PMJ, seed, dim)), pixel);
+fn pmj02<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
+    let key = combine(L::splat(combine_key(TAG_PMJ, seed, dim)), pixel);
     let index = sample.mul(L::splat(n.max(1))).add(k).and(L::splat(TABLE_POINTS - 1));
     let pick = combine(key, L::splat(1));
     // Table from the top bits, axis swap from the lowest bit (as an all-ones/all-zeros mask).
@@ -251,7 +264,7 @@ mod tests {
         }
         let mut used = [[false; 2]; TABLES as usize];
         for p in 0..2000u32 {
-            let pick = combine(combine(stream_key(TAG_PMJ, 0, 0), p), 1);
+            let pick = combine(combine(combine_key(TAG_PMJ, 0, 0), p), 1);
             used[(pick >> (32 - LOG_TABLES)) as usize][(pick & 1) as usize] = true;
         }
         assert!(used.iter().flatten().all(|&u| u));

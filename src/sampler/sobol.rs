@@ -35,10 +35,13 @@
 //! `y < 2^24`, exactly representable, in [0, 1). The index wraps modulo 2^32; elementary intervals
 //! are exact for a, b <= 24 (below that the 2^-24 grid, not the sequence, limits resolution).
 //!
-//! Scalar and 8-lane versions run the same generic code (trait `Words`), so they agree bit for
-//! bit. The hash (murmur3's public-domain `fmix32` finalizer and `combine`) is local to this module
-//! and shared with `pmj`; its domain tags differ from `mod.rs`'s.
+//! Scalar and 8-lane versions run the same generic code , so they agree bit for
+//! bit (trait [`Lanes`]). The hash is `hash::combine` (murmur3's public-domain `fmix32` finalizer),
+//! shared with `pmj`, under this module's own domain tag.
 
+use super::hash::{combine, combine_key};
+use super::lanes::Lanes;
+use super::layout::{Layout, SetShape};
 use crate::simd::{F8, U8};
 
 /// Point k of the n-point Owen-scrambled Sobol' set of stream (pixel, sample, dim) under seed:
@@ -57,21 +60,41 @@ pub fn sobol_owen_2d_x8(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u6
 
 const TAG_SOBOL: u32 = 0x50b0_1002;
 
-fn sobol_owen<L: Words>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
-    let key = combine(L::splat(stream_key(TAG_SOBOL, seed, dim)), pixel);
+/// Owen-scrambled Sobol' (dimensions 0, 1; hash-based nested scrambling) at `sample * n + k`.
+#[derive(Clone, Copy, Debug)]
+pub struct Sobol;
+
+impl Layout for Sobol {
+    #[inline]
+    fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
+        sobol_owen(pixel, sample, dim, k, set.n(), seed)
+    }
+}
+
+fn sobol_owen<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
+    let key = combine(L::splat(combine_key(TAG_SOBOL, seed, dim)), pixel);
     let index = sample.mul(L::splat(n.max(1))).add(k);
     // The index shuffle i' = nus(index) = rev(lk(rev(index))).
     let i = reverse_bits(lk_permute(reverse_bits(index), combine(key, L::splat(1))));
+    let (x, y) = scrambled_point(i, key);
+    (x.unit24(), y.unit24())
+}
+
+/// Sobol' point `i` (dimensions 0, 1), Owen-scrambled with the axis keys `combine(key, 2)` and
+/// `combine(key, 3)`, as 24-bit fixed point (no index shuffle: callers choose the index). A
+/// building block for layouts that order the sequence themselves (`zsobol`).
+#[inline]
+pub(super) fn scrambled_point<L: Lanes>(i: L, key: L) -> (L, L) {
     // x = nus(vdc(i')) = rev(lk(rev(rev(i')))) = rev(lk(i')); y = nus(rev(pascal(i'))) = rev(lk(pascal(i'))).
     let x = reverse_bits(lk_permute(i, combine(key, L::splat(2))));
     let y = reverse_bits(lk_permute(pascal(i), combine(key, L::splat(3))));
-    (x.shr(8).unit24(), y.shr(8).unit24())
+    (x.shr(8), y.shr(8))
 }
 
 /// Sobol' dimension 1 before the final bit reversal: bit r of the result is the XOR of the bits c
 /// of `i` with r a subset of c (binom(c, r) odd), i.e. the reversed value `sum_c i_c v_{c+1}`.
 #[inline]
-fn pascal<L: Words>(i: L) -> L {
+fn pascal<L: Lanes>(i: L) -> L {
     let mut e = i;
     for (s, m) in [(1, 0x5555_5555), (2, 0x3333_3333), (4, 0x0f0f_0f0f), (8, 0x00ff_00ff), (16, 0x0000_ffff)] {
         e = e.xor(e.shr(s).and(L::splat(m)));
@@ -84,7 +107,7 @@ fn pascal<L: Words>(i: L) -> L {
 /// even number only carry upwards. Key-dependent multipliers (rotations of the key) make the flips
 /// depend on the key non-linearly, which Burley's fixed multipliers do not.
 #[inline]
-fn lk_permute<L: Words>(x: L, key: L) -> L {
+fn lk_permute<L: Lanes>(x: L, key: L) -> L {
     let x = x.add(key);
     let x = x.xor(x.mul(rotl(key, 11).shl(1)));
     let x = x.mul(rotl(key, 22).or(L::splat(1)));
@@ -94,13 +117,13 @@ fn lk_permute<L: Words>(x: L, key: L) -> L {
 }
 
 #[inline]
-fn rotl<L: Words>(x: L, s: u32) -> L {
+fn rotl<L: Lanes>(x: L, s: u32) -> L {
     x.shl(s).or(x.shr(32 - s))
 }
 
 /// Reverses the 32 bits of every lane.
 #[inline]
-fn reverse_bits<L: Words>(x: L) -> L {
+fn reverse_bits<L: Lanes>(x: L) -> L {
     let mut x = x.shr(16).or(x.shl(16));
     for (s, m) in [(8, 0x00ff_00ff), (4, 0x0f0f_0f0f), (2, 0x3333_3333), (1, 0x5555_5555)] {
         x = x.shr(s).and(L::splat(m)).or(x.and(L::splat(m)).shl(s));
@@ -109,33 +132,12 @@ fn reverse_bits<L: Words>(x: L) -> L {
 }
 
 // ------------------------------------------------------------------------------------------------
-// Lanes and hash, shared with `pmj`
-// ------------------------------------------------------------------------------------------------
-
-/// The sampler module's lane abstraction (`u32` or [`U8`]), so that scalar and x8 run the same
-/// integer operations as the other generators.
-pub(super) use super::Lanes as Words;
-
-/// The sampler module's murmur3 `fmix32` finalizer.
-pub(super) use super::fmix;
-
-/// Folds word `w` into hash state `h`; a bijection in each argument when the other is fixed.
-#[inline]
-pub(super) fn combine<L: Words>(h: L, w: L) -> L {
-    fmix(h.mul(L::splat(0x2c1b_3c6d)).add(w))
-}
-
-/// Lane-uniform part of a stream key: hash of (tag, seed, dim).
-pub(super) fn stream_key(tag: u32, seed: u64, dim: u32) -> u32 {
-    [seed as u32, (seed >> 32) as u32, dim].into_iter().fold(fmix(tag), combine)
-}
-
-// ------------------------------------------------------------------------------------------------
 // Tests
 // ------------------------------------------------------------------------------------------------
 
 #[cfg(test)]
 pub(super) mod tests {
+    use super::super::hash::fmix;
     use super::*;
 
     /// Small deterministic generator for test inputs.

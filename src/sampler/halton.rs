@@ -1,0 +1,125 @@
+//! `halton`: bases 2 and 3, nested (Owen) scrambled per (pixel, dim, seed), at global index
+//! `i = sample * n + k` (wrapping in u32): the n points of one pixel sample are consecutive Halton
+//! points and successive samples continue the sequence, so for the camera `n = spp, k = s,
+//! sample = 0` and `n = 1, k = 0, sample = s` give the same points.
+//!
+//! Precision: Halton uses the low 24 base-2 digits and the low 15 base-3 digits of the index (the
+//! coordinates repeat with periods 2^24 and 3^15 ~ 1.4e7 points per (pixel, dim)); the
+//! 2^a x 3^b elementary-interval property holds exactly for a <= 24, b <= 15.
+
+use super::divisor::Divisor;
+use super::hash::{mix, stream_key};
+use super::lanes::Lanes;
+use super::layout::{Layout, SetShape, StreamKey};
+
+const TAG_HALTON: u32 = 0x51a7_0003;
+
+/// Owen-scrambled Halton points (bases 2, 3) at index `sample * n + k`.
+#[derive(Clone, Copy, Debug)]
+pub struct Halton;
+
+impl Layout for Halton {
+    #[inline]
+    fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
+        let index = sample.mul(L::splat(set.n())).add(k);
+        let key = mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel);
+        let x = RADIX2.inverse(index, Some(mix(key, L::splat(2))));
+        let y = RADIX3.inverse(index, Some(mix(key, L::splat(3))));
+        (x.unit24(), y.unit24())
+    }
+
+    #[inline]
+    fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
+        let prefix = mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel);
+        StreamKey { prefix, base: sample.mul(L::splat(set.n())), sample, dim, seed }
+    }
+
+    #[inline]
+    fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
+        let index = s.base.add(L::splat(k));
+        let x = RADIX2.inverse(index, Some(mix(s.prefix, L::splat(2))));
+        let y = RADIX3.inverse(index, Some(mix(s.prefix, L::splat(3))));
+        (x.unit24(), y.unit24())
+    }
+}
+
+/// Unscrambled radical inverse of `index` in base 2 or 3 (`None` for other bases), in [0, 1): the
+/// 24-bit fixed-point value in the same base^-D cell as the exact value, with D = 24 digits for base
+/// 2 (exact) and D = 15 for base 3 (within 2^-24 above); index digits beyond D are ignored.
+pub fn radical_inverse(base: u32, index: u32) -> Option<f32> {
+    let radix = match base {
+        2 => &RADIX2,
+        3 => &RADIX3,
+        _ => return None,
+    };
+    Some(radix.inverse(index, None).unit24())
+}
+
+/// One Halton axis: `digits` base-`base` digits, and the map from the digit integer
+/// R < base^digits to 24-bit fixed point: `y = floor((R * scale + offset) / 2^31)`.
+pub(super) struct Radix {
+    base: u32,
+    digits: u32,
+    div: Divisor,
+    scale: u32,
+    offset: u32,
+}
+
+/// Base 2: 24 digits are already 24-bit fixed point (scale 1, offset 1/2 => y = R).
+pub(super) const RADIX2: Radix = Radix { base: 2, digits: 24, div: Divisor::new(2), scale: 1 << 31, offset: 1 << 30 };
+
+pub(super) const POW3_15: u64 = 14_348_907;
+/// round(2^31 * alpha), alpha = 2^24 / 3^15 ~ 1.169 (grid points per finest base-3 cell).
+const RADIX3_SCALE: u64 = ((1u64 << 55) + POW3_15 / 2) / POW3_15;
+/// Base 3: 15 digits (3^15 < 2^24). With offset beta = (1 + alpha) / 2, floor(R alpha + beta) lies in
+/// [R alpha, (R + 1) alpha), i.e. inside R's cell, with margin (alpha - 1) / 2 ~ 0.085 on both
+/// sides, far above the fixed-point error R * 2^-32 <= 2^-8 (checked exhaustively in the tests).
+pub(super) const RADIX3: Radix = Radix {
+    base: 3,
+    digits: 15,
+    div: Divisor::new(3),
+    scale: RADIX3_SCALE as u32,
+    offset: ((1u64 << 31) + RADIX3_SCALE).div_ceil(2) as u32,
+};
+
+impl Radix {
+    /// Digit-reversed `index` (its low `digits` digits) as 24-bit fixed point. With a `key`, output
+    /// digit j is a random permutation of index digit j chosen by hash(key, j, index mod base^j):
+    /// nested uniform scrambling, a bijection on every level, so base^-j intervals are preserved.
+    pub(super) fn inverse<L: Lanes>(&self, index: L, key: Option<L>) -> L {
+        let b = self.base;
+        let (mut rest, mut prefix, mut acc) = (index, L::splat(0), L::splat(0));
+        let (mut pow, mut weight) = (1u32, b.pow(self.digits - 1));
+        for _ in 0..self.digits {
+            let (q, a) = self.div.div_rem(rest);
+            let d = match key {
+                None => a,
+                Some(key) => {
+                    // prefix + b^j is unique per (level j, prefix < b^j).
+                    let h = mix(key, prefix.add(L::splat(pow)));
+                    // Permutation = optional reflection (top hash bit), then a cyclic shift by
+                    // floor(b * bits30..0 / 2^31); for b <= 3 this reaches all b! permutations evenly.
+                    let r = h.lt_select(L::splat(1 << 31), a, L::splat(b - 1).sub(a));
+                    let d = r.add(h.shl(1).mulhi(L::splat(b)));
+                    d.lt_select(L::splat(b), d, d.sub(L::splat(b)))
+                }
+            };
+            acc = acc.add(d.mul(L::splat(weight)));
+            prefix = prefix.add(a.mul(L::splat(pow)));
+            rest = q;
+            pow *= b;
+            weight /= b;
+        }
+        self.to_fixed24(acc)
+    }
+
+    /// `floor((r * scale + offset) / 2^31)` via a 64-bit product with carry; 0 stays 0.
+    #[inline]
+    pub(super) fn to_fixed24<L: Lanes>(&self, r: L) -> L {
+        let (lo, hi) = r.mul_wide(L::splat(self.scale));
+        let lo = lo.add(L::splat(self.offset));
+        let hi = lo.lt_select(L::splat(self.offset), hi.add(L::splat(1)), hi);
+        let y = hi.shl(1).or(lo.shr(31));
+        r.lt_select(L::splat(1), L::splat(0), y)
+    }
+}

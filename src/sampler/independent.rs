@@ -1,0 +1,31 @@
+//! `independent`: two hashed uniforms per point, independent across every input.
+
+use super::hash::{hash, mix, stream_key, unit};
+use super::lanes::Lanes;
+use super::layout::{Layout, SetShape, StreamKey};
+
+const TAG_INDEPENDENT: u32 = 0x51a7_0001;
+
+/// Independent uniform points (a hash of all inputs); k is only another hash input.
+#[derive(Clone, Copy, Debug)]
+pub struct Independent;
+
+impl Layout for Independent {
+    #[inline]
+    fn point<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
+        let h = hash(TAG_INDEPENDENT, seed, dim, [pixel, sample, k]);
+        (unit(h), unit(mix(h, L::splat(1))))
+    }
+
+    #[inline]
+    fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
+        let prefix = mix(mix(L::splat(stream_key(TAG_INDEPENDENT, seed, dim)), pixel), sample);
+        StreamKey { prefix, base: L::splat(0), sample, dim, seed }
+    }
+
+    #[inline]
+    fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
+        let h = mix(s.prefix, L::splat(k));
+        (unit(h), unit(mix(h, L::splat(1))))
+    }
+}

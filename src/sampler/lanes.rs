@@ -1,0 +1,148 @@
+//! The scalar/x8 lane abstraction every generator is written against. All arithmetic wraps modulo
+//! 2^32, so the `u32` and the [`U8`] instantiation of one generic generator agree bit for bit.
+
+use crate::simd::{i32x8, F8, U8};
+
+/// Unsigned 32-bit lanes: `u32` (one lane) or `U8` (eight). Every generator is written once against
+/// this trait, so the scalar and the x8 instantiation run the same integer operations.
+pub trait Lanes: Copy {
+    /// Matching float lanes (`f32` or `F8`).
+    type F;
+    /// Every lane `x`.
+    fn splat(x: u32) -> Self;
+    /// Wrapping add.
+    fn add(self, o: Self) -> Self;
+    /// Wrapping subtract.
+    fn sub(self, o: Self) -> Self;
+    /// Wrapping multiply (low word).
+    fn mul(self, o: Self) -> Self;
+    /// Bitwise xor.
+    fn xor(self, o: Self) -> Self;
+    /// Bitwise or.
+    fn or(self, o: Self) -> Self;
+    /// Bitwise and.
+    fn and(self, o: Self) -> Self;
+    /// Logical shift right by a lane-uniform amount.
+    fn shr(self, s: u32) -> Self;
+    /// Shift left by a lane-uniform amount.
+    fn shl(self, s: u32) -> Self;
+    /// Full 64-bit product as (low word, high word).
+    fn mul_wide(self, o: Self) -> (Self, Self);
+    /// Per lane `if self < o { a } else { b }`, unsigned compare.
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self;
+    /// Per lane `self * 2^-24` as f32; exact for self < 2^24.
+    fn unit24(self) -> Self::F;
+    /// `f` applied to every lane (table look-ups).
+    fn map(self, f: impl Fn(u32) -> u32) -> Self;
+    /// High word of the 64-bit product.
+    fn mulhi(self, o: Self) -> Self {
+        self.mul_wide(o).1
+    }
+}
+
+const INV_2_24: f32 = 1.0 / 16_777_216.0;
+
+impl Lanes for u32 {
+    type F = f32;
+    fn splat(x: u32) -> Self {
+        x
+    }
+    fn add(self, o: Self) -> Self {
+        self.wrapping_add(o)
+    }
+    fn sub(self, o: Self) -> Self {
+        self.wrapping_sub(o)
+    }
+    fn mul(self, o: Self) -> Self {
+        self.wrapping_mul(o)
+    }
+    fn xor(self, o: Self) -> Self {
+        self ^ o
+    }
+    fn or(self, o: Self) -> Self {
+        self | o
+    }
+    fn and(self, o: Self) -> Self {
+        self & o
+    }
+    fn shr(self, s: u32) -> Self {
+        self >> s
+    }
+    fn shl(self, s: u32) -> Self {
+        self << s
+    }
+    fn mul_wide(self, o: Self) -> (Self, Self) {
+        let p = u64::from(self) * u64::from(o);
+        (p as u32, (p >> 32) as u32)
+    }
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self {
+        if self < o {
+            a
+        } else {
+            b
+        }
+    }
+    fn unit24(self) -> f32 {
+        self as f32 * INV_2_24
+    }
+    fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        f(self)
+    }
+}
+
+impl Lanes for U8 {
+    type F = F8;
+    #[inline]
+    fn splat(x: u32) -> Self {
+        U8::splat(x)
+    }
+    #[inline]
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    #[inline]
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    #[inline]
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
+    #[inline]
+    fn xor(self, o: Self) -> Self {
+        self ^ o
+    }
+    #[inline]
+    fn or(self, o: Self) -> Self {
+        self | o
+    }
+    #[inline]
+    fn and(self, o: Self) -> Self {
+        self & o
+    }
+    #[inline]
+    fn shr(self, s: u32) -> Self {
+        self >> s
+    }
+    #[inline]
+    fn shl(self, s: u32) -> Self {
+        self << s
+    }
+    #[inline]
+    fn mul_wide(self, o: Self) -> (Self, Self) {
+        self.mul_keep_low_high(o)
+    }
+    #[inline]
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self {
+        self.simd_lt(o).select(a, b)
+    }
+    #[inline]
+    fn unit24(self) -> F8 {
+        // Lanes are < 2^24, so the signed conversion is exact.
+        F8::from_i32x8(wide::bytemuck::cast::<U8, i32x8>(self)) * F8::splat(INV_2_24)
+    }
+    #[inline]
+    fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        U8::new(self.to_array().map(f))
+    }
+}

@@ -1,0 +1,87 @@
+//! Keyed pseudo-random permutations of 0..n (shuffled strata for padded stratified sampling).
+
+use super::divisor::Divisor;
+use super::hash::fmix;
+use super::lanes::Lanes;
+use crate::simd::U8;
+
+/// A keyed pseudo-random permutation of 0..n: `permute(i, n, key)` for i in 0..n visits every
+/// value of 0..n once. Used to shuffle strata independently per sampling dimension (so that the
+/// sample in stratum s of one dimension lands in an unrelated stratum of the next, as a padded
+/// stratified sampler does). Built from xorshift-multiply rounds that are bijections on the
+/// smallest power-of-two domain >= n, with cycle walking back into 0..n (expected < 2 rounds).
+/// i >= n is reduced modulo n first; n == 0 acts as 1.
+pub fn permute(i: u32, n: u32, key: u32) -> u32 {
+    let n = n.max(1);
+    if n == 1 {
+        return 0;
+    }
+    let (mask, half) = permute_domain(n);
+    let key = fmix(key ^ 0x6a09_e667);
+    let r = rotation(key, n);
+    let mut x = i % n;
+    loop {
+        x = permute_round(x, key, mask, half);
+        if x < n {
+            let y = x + r;
+            return if y >= n { y - n } else { y };
+        }
+    }
+}
+
+/// Keyed rotation r in 0..n applied after the rounds: `(x + r) mod n`. The rounds alone are a
+/// small, correlated family for small n (two keys give related permutations), so the strata two
+/// dimensions give one sample index were not jointly uniform over pixels, which biases an
+/// estimator; an independent uniform rotation per key makes each dimension's stratum uniform
+/// whatever the other's, which is exactly the joint uniformity unbiasedness needs.
+#[inline]
+fn rotation<L: Lanes>(key: L, n: u32) -> L {
+    fmix(key.xor(L::splat(0xbb67_ae85))).mulhi(L::splat(n))
+}
+
+/// Eight lanes of [`permute`] with a lane-uniform n and per-lane keys, bit-identical to it per
+/// lane: the rounds run on all lanes until every lane has walked back into 0..n.
+pub fn permute_x8(i: U8, n: u32, key: U8) -> U8 {
+    let n = n.max(1);
+    if n == 1 {
+        return U8::splat(0);
+    }
+    let (mask, half) = permute_domain(n);
+    let key = fmix(key ^ U8::splat(0x6a09_e667));
+    let r = rotation(key, n);
+    let nn = U8::splat(n);
+    let mut x = Divisor::new(n).rem(i);
+    let mut out = U8::splat(0);
+    let mut done = U8::splat(0);
+    loop {
+        x = permute_round(x, key, mask, half);
+        // First round in range wins: lanes already done keep their value.
+        let inside = x.simd_lt(nn) & !done;
+        out = inside.select(x, out);
+        done |= inside;
+        if done.all() {
+            let y = out + r;
+            return y.simd_lt(nn).select(y, y - nn);
+        }
+    }
+}
+
+/// Power-of-two domain of [`permute`] for n >= 2: (mask 2^bits - 1, xorshift amount).
+fn permute_domain(n: u32) -> (u32, u32) {
+    let bits = 32 - (n - 1).leading_zeros();
+    let mask = if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 };
+    (mask, (bits / 2).max(1))
+}
+
+/// One bijective round of [`permute`] on [0, 2^bits): xor with the key, multiply by an odd
+/// constant, xorshift right, multiply by an odd key-dependent constant, xorshift, xor.
+#[inline]
+fn permute_round<L: Lanes>(x: L, key: L, mask: u32, half: u32) -> L {
+    let m = L::splat(mask);
+    let x = x.xor(key.and(m));
+    let x = x.mul(L::splat(0x9e37_79b9 | 1)).and(m);
+    let x = x.xor(x.shr(half));
+    let x = x.mul(key.or(L::splat(1)).mul(L::splat(0x85eb_ca6b)).or(L::splat(1))).and(m);
+    let x = x.xor(x.shr(half));
+    x.xor(key.shr(16).and(m))
+}
