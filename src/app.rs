@@ -76,6 +76,29 @@ pub struct RenderOptions {
     pub max_depth: Option<i32>,
     /// resource caps (`--limit NAME=VALUE`), applied to the scene file and to the overrides
     pub limits: Limits,
+    /// PNG quantizer (`--quantize`; default [`default_quantize`]: the course's truncation for `.test`)
+    pub quantize: Option<film::Quantize>,
+    /// where pixel sample 0 goes (`--first-sample`; default [`default_first_sample`])
+    pub first_sample: Option<crate::integrator::FirstSample>,
+}
+
+/// The PNG quantizer of `opts`: `--quantize`, else truncation like the CSE168 course's writer for
+/// `.test` scenes (and the built-in one, a `.test`), rounding for `.obj` scenes (not course scenes).
+pub fn default_quantize(opts: &RenderOptions) -> film::Quantize {
+    opts.quantize.unwrap_or(match &opts.scene {
+        Some(p) if is_obj(p) => film::Quantize::Round,
+        _ => film::Quantize::Truncate,
+    })
+}
+
+/// Where pixel sample 0 goes for `opts`: `--first-sample`, else through the pixel centre like the
+/// CSE168 course code for `.test` scenes (and the built-in one), jittered for `.obj` scenes.
+pub fn default_first_sample(opts: &RenderOptions) -> crate::integrator::FirstSample {
+    use crate::integrator::FirstSample;
+    opts.first_sample.unwrap_or(match &opts.scene {
+        Some(p) if is_obj(p) => FirstSample::Jittered,
+        _ => FirstSample::Centre,
+    })
 }
 
 /// Default seconds between two checkpoints.
@@ -237,6 +260,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), String> {
         integrator.kernel = Kernel::GENERAL;
     }
     integrator.clamp = opts.clamp;
+    integrator.first_sample = default_first_sample(opts);
     Ok((scene, integrator))
 }
 
@@ -264,6 +288,8 @@ pub fn identity(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<
         ("layout", json!(if opts.time_budget.is_some() { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
         ("clamp", json!(it.clamp)),
+        ("first_sample", json!(it.first_sample.name())),
+        ("quantize", json!(default_quantize(opts).name())),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
@@ -509,6 +535,8 @@ pub fn header_metadata(h: &Header) -> Metadata {
         ("strata.light_sampler".into(), opt("light_sampler")),
         ("strata.light_samples".into(), opt("light_samples")),
         ("strata.layout".into(), opt("layout")),
+        ("strata.first_sample".into(), opt("first_sample")),
+        ("strata.quantize".into(), opt("quantize")),
         ("strata.render_seconds".into(), format!("{:.6}", h.render_seconds)),
         ("strata.cpu_seconds".into(), format!("{:.6}", h.cpu_seconds)),
         ("strata.rays".into(), h.rays.to_string()),
@@ -563,6 +591,8 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "nonfinite_samples": c.nonfinite,
         "clamp": out.integrator.clamp,
         "biased": out.integrator.clamp.is_some(),
+        "first_sample": out.integrator.first_sample.name(),
+        "quantize": out.header.options.get("quantize"),
         "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
@@ -619,7 +649,8 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, String> {
     let exr = with_ext(&stem, "exr");
     film::write_exr(&exr, w, h, &mean, Some(&var), &metadata(&out)).map_err(|e| format!("{}: {e}", exr.display()))?;
     let png = with_ext(&stem, "png");
-    film::write_png(&png, w, h, &mean, out.scene.desc.gamma).map_err(|e| format!("{}: {e}", png.display()))?;
+    film::write_png_quantized(&png, w, h, &mean, out.scene.desc.gamma, default_quantize(opts))
+        .map_err(|e| format!("{}: {e}", png.display()))?;
     out.out = Some(stem);
     if let Some(p) = &opts.stats {
         let text = serde_json::to_string_pretty(&stats_json(&out)).map_err(|e| e.to_string())?;
@@ -734,7 +765,10 @@ pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, String> {
         .map_err(|e| format!("{}: {e}", exr.display()))?;
     let gamma = header.options.get("gamma").and_then(|v| v.as_f64()).unwrap_or(1.0) as f32;
     let png = with_ext(&stem, "png");
-    film::write_png(&png, w, h, &mean, gamma).map_err(|e| format!("{}: {e}", png.display()))?;
+    // Parts written before `quantize` was recorded were rounded.
+    let q = header.options.get("quantize").and_then(|v| v.as_str()).and_then(film::Quantize::parse);
+    film::write_png_quantized(&png, w, h, &mean, gamma, q.unwrap_or(film::Quantize::Round))
+        .map_err(|e| format!("{}: {e}", png.display()))?;
     Ok(MergeOutput { header, film, out: stem })
 }
 

@@ -455,14 +455,63 @@ pub fn to_u8(v: f32, gamma: f32) -> u8 {
     (v.powf(1.0 / gamma).min(1.0) * 255.0).round() as u8
 }
 
+/// How an 8-bit PNG value is made from `v^(1/gamma)` clamped to [0, 1] (times 255).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantize {
+    /// `floor`: the CSE168 course's writer, `uchar(min(255, max(0, 255 * c)))` (the default for `.test` scenes)
+    Truncate,
+    /// nearest value ([`to_u8`]; the default for `.obj` scenes)
+    Round,
+}
+
+impl Quantize {
+    /// "truncate" | "round".
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim() {
+            "truncate" => Some(Self::Truncate),
+            "round" => Some(Self::Round),
+            _ => None,
+        }
+    }
+
+    /// Canonical name (accepted by `parse`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Truncate => "truncate",
+            Self::Round => "round",
+        }
+    }
+}
+
+/// [`to_u8`] with the quantizer `q` (`Round` is `to_u8` itself).
+pub fn to_u8_quantized(v: f32, gamma: f32, q: Quantize) -> u8 {
+    match q {
+        Quantize::Round => to_u8(v, gamma),
+        Quantize::Truncate if !v.is_finite() || v <= 0.0 => 0,
+        Quantize::Truncate => (v.powf(1.0 / gamma).min(1.0) * 255.0) as u8,
+    }
+}
+
 /// Writes an 8-bit RGB PNG preview (no sRGB curve, just [`to_u8`] with `gamma`). Atomic, see
 /// [`write_atomic`].
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]], gamma: f32) -> io::Result<()> {
+    write_png_quantized(path, width, height, rgb, gamma, Quantize::Round)
+}
+
+/// [`write_png`] with the quantizer `q`.
+pub fn write_png_quantized(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    gamma: f32,
+    q: Quantize,
+) -> io::Result<()> {
     if rgb.len() != width as usize * height as usize {
         let msg = format!("PNG {}: {} pixels, expected {width}x{height}", path.display(), rgb.len());
         return Err(io::Error::new(io::ErrorKind::InvalidInput, msg));
     }
-    let data: Vec<u8> = rgb.iter().flat_map(|p| p.map(|v| to_u8(v, gamma))).collect();
+    let data: Vec<u8> = rgb.iter().flat_map(|p| p.map(|v| to_u8_quantized(v, gamma, q))).collect();
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, width, height);
     encoder.set_color(png::ColorType::Rgb);
@@ -685,6 +734,12 @@ mod tests {
         assert_eq!(to_u8(0.5, 1.0), 128);
         assert_eq!([to_u8(f32::NAN, 2.2), to_u8(f32::INFINITY, 2.2), to_u8(f32::NEG_INFINITY, 2.2)], [0; 3]);
         assert_eq!([to_u8(-0.5, 2.2), to_u8(0.0, 2.2), to_u8(1.0, 2.2), to_u8(7.0, 2.2)], [0, 0, 255, 255]);
+        let t = |v: f32| to_u8_quantized(v, 1.0, Quantize::Truncate);
+        assert_eq!(
+            [t(0.5), t(0.999 / 255.0), t(254.99 / 255.0), t(1.0), t(7.0), t(-1.0), t(f32::NAN)],
+            [127, 0, 254, 255, 255, 0, 0]
+        );
+        assert_eq!(to_u8_quantized(0.5, 2.2, Quantize::Round), to_u8(0.5, 2.2));
     }
 
     #[test]
