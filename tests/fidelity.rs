@@ -24,7 +24,11 @@ const HW1_STRICT: &[&str] = &["hw1/scene1", "hw1/scene2", "hw1/scene3"];
 /// power. Waits for `--light-selection all`.
 const EXPECTED_TO_FAIL: &[(&str, f64, &str)] = &[
     ("hw4/mis", 9.5, "NEE light selection: uniform one-of-5 lights vs the course's all-lights loop"),
-    ("hw4/dragon", 2.0, "1.74 against a max of 1.60 from only 3 students; cause not established (noise level)"),
+    (
+        "hw4/dragon",
+        2.0,
+        "two quad lights of unequal power: NEE light selection suspected; 1.74 vs max 1.60 of only 3 students",
+    ),
 ];
 
 /// The consensus set of each scene: the student renders SOURCES.md section 5 lists as agreeing (the
