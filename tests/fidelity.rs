@@ -537,3 +537,30 @@ fn strata_matches_the_course_images() {
     }
     assert!(bad.is_empty(), "fidelity:\n{}", bad.join("\n"));
 }
+
+/// The conventions are recorded (stats JSON) and part of the checkpoint identity: a resume with
+/// another `--first-sample` or `--quantize` is refused.
+#[test]
+fn conventions_are_recorded_and_guard_resumes() {
+    let d = tmpdir("fidelity-flags");
+    let run = |extra: &[&str]| {
+        let mut c = strata();
+        c.args(["render", "--size", "12x8", "--spp", "2", "--threads", "1", "--quiet"]).args(extra);
+        c.output().unwrap()
+    };
+    let stats = d.join("s.json");
+    let r = run(&["-o", d.join("a").to_str().unwrap(), "--stats", stats.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!((j["first_sample"].as_str(), j["quantize"].as_str()), (Some("centre"), Some("truncate")));
+    let ckpt = d.join("part.ckpt");
+    let (o, c) = (d.join("b"), ckpt.to_str().unwrap().to_string());
+    let r = run(&["--samples", "0..1", "--checkpoint", &c, "-o", o.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    for flags in [["--first-sample", "jittered"], ["--quantize", "round"]] {
+        let r = run(&[&["--samples", "0..1", "--resume", &c, "-o", o.to_str().unwrap()], &flags[..]].concat());
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success() && err.contains(&flags[0][2..].replace('-', "_")), "{flags:?}: {err}");
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
