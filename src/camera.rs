@@ -4,7 +4,7 @@
 //!
 //! Layer: above `scene` and `sampler`, below `integrator` and `render` (both import it).
 
-use crate::sampler::PointSet;
+use crate::sampler::{PointSet, SamplerKind};
 use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
 
 /// Sampler dimension of the camera (pixel) jitter.
@@ -69,13 +69,68 @@ pub struct Camera<'a> {
     pub pixel_set: &'a PointSet,
     /// base seed
     pub seed: u64,
+    /// where pixel sample 0 goes
+    pub first_sample: FirstSample,
+}
+
+/// Where pixel sample 0 goes (`--first-sample`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FirstSample {
+    /// Sample 0 through the pixel centre, as the CSE168 course code does (the default for `.test`
+    /// scenes; at spp 1 the render is the course's deterministic one). With the stratified layout
+    /// sample 0 takes the stratum that holds the centre (whose own sample takes sample 0's stratum),
+    /// so the other samples keep one jittered point per stratum: the estimate is biased by
+    /// (f(centre) - mean of f over that stratum) / spp, O(1/spp). `grid-center` is unchanged.
+    Centre,
+    /// Sample 0 is jittered like the others: strata's unbiased layout (the default for `.obj` scenes).
+    Jittered,
+}
+
+impl FirstSample {
+    /// "centre" | "center" | "jittered".
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim() {
+            "centre" | "center" => Some(Self::Centre),
+            "jittered" => Some(Self::Jittered),
+            _ => None,
+        }
+    }
+
+    /// Canonical name (accepted by `parse`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Centre => "centre",
+            Self::Jittered => "jittered",
+        }
+    }
+}
+
+/// Stratum of sample `s` of an n-point stratified set when sample 0 is at the centre: the stratum
+/// holding (0.5, 0.5) (cell (nx/2, ny/2) of `strata_shape(n)`) is sample 0's, so its own sample
+/// takes stratum 0; every other sample keeps its stratum.
+fn centre_swap(s: u32, n: u32) -> u32 {
+    let (nx, ny) = crate::sampler::strata_shape(n);
+    let c = (ny / 2) * nx + nx / 2;
+    if s % n == c {
+        0
+    } else {
+        s
+    }
 }
 
 impl Camera<'_> {
     /// Camera rays of packet `pk` for pixel sample `s`: origins and unit directions.
     #[inline]
     pub fn rays(&self, pk: &PixelPacket, s: u32) -> (Vec3x8, Vec3x8) {
-        let (jx, jy) = self.pixel_set.point_x8(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(s), self.seed);
+        let kind = self.pixel_set.kind();
+        let centre = self.first_sample == FirstSample::Centre && kind != SamplerKind::GRID_CENTER;
+        let (jx, jy) = if centre && s == 0 {
+            (F8::splat(0.5), F8::splat(0.5))
+        } else {
+            // Stratified: the sample whose stratum holds the centre takes sample 0's stratum.
+            let k = if centre && kind == SamplerKind::STRATIFIED { centre_swap(s, self.pixel_set.n()) } else { s };
+            self.pixel_set.point_x8(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(k), self.seed)
+        };
         let dir = self.lens.dirs8(pk.x + jx, pk.y + jy);
         (Vec3x8::splat(self.lens.eye), dir)
     }

@@ -200,6 +200,15 @@ struct RenderArgs {
     /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth.
     #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_limit)]
     limits: Vec<String>,
+    /// 8-bit PNG values: truncate (the CSE168 course's writer, floor(255 c); default for .test scenes)
+    /// or round (default for .obj scenes). The EXR is linear and not affected.
+    #[arg(long, value_parser = parse_quantize)]
+    quantize: Option<strata::film::Quantize>,
+    /// Pixel sample 0: centre (through the pixel centre like the CSE168 course code; default for .test
+    /// scenes; O(1/spp) bias, see README) or jittered (strata's unbiased stratified layout; default for
+    /// .obj scenes). spp 1 with centre is the course's deterministic image.
+    #[arg(long, value_parser = parse_first_sample)]
+    first_sample: Option<strata::integrator::FirstSample>,
 }
 
 impl RenderArgs {
@@ -231,6 +240,8 @@ impl RenderArgs {
             russian_roulette: self.russian_roulette,
             max_depth: self.max_depth,
             limits: limits_of(&self.limits),
+            quantize: self.quantize,
+            first_sample: self.first_sample,
         }
     }
 }
@@ -253,6 +264,14 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got `{s}`"))?;
     let p = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected WxH with positive integers, got `{s}`"));
     Ok((p(w)?, p(h)?))
+}
+
+fn parse_quantize(s: &str) -> Result<strata::film::Quantize, String> {
+    strata::film::Quantize::parse(s).ok_or_else(|| format!("expected truncate or round, got `{s}`"))
+}
+
+fn parse_first_sample(s: &str) -> Result<strata::integrator::FirstSample, String> {
+    strata::integrator::FirstSample::parse(s).ok_or_else(|| format!("expected centre or jittered, got `{s}`"))
 }
 
 fn parse_clamp(s: &str) -> Result<f32, String> {

@@ -86,6 +86,7 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("layout", json!(if time_budget { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
         ("clamp", json!(it.clamp)),
+        ("first_sample", json!(it.first_sample.name())),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
@@ -125,6 +126,8 @@ pub fn header_metadata(h: &Header) -> Metadata {
         ("strata.light_sampler".into(), opt("light_sampler")),
         ("strata.light_samples".into(), opt("light_samples")),
         ("strata.layout".into(), opt("layout")),
+        ("strata.first_sample".into(), opt("first_sample")),
+        ("strata.quantize".into(), opt("quantize")),
         ("strata.render_seconds".into(), format!("{:.6}", h.render_seconds)),
         ("strata.cpu_seconds".into(), format!("{:.6}", h.cpu_seconds)),
         ("strata.rays".into(), h.rays.to_string()),

@@ -89,7 +89,9 @@ pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, Checkpoin
         .map_err(|source| CheckpointError::Output { path: exr.clone(), source })?;
     let gamma = header.options.get("gamma").and_then(|v| v.as_f64()).unwrap_or(1.0) as f32;
     let png = with_ext(&stem, "png");
-    film::write_png(&png, w, h, &mean, gamma)
+    // Parts written before `quantize` was recorded were rounded.
+    let q = header.options.get("quantize").and_then(|v| v.as_str()).and_then(film::Quantize::parse);
+    film::write_png_quantized(&png, w, h, &mean, gamma, q.unwrap_or(film::Quantize::Round))
         .map_err(|source| CheckpointError::Output { path: png.clone(), source })?;
     Ok(MergeOutput { header, film, out: stem })
 }

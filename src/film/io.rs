@@ -121,6 +121,43 @@ fn exr_error(e: exr::error::Error, path: &Path) -> io::Error {
     io::Error::new(kind, format!("EXR {}: {e}", path.display()))
 }
 
+/// How an 8-bit PNG value is made from `v^(1/gamma)` clamped to [0, 1] (times 255).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantize {
+    /// `floor`: the CSE168 course's writer, `uchar(min(255, max(0, 255 * c)))` (the default for `.test` scenes)
+    Truncate,
+    /// nearest value ([`to_u8`]; the default for `.obj` scenes)
+    Round,
+}
+
+impl Quantize {
+    /// "truncate" | "round".
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim() {
+            "truncate" => Some(Self::Truncate),
+            "round" => Some(Self::Round),
+            _ => None,
+        }
+    }
+
+    /// Canonical name (accepted by `parse`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Truncate => "truncate",
+            Self::Round => "round",
+        }
+    }
+}
+
+/// [`to_u8`] with the quantizer `q` (`Round` is `to_u8` itself).
+pub fn to_u8_quantized(v: f32, gamma: f32, q: Quantize) -> u8 {
+    match q {
+        Quantize::Round => to_u8(v, gamma),
+        Quantize::Truncate if !v.is_finite() || v <= 0.0 => 0,
+        Quantize::Truncate => (v.powf(1.0 / gamma).min(1.0) * 255.0) as u8,
+    }
+}
+
 /// The tone mapping of [`write_png`]: `v^(1/gamma)` clamped to [0, 1], times 255, rounded;
 /// non-finite or negative values map to 0.
 pub fn to_u8(v: f32, gamma: f32) -> u8 {
@@ -133,11 +170,23 @@ pub fn to_u8(v: f32, gamma: f32) -> u8 {
 /// Writes an 8-bit RGB PNG preview (no sRGB curve, just [`to_u8`] with `gamma`). Atomic, see
 /// [`write_atomic`].
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[[f32; 3]], gamma: f32) -> io::Result<()> {
+    write_png_quantized(path, width, height, rgb, gamma, Quantize::Round)
+}
+
+/// [`write_png`] with the quantizer `q`.
+pub fn write_png_quantized(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    gamma: f32,
+    q: Quantize,
+) -> io::Result<()> {
     if rgb.len() != width as usize * height as usize {
         let msg = format!("PNG {}: {} pixels, expected {width}x{height}", path.display(), rgb.len());
         return Err(io::Error::new(io::ErrorKind::InvalidInput, msg));
     }
-    let data: Vec<u8> = rgb.iter().flat_map(|p| p.map(|v| to_u8(v, gamma))).collect();
+    let data: Vec<u8> = rgb.iter().flat_map(|p| p.map(|v| to_u8_quantized(v, gamma, q))).collect();
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, width, height);
     encoder.set_color(png::ColorType::Rgb);

@@ -19,7 +19,10 @@
 //! costs 48 bytes per pixel, and at most about 2 log2(hi - lo) blocks are live.
 
 mod io;
-pub use io::{read_exr, stem_of, to_u8, with_ext, write_atomic, write_exr, write_png, ExrImage, Metadata};
+pub use io::{
+    read_exr, stem_of, to_u8, to_u8_quantized, with_ext, write_atomic, write_exr, write_png, write_png_quantized,
+    ExrImage, Metadata, Quantize,
+};
 
 use std::ops::Range;
 

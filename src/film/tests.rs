@@ -188,6 +188,12 @@ fn tone_mapping() {
     assert_eq!(to_u8(0.5, 1.0), 128);
     assert_eq!([to_u8(f32::NAN, 2.2), to_u8(f32::INFINITY, 2.2), to_u8(f32::NEG_INFINITY, 2.2)], [0; 3]);
     assert_eq!([to_u8(-0.5, 2.2), to_u8(0.0, 2.2), to_u8(1.0, 2.2), to_u8(7.0, 2.2)], [0, 0, 255, 255]);
+    let t = |v: f32| to_u8_quantized(v, 1.0, Quantize::Truncate);
+    assert_eq!(
+        [t(0.5), t(0.999 / 255.0), t(254.99 / 255.0), t(1.0), t(7.0), t(-1.0), t(f32::NAN)],
+        [127, 0, 254, 255, 255, 0, 0]
+    );
+    assert_eq!(to_u8_quantized(0.5, 2.2, Quantize::Round), to_u8(0.5, 2.2));
 }
 
 #[test]

@@ -12,6 +12,7 @@
 //! [`DIM_LIGHT_BASE`] + light index for the light samples of `direct`.
 
 use crate::accel::{Hits8, RayHit8};
+pub use crate::camera::FirstSample;
 use crate::camera::{Camera, PixelPacket};
 use crate::sampler::{GridTable, PointSet, SamplerKind};
 use crate::scene::build::Scene;
@@ -64,6 +65,8 @@ pub struct Integrator {
     /// path tracer, opt-in and biased: each pixel sample is scaled so its largest channel is at
     /// most this radiance (None: no clamping, the unbiased default)
     pub clamp: Option<f32>,
+    /// where pixel sample 0 goes ([`FirstSample`]; `new` gives `Jittered`)
+    pub first_sample: FirstSample,
 }
 
 impl Integrator {
@@ -93,6 +96,7 @@ impl Integrator {
             max_depth: d.max_depth,
             kernel: Kernel::for_scene(scene),
             clamp: None,
+            first_sample: FirstSample::Jittered,
         }
     }
 
@@ -118,7 +122,7 @@ impl Integrator {
 
     /// The camera of this integrator on `scene` (its pixel sampler and seed).
     pub fn camera<'a>(&'a self, scene: &'a Scene) -> Camera<'a> {
-        Camera { lens: &scene.camera, pixel_set: &self.pixel_set, seed: self.seed }
+        Camera { lens: &scene.camera, pixel_set: &self.pixel_set, seed: self.seed, first_sample: self.first_sample }
     }
 
     /// Camera rays of packet `pk` for pixel sample `s`: origins and unit directions.

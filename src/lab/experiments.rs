@@ -133,6 +133,8 @@ fn scene_opts(cfg: &Config, rel: &str, aspect: f64) -> RenderOptions {
         scene: Some(cfg.corpus.join(rel)),
         size: Some((cfg.width, h)),
         threads: cfg.threads,
+        // Error studies need the unbiased layout, not the course's pixel-centre sample 0.
+        first_sample: Some(crate::integrator::FirstSample::Jittered),
         ..Default::default()
     }
 }

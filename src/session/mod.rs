@@ -21,7 +21,7 @@ pub mod scene;
 pub mod stats;
 
 pub use error::SessionError;
-pub use options::{RenderOptions, DEFAULT_CHECKPOINT_EVERY, DEFAULT_SCENE};
+pub use options::{default_first_sample, default_quantize, RenderOptions, DEFAULT_CHECKPOINT_EVERY, DEFAULT_SCENE};
 pub use output::{metadata, output_stem, run_render};
 pub use pass::{render_to_film, stop_on_signals, RenderOutput};
 pub use rays::{rates_table, run_rays};

@@ -70,4 +70,28 @@ pub struct RenderOptions {
     pub max_depth: Option<i32>,
     /// resource caps (`--limit NAME=VALUE`), applied to the scene file and to the overrides
     pub limits: Limits,
+    /// PNG quantizer (`--quantize`; default [`default_quantize`]: the course's truncation for `.test`)
+    pub quantize: Option<crate::film::Quantize>,
+    /// where pixel sample 0 goes (`--first-sample`; default [`default_first_sample`])
+    pub first_sample: Option<crate::camera::FirstSample>,
+}
+
+/// The PNG quantizer of `opts`: `--quantize`, else truncation like the CSE168 course's writer for
+/// `.test` scenes (and the built-in one, a `.test`), rounding for `.obj` scenes (not course scenes).
+pub fn default_quantize(opts: &RenderOptions) -> crate::film::Quantize {
+    use crate::film::Quantize;
+    opts.quantize.unwrap_or(match &opts.scene {
+        Some(p) if super::scene::is_obj(p) => Quantize::Round,
+        _ => Quantize::Truncate,
+    })
+}
+
+/// Where pixel sample 0 goes for `opts`: `--first-sample`, else through the pixel centre like the
+/// CSE168 course code for `.test` scenes (and the built-in one), jittered for `.obj` scenes.
+pub fn default_first_sample(opts: &RenderOptions) -> crate::camera::FirstSample {
+    use crate::camera::FirstSample;
+    opts.first_sample.unwrap_or(match &opts.scene {
+        Some(p) if super::scene::is_obj(p) => FirstSample::Jittered,
+        _ => FirstSample::Centre,
+    })
 }

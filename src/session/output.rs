@@ -39,7 +39,7 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
     film::write_exr(&exr, w, h, &mean, Some(&var), &metadata(&out))
         .map_err(|source| SessionError::Output { path: exr.clone(), source })?;
     let png = with_ext(&stem, "png");
-    film::write_png(&png, w, h, &mean, out.scene.desc.gamma)
+    film::write_png_quantized(&png, w, h, &mean, out.scene.desc.gamma, super::options::default_quantize(opts))
         .map_err(|source| SessionError::Output { path: png.clone(), source })?;
     out.out = Some(stem);
     if let Some(p) = &opts.stats {

@@ -63,6 +63,7 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
     };
     let mut header = checkpoint::identity(&scene_hash(opts)?, &scene, &integrator, opts.time_budget.is_some());
     header.target = [target.start, target.end];
+    header.options.insert("quantize".into(), serde_json::json!(super::options::default_quantize(opts).name()));
     let mut film = Film::new(scene.desc.width, scene.desc.height);
     if let Some(path) = &opts.resume {
         let (h, f) = checkpoint::read(path)?;

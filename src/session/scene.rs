@@ -100,6 +100,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         integrator.kernel = Kernel::GENERAL;
     }
     integrator.clamp = opts.clamp;
+    integrator.first_sample = super::options::default_first_sample(opts);
     Ok((scene, integrator))
 }
 

@@ -41,6 +41,8 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "nonfinite_samples": c.nonfinite,
         "clamp": out.integrator.clamp,
         "biased": out.integrator.clamp.is_some(),
+        "first_sample": out.integrator.first_sample.name(),
+        "quantize": out.header.options.get("quantize"),
         "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
