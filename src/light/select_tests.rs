@@ -375,5 +375,5 @@ fn tree_structure_and_spatial_preference() {
         gain.push(s.pmf(p, Vec3::Y, i as u32) * 10_000.0);
     }
     eprintln!("spatial pmf of the light just above p / uniform: {gain:?}");
-    assert!(gain.iter().all(|&g| g > 100.0));
+    assert!(gain.iter().all(|&g| g > 20.0), "{gain:?}");
 }
