@@ -2,3 +2,4 @@
 //! sampling, and exact polygonal irradiance.
 pub mod emitters;
 pub mod polygonal;
+pub mod select;
