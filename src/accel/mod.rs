@@ -16,6 +16,7 @@
 //! Geometry kinds must be added in this order; a kind may be skipped.
 
 pub mod alloc;
+pub mod ellipsoid;
 
 use crate::simd::{mask_to_valid, Mask8, Vec3x8, F8, U8};
 use embree4_sys as sys;
@@ -637,6 +638,7 @@ struct Ellipsoid {
     inv: [[f64; 4]; 3],
     lower: [f32; 3],
     upper: [f32; 3],
+    fast: ellipsoid::Fast,
 }
 
 impl Ellipsoid {
@@ -659,7 +661,8 @@ impl Ellipsoid {
             lower[i] = (row.w - ext) as f32;
             upper[i] = (row.w + ext) as f32;
         }
-        Some(Self { inv: [r(0), r(1), r(2)], lower, upper })
+        let inv = [r(0), r(1), r(2)];
+        Some(Self { inv, lower, upper, fast: ellipsoid::Fast::new(&inv) })
     }
 
     /// Nearest root t in (tnear, tfar) of |o' + t d'| = 1 in object space, if any.
@@ -733,16 +736,15 @@ unsafe fn each_ellipsoid_hit(
     unsafe {
         let prims = &*(user as *const Vec<Ellipsoid>);
         let e = &prims[prim as usize];
-        let f = |field: usize, lane: usize| f32::from_bits(*soa(base, n, field, lane));
-        for lane in 0..n {
-            if *valid.add(lane) != -1 {
-                continue;
-            }
-            let o = [f(0, lane), f(1, lane), f(2, lane)];
-            let d = [f(4, lane), f(5, lane), f(6, lane)];
-            if let Some(t) = e.hit(o, d, f(3, lane), f(8, lane)) {
-                on_hit(lane, t);
-            }
+        for start in (0..n).step_by(8) {
+            let m = (n - start).min(8);
+            let load = |field: usize| {
+                let mut v = [0f32; 8];
+                std::ptr::copy_nonoverlapping(soa(base, n, field, start) as *const f32, v.as_mut_ptr(), m);
+                v
+            };
+            let valid = |i: usize| *valid.add(start + i) == -1;
+            ellipsoid::packet_hits(e, m, load, valid, |i, t| on_hit(start + i, t));
         }
     }
 }
