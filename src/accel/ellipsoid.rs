@@ -279,10 +279,13 @@ pub(super) fn packet_hits(
         return;
     }
     let t = r.t.to_array();
-    for i in 0..m {
+    let mut bits = hit | unsure;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
         if hit & (1 << i) != 0 {
             on_hit(i, t[i]);
-        } else if unsure & (1 << i) != 0 {
+        } else {
             let (o, d) = (org.lane(i), dir.lane(i));
             if let Some(t) = e.hit(o.to_array(), d.to_array(), tnear.as_array()[i], tfar.as_array()[i]) {
                 on_hit(i, t);

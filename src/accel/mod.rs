@@ -739,8 +739,12 @@ unsafe fn each_ellipsoid_hit(
         for start in (0..n).step_by(8) {
             let m = (n - start).min(8);
             let load = |field: usize| {
+                let p = soa(base, n, field, start) as *const f32;
+                if m == 8 {
+                    return std::ptr::read_unaligned(p as *const [f32; 8]);
+                }
                 let mut v = [0f32; 8];
-                std::ptr::copy_nonoverlapping(soa(base, n, field, start) as *const f32, v.as_mut_ptr(), m);
+                std::ptr::copy_nonoverlapping(p, v.as_mut_ptr(), m);
                 v
             };
             let valid = |i: usize| *valid.add(start + i) == -1;
