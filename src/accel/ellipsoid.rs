@@ -7,35 +7,39 @@
 //!
 //! # Formulation
 //! Object space with the ellipsoid's centre `C` (world) taken out first: `D = (o - C_hi) - C_lo`
-//! (`C` as an f32 pair, so rays near an ellipsoid far from the world origin lose nothing),
-//! `o' = A D`, `d' = A d` with `A` the world-to-object linear part (for spheres, `o' = D / r`,
-//! `d' = d / r`: the rotation does not change any distance). Then, as the f64 path:
-//! `a = d'.d'`, `b = -(o'.d') / a` (closest approach), `f = o' + b d'`, `disc = 1 - f.f`; roots
-//! `b -+ h`, `h = sqrt(disc / a)`, the one farther from 0 as `q = b + sign(b) h` and the other as
-//! `(o'.o' - 1) / (a q)` (no cancellation in either).
+//! (`C` as an f32 pair, so rays near an ellipsoid far from the world origin lose nothing). For a
+//! sphere (A a similarity to 1e-6), `o' = D / r`, `d' = d / r`. Otherwise `o' = B D`, `d' = B d`
+//! with `B = S V^T` from the SVD `A = U S V^T` of the world-to-object linear part (f64 Jacobi at
+//! build): `|B x| = |A x|` for all x, so B describes the same unit sphere up to the rotation U,
+//! which no distance sees, and B's rows do not mix the axes (rounding stays relative per axis).
+//! Then, as the f64 path: `a = d'.d'`, `b = -(o'.d') / a` (closest approach), `f = o' + b d'`,
+//! `disc = 1 - f.f`; roots `b -+ h`, `h = sqrt(disc / a)`, the one farther from 0 as
+//! `q = b + sign(b) h` and the other as `(o'.o' - 1) / (a q)` (no cancellation in either).
 //!
-//! # Error bound (u = 2^-24; first order, every constant rounded up)
-//! 1. Inputs are exact f32. `D` has error <= 2u|D| per component (two roundings, the second
-//!    subtraction of `C_lo` ~ u|C| is below u^2|C|, kept as `eps_c`). `o' = A D` with `A` rounded
-//!    to f32 (u) and a 3-term FMA dot (3u): |do'| <= 6u (w . |D|) + eps_c =: E_o, with `w` the
-//!    column sums of |A| (so |A||D| summed over rows; exact for a diagonal A, whatever its axis
-//!    ratio). Likewise |dd'| <= 4u (w . |d|) =: E_d. Spheres: 3u + s and u + s with `s` the
-//!    relative deviation of A from a similarity (measured in f64 at build).
-//! 2. Closest approach: `f = P o'` (P projects out d'), so do' moves f by <= E_o; a relative
-//!    direction error eta = E_d / |d'| moves it by <= |o'| eta (2x taken); rounding in p, a, b, f
-//!    adds <= 8u|o'|. So |df| <= E := E_o + 2|o'| eta + 8u|o'|. Requires eta <= 1e-3 (else f64).
-//! 3. disc = 1 - f.f: |d disc| <= (2|f| + 3E) E + 4u (f.f + 1) =: E_disc. Certain miss if
-//!    disc < -E_disc, certain real roots if disc > E_disc, otherwise (within the bound of
-//!    tangency) f64.
-//! 4. Roots: the exact roots move by <= (1.5E + E_disc / sqrt(disc)) / |d'| (b by 1.5E/|d'|;
-//!    sqrt(disc) by E_disc / sqrt(disc) when disc > E_disc), plus rounding <= 8u (|b| + h):
-//!    E_t. A lane goes to f64 if any root is within E_t of tnear or tfar (the interval test could
-//!    flip), or if the chosen root has E_t > TAU |t|.
+//! # Error bound (u = 2^-24; first order, constants rounded up; [`fast8`] follows it line by line)
+//! 1. Inputs are exact f32. `D` has error <= 2u|D_i| per component (the `C_lo` residue is
+//!    <= 2u^2|C|: `eps_c`). `o' = B D` with B rounded to f32 (u) and a 3-term FMA dot (3u):
+//!    |do'| <= 6u |n| max|D_i| + eps_c =: E_o, n_i = sum_j |B_ij| (row i is s_i v_i, so this is
+//!    relative to the axis' own scale). `d'`: E_d = 4u |n| max|d_i|. Spheres: (4u + dev) sqrt3/r
+//!    and (2u + dev) sqrt3/r, dev = deviation of r^2 A^T A from I (measured in f64 at build).
+//!    eta = E_d / |d'| is the relative direction error; lanes with eta > 1e-3 go to f64.
+//! 2. Closest approach, exact function of (o', d'): `f = P o'` (P projects out d'). do' moves f
+//!    by <= E_o; the direction error moves |f| by <= 1.1 |o'| eta (the part along d' is second
+//!    order); rounding of the fma `f` adds u|f|: radial error E_r. The along-ray error of the
+//!    closest approach `b |d'|` is E_b = E_o + 2 |o'| eta + 7u |o'| (p = o'.d' 3u, a 3u, /a u).
+//!    An error in b moves f along d', orthogonal to the exact f, so it enters |f|^2 only squared.
+//! 3. disc = 1 - f.f: |d disc| <= (2|f| + E_r) E_r + E_b (E_b + 2u|f|) + 4u (f.f + 1) =: E_disc.
+//!    Certain miss if disc < -E_disc, certain real roots if disc > E_disc, otherwise (within the
+//!    bound of tangency) f64.
+//! 4. Roots: sqrt(disc) moves by <= E_disc / (sqrt(disc) + sqrt(disc - E_disc)), b by E_b/|d'|,
+//!    |d'| by eta relative, plus rounding <= 8u (|b| + h): E_t. A lane goes to f64 if any root is
+//!    within E_t of tnear or tfar (the interval test could flip), or if the chosen root has
+//!    E_t > TAU |t|.
 //! Hence every lane answered in f32 has the same hit/miss and root choice as the exact
 //! computation and |t - t_exact| <= TAU |t| + u|t| (final rounding); the f64 path is within a few
-//! f64 ulps of exact, so |t - t64| <= 1e-5 |t64| holds with margin. Rays that are exactly (or,
-//! at the f32 bound, nearly) tangent, start on the surface, come from very far away relative to
-//! the size (|o'| u comparable to 1), or have a degenerate/non-finite direction all land in f64.
+//! f64 ulps of exact and rounds to f32 (u), so |t - t64| <= 1e-5 |t64| holds. Rays exactly (or,
+//! at the f32 bound, nearly) tangent, starting on the surface, coming from so far away that
+//! u |o'| is comparable to 1 (1e6 radii), or with a degenerate/non-finite direction land in f64.
 //! NaN anywhere makes every comparison false and sends the lane to f64, which rejects it.
 
 use super::Ellipsoid;
