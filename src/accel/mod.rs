@@ -23,6 +23,7 @@
 
 pub mod alloc;
 mod device;
+pub mod ellipsoid;
 mod ffi;
 mod ftz;
 mod scene;

@@ -10,9 +10,11 @@ use std::ffi::c_void;
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Ellipsoid {
     /// world-to-object linear part (row-major 3x3) and translation
-    inv: [[f64; 4]; 3],
-    lower: [f32; 3],
-    upper: [f32; 3],
+    pub(super) inv: [[f64; 4]; 3],
+    pub(super) lower: [f32; 3],
+    pub(super) upper: [f32; 3],
+    /// the f32 SIMD intersector's precomputed form (see `accel::ellipsoid`)
+    pub(super) fast: super::ellipsoid::Fast,
 }
 
 impl Ellipsoid {
@@ -36,12 +38,13 @@ impl Ellipsoid {
             lower[i] = (row.w - ext) as f32;
             upper[i] = (row.w + ext) as f32;
         }
-        Some(Self { inv: [r(0), r(1), r(2)], lower, upper })
+        let inv = [r(0), r(1), r(2)];
+        Some(Self { inv, lower, upper, fast: super::ellipsoid::Fast::new(&inv) })
     }
 
     /// Nearest root t in (tnear, tfar) of |o' + t d'| = 1 in object space, if any.
     #[inline]
-    fn hit(&self, o: [f32; 3], d: [f32; 3], tnear: f32, tfar: f32) -> Option<f32> {
+    pub(super) fn hit(&self, o: [f32; 3], d: [f32; 3], tnear: f32, tfar: f32) -> Option<f32> {
         let m = &self.inv;
         let (o, d) = (o.map(f64::from), d.map(f64::from));
         let oo: [f64; 3] = std::array::from_fn(|i| m[i][0] * o[0] + m[i][1] * o[1] + m[i][2] * o[2] + m[i][3]);
@@ -110,16 +113,19 @@ unsafe fn each_ellipsoid_hit(
     unsafe {
         let prims = &*(user as *const Vec<Ellipsoid>);
         let e = &prims[prim as usize];
-        let f = |field: usize, lane: usize| f32::from_bits(*soa(base, n, field, lane));
-        for lane in 0..n {
-            if *valid.add(lane) != -1 {
-                continue;
-            }
-            let o = [f(0, lane), f(1, lane), f(2, lane)];
-            let d = [f(4, lane), f(5, lane), f(6, lane)];
-            if let Some(t) = e.hit(o, d, f(3, lane), f(8, lane)) {
-                on_hit(lane, t);
-            }
+        for start in (0..n).step_by(8) {
+            let m = (n - start).min(8);
+            let load = |field: usize| {
+                let p = soa(base, n, field, start) as *const f32;
+                if m == 8 {
+                    return std::ptr::read_unaligned(p as *const [f32; 8]);
+                }
+                let mut v = [0f32; 8];
+                std::ptr::copy_nonoverlapping(p, v.as_mut_ptr(), m);
+                v
+            };
+            let valid = |i: usize| *valid.add(start + i) == -1;
+            super::ellipsoid::packet_hits(e, m, load, valid, |i, t| on_hit(start + i, t));
         }
     }
 }

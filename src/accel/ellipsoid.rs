@@ -1,0 +1,692 @@
+//! Packet intersection of one ellipsoid (the unit sphere under an affine map) with up to 8 rays at
+//! once, in f32 SIMD, with a per-lane running error bound: a lane whose f32 answer could differ
+//! from the exact one (hit vs miss, which root, or a hit distance off by more than [`TAU`]
+//! relative) is recomputed by the scalar f64 [`Ellipsoid::hit`], which stays the reference.
+//! Safe code only: the Embree callback in `accel/mod.rs` loads the SoA lanes and calls
+//! [`packet_hits`].
+//!
+//! # Formulation
+//! Object space with the ellipsoid's centre `C` (world) taken out first: `D = (o - C_hi) - C_lo`
+//! (`C` as an f32 pair, so rays near an ellipsoid far from the world origin lose nothing). For a
+//! sphere (A a similarity to 1e-6), `o' = D / r`, `d' = d / r`. Otherwise `o' = B D`, `d' = B d`
+//! with `B = S V^T` from the SVD `A = U S V^T` of the world-to-object linear part (f64 Jacobi at
+//! build): `|B x| = |A x|` for all x, so B describes the same unit sphere up to the rotation U,
+//! which no distance sees, and B's rows do not mix the axes (rounding stays relative per axis).
+//! Then, as the f64 path: `a = d'.d'`, `b = -(o'.d') / a` (closest approach), `f = o' + b d'`,
+//! `disc = 1 - f.f`; roots `b -+ h`, `h = sqrt(disc / a)`, the one farther from 0 as
+//! `q = b + sign(b) h` and the other as `(o'.o' - 1) / (a q)` (no cancellation in either).
+//!
+//! # Error bound (u = 2^-24; first order, constants rounded up; [`fast8`] follows it line by line)
+//! 1. Inputs are exact f32. `D` has error <= 2u|D_i| per component (the `C_lo` residue is
+//!    <= 2u^2|C|: `eps_c`). `o' = B D` with B rounded to f32 (u) and a 3-term FMA dot (3u):
+//!    |do'| <= 6u |n| max|D_i| + eps_c =: E_o, n_i = sum_j |B_ij| (row i is s_i v_i, so this is
+//!    relative to the axis' own scale). `d'`: E_d = 4u |n| max|d_i|. Spheres: (4u + dev) sqrt3/r
+//!    and (2u + dev) sqrt3/r, dev = deviation of r^2 A^T A from I (measured in f64 at build).
+//!    eta = E_d / |d'| is the relative direction error; lanes with eta > 1e-3 go to f64.
+//! 2. Closest approach, exact function of (o', d'): `f = P o'` (P projects out d'). do' moves f
+//!    by <= E_o; the direction error moves |f| by <= 1.1 |o'| eta (the part along d' is second
+//!    order); rounding of the fma `f` adds u|f|: radial error E_r. The along-ray error of the
+//!    closest approach `b |d'|` is E_b = E_o + 2 |o'| eta + 7u |o'| (p = o'.d' 3u, a 3u, /a u).
+//!    An error in b moves f along d', orthogonal to the exact f, so it enters |f|^2 only squared.
+//! 3. disc = 1 - f.f: |d disc| <= (2|f| + E_r) E_r + E_b (E_b + 2u|f|) + 4u (f.f + 1) =: E_disc.
+//!    Certain miss if disc < -E_disc, certain real roots if disc > E_disc, otherwise (within the
+//!    bound of tangency) f64.
+//! 4. Roots: sqrt(disc) moves by <= E_disc / (sqrt(disc) + sqrt(disc - E_disc)), b by E_b/|d'|,
+//!    |d'| by eta relative, plus rounding <= 8u (|b| + h): E_t. A lane goes to f64 if any root is
+//!    within E_t of tnear or tfar (the interval test could flip), or if the chosen root has
+//!    E_t > TAU |t|.
+//! Hence every lane answered in f32 has the same hit/miss and root choice as the exact
+//! computation and |t - t_exact| <= TAU |t| + u|t| (final rounding); the f64 path is within a few
+//! f64 ulps of exact and rounds to f32 (u), so |t - t64| <= 1e-5 |t64| holds. Rays exactly (or,
+//! at the f32 bound, nearly) tangent, starting on the surface, coming from so far away that
+//! u |o'| is comparable to 1 (1e6 radii), or with a degenerate/non-finite direction land in f64.
+//! NaN anywhere makes every comparison false and sends the lane to f64, which rejects it.
+
+use super::user_geometry::Ellipsoid;
+use crate::simd::{Mask8, Vec3x8, F8};
+
+/// Largest relative error bound on a hit distance answered in f32 (bigger goes to f64).
+pub(super) const TAU: f32 = 9e-6;
+/// Unit roundoff of f32, rounded up.
+const U: f32 = 5.97e-8;
+
+/// Per-ellipsoid f32 data for [`fast8`], precomputed in f64 from the world-to-object map.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Fast {
+    /// B = S V^T of the SVD A = U S V^T of the world-to-object linear part, rows (unused for spheres)
+    b: [[f32; 3]; 3],
+    /// world centre as hi + lo
+    c_hi: [f32; 3],
+    c_lo: [f32; 3],
+    /// |do'| <= k_o max|D_i| + eps_c, |dd'| <= k_d max|d_i|
+    k_o: f32,
+    k_d: f32,
+    eps_c: f32,
+    /// Some(1/r) for spheres (A a similarity up to 1e-6 relative)
+    inv_r: Option<f32>,
+    /// false if anything is non-finite or out of range: every lane takes the f64 path
+    usable: bool,
+}
+
+/// Eigen-decomposition of a symmetric 3x3 matrix (cyclic Jacobi): eigenvalues and eigenvectors
+/// (columns of the returned matrix).
+fn sym_eigen(m: glam::DMat3) -> ([f64; 3], glam::DMat3) {
+    let mut a = m.to_cols_array_2d(); // a[col][row], symmetric
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _ in 0..50 {
+        let off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if !(off > 1e-36 * diag) {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let (c, s) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+            // a = J^T a J with J the rotation in the (p, q) plane.
+            for k in 0..3 {
+                let (akp, akq) = (a[k][p], a[k][q]);
+                a[k][p] = c * akp - s * akq;
+                a[k][q] = s * akp + c * akq;
+            }
+            for k in 0..3 {
+                let (apk, aqk) = (a[p][k], a[q][k]);
+                a[p][k] = c * apk - s * aqk;
+                a[q][k] = s * apk + c * aqk;
+            }
+            for row in &mut v {
+                let (vp, vq) = (row[p], row[q]);
+                row[p] = c * vp - s * vq;
+                row[q] = s * vp + c * vq;
+            }
+        }
+    }
+    let vm = glam::DMat3::from_cols_array_2d(&[
+        [v[0][0], v[1][0], v[2][0]],
+        [v[0][1], v[1][1], v[2][1]],
+        [v[0][2], v[1][2], v[2][2]],
+    ]);
+    ([a[0][0], a[1][1], a[2][2]], vm)
+}
+
+impl Fast {
+    /// From the world-to-object rows (linear part and translation) of the f64 path.
+    pub(super) fn new(inv: &[[f64; 4]; 3]) -> Self {
+        let a64 = glam::DMat3::from_cols_array(&[
+            inv[0][0], inv[1][0], inv[2][0], inv[0][1], inv[1][1], inv[2][1], inv[0][2], inv[1][2], inv[2][2],
+        ]);
+        let t64 = glam::DVec3::new(inv[0][3], inv[1][3], inv[2][3]);
+        // Centre: A C + t = 0.
+        let c = -(a64.inverse() * t64);
+        let c_hi = c.to_array().map(|v| v as f32);
+        let c_lo: [f32; 3] = std::array::from_fn(|i| (c[i] - f64::from(c_hi[i])) as f32);
+        let u = f64::from(U);
+        // Similarity? r^2 A^T A = I up to dev (relative); then |A x - R x / r| <= dev |x| / r.
+        let g = a64.transpose() * a64;
+        let r2inv = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+        let dev = (g - glam::DMat3::from_diagonal(glam::DVec3::splat(r2inv)))
+            .to_cols_array()
+            .iter()
+            .fold(0f64, |m, v| m.max(v.abs()))
+            / r2inv;
+        let mut b = [[0f32; 3]; 3];
+        let (k_o, k_d, nrm, inv_r) = if dev <= 1e-6 && r2inv > 0.0 {
+            // o' = D / r: D (2u), times 1/r (u), 1/r rounded (u), plus dev; |D| <= sqrt 3 max|D_i|.
+            let ir = r2inv.sqrt();
+            let k = 3f64.sqrt() * ir * 1.01;
+            ((4.0 * u + dev) * k, (2.0 * u + dev) * k, k, Some(ir as f32))
+        } else {
+            // A^T A = V S^2 V^T; |A x| = |S V^T x| for every x, so B = S V^T serves as A (the
+            // rotation U changes no distance). Row i of B is s_i v_i: its rounding error is
+            // relative to s_i, not mixed with the other axes as in A.
+            let (ev, v) = sym_eigen(g);
+            let mut n = 0.0;
+            for i in 0..3 {
+                let si = ev[i].max(0.0).sqrt();
+                let vi = v.col(i);
+                b[i] = [(si * vi.x) as f32, (si * vi.y) as f32, (si * vi.z) as f32];
+                let row = si * (vi.x.abs() + vi.y.abs() + vi.z.abs());
+                n += row * row;
+            }
+            // B's own error (the eigen solve in f64) is ~1e-15 relative: inside the 1.01.
+            let k = n.sqrt() * 1.01;
+            // D (2u) + B rounded (u) + 3-term dot (3u); d' with exact d: 4u.
+            (6.0 * u * k, 4.0 * u * k, k, None)
+        };
+        let cmax = c.abs().max_element();
+        let eps_c = (4.0 * u * u * cmax * nrm) as f32;
+        let (k_o, k_d) = (k_o as f32, k_d as f32);
+        let finite = b.iter().flatten().chain(&c_hi).chain(&c_lo).all(|v| v.is_finite())
+            && [k_o, k_d, eps_c].iter().all(|v| v.is_finite())
+            && inv_r.is_none_or(|r| r.is_finite() && r > 0.0);
+        // Keep |o'|^2 and the error terms far from f32 overflow and underflow.
+        let usable = finite && nrm < 1e15 && nrm > 1e-15;
+        Self { b, c_hi, c_lo, k_o, k_d, eps_c, inv_r, usable }
+    }
+}
+
+/// f32 SIMD result of one packet: lanes hit (with distance `t`) and lanes it cannot decide.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Fast8 {
+    /// lanes with a certain hit in (tnear, tfar), distance `t` within TAU relative
+    pub hit: Mask8,
+    /// hit distance where `hit`
+    pub t: F8,
+    /// lanes to recompute in f64 (never overlaps `hit`)
+    pub unsure: Mask8,
+}
+
+#[inline(always)]
+fn max_abs(v: Vec3x8) -> F8 {
+    v.x.abs().max(v.y.abs()).max(v.z.abs())
+}
+
+/// The f32 SIMD pass over the `valid` lanes (see the module doc for the bound).
+#[inline]
+pub(super) fn fast8(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, valid: Mask8) -> Fast8 {
+    let none = F8::ZERO;
+    if !e.usable {
+        return Fast8 { hit: none, t: none, unsure: valid };
+    }
+    let s = |v: f32| F8::splat(v);
+    let dd = (org - Vec3x8::new(s(e.c_hi[0]), s(e.c_hi[1]), s(e.c_hi[2])))
+        - Vec3x8::new(s(e.c_lo[0]), s(e.c_lo[1]), s(e.c_lo[2]));
+    let (o, d) = match e.inv_r {
+        Some(ir) => (dd * s(ir), dir * s(ir)),
+        None => {
+            let m = |v: Vec3x8| {
+                let row = |r: &[f32; 3]| s(r[0]).mul_add(v.x, s(r[1]).mul_add(v.y, s(r[2]) * v.z));
+                Vec3x8::new(row(&e.b[0]), row(&e.b[1]), row(&e.b[2]))
+            };
+            (m(dd), m(dir))
+        }
+    };
+    let e_o = s(e.k_o).mul_add(max_abs(dd), s(e.eps_c));
+    let e_d = s(e.k_d) * max_abs(dir);
+    let a = d.dot(d);
+    let oo = o.dot(o);
+    let inv_a = F8::ONE / a;
+    let b = -o.dot(d) * inv_a;
+    let f = d.mul_add(b, o);
+    let ff = f.dot(f);
+    let disc = F8::ONE - ff;
+    let (dlen, olen, flen) = (a.sqrt(), oo.sqrt(), ff.sqrt());
+    let eta = e_d / dlen;
+    // Along-ray error of the closest approach (object units), and radial error of f.
+    let e_b = e_o + olen * (s(2.0) * eta + s(7.0 * U));
+    let e_r = e_o + olen * (s(1.1) * eta) + s(U) * flen;
+    let e_disc = (s(2.0) * flen + e_r).mul_add(e_r, e_b * (e_b + s(2.0 * U) * flen)) + s(4.0 * U) * (ff + F8::ONE);
+    // eta <= 1e-3 is false for NaN and for a == 0 (eta = inf or NaN).
+    let ok = valid & eta.simd_le(s(1e-3)) & olen.simd_lt(s(1e18)) & a.simd_gt(s(1e-30)) & a.simd_lt(s(1e30));
+    let miss = ok & disc.simd_lt(-e_disc);
+    let two_roots = ok & disc.simd_gt(e_disc);
+    let mut unsure = valid & !miss & !two_roots;
+    if two_roots.none() {
+        return Fast8 { hit: none, t: none, unsure };
+    }
+    let disc = two_roots.select(disc, F8::ONE);
+    let sd = disc.sqrt();
+    let h = sd / dlen;
+    // Stable roots: q = b + sign(b) h has no cancellation; the other root is c / (a q).
+    let q = b + b.simd_lt(F8::ZERO).select(-h, h);
+    let r2 = (oo - F8::ONE) * inv_a / q;
+    let t_lo = q.min(r2);
+    let t_hi = q.max(r2);
+    // |sqrt(x') - sqrt(x)| <= e / (sqrt x + sqrt(x - e)) for |x' - x| <= e < x.
+    let e_sqrt = e_disc / (sd + (disc - e_disc).max(F8::ZERO).sqrt());
+    let e_t = (e_b + e_sqrt) / dlen + (s(1.1) * eta + s(8.0 * U)) * (b.abs() + h);
+    let near = |t: F8, x: F8| (t - x).abs().simd_le(e_t);
+    let edge = near(t_lo, tnear) | near(t_lo, tfar) | near(t_hi, tnear) | near(t_hi, tfar);
+    let in_lo = t_lo.simd_gt(tnear) & t_lo.simd_lt(tfar);
+    let in_hi = t_hi.simd_gt(tnear) & t_hi.simd_lt(tfar);
+    let t = in_lo.select(t_lo, t_hi);
+    let any = in_lo | in_hi;
+    // NaN in e_t (or t) fails the <= test and goes to f64 too.
+    let loose = any & !e_t.simd_le(s(TAU) * t.abs());
+    let bad = two_roots & (edge | loose | !e_t.is_finite());
+    unsure |= bad;
+    let hit = two_roots & any & !bad;
+    Fast8 { hit, t: hit.select(t, none), unsure }
+}
+
+/// Intersects the ellipsoid with the `m <= 8` lanes of a packet: `load(field)` returns the first
+/// `m` floats of Embree ray field `field` (0-2 org, 3 tnear, 4-6 dir, 8 tfar; lanes >= m
+/// anything finite), `valid(i)` whether lane i is active. Calls `on_hit(lane, t)` for every lane
+/// hit inside (tnear, tfar), f32 SIMD with f64 ([`Ellipsoid::hit`]) for the unsure lanes.
+#[inline]
+pub(super) fn packet_hits(
+    e: &Ellipsoid,
+    m: usize,
+    load: impl Fn(usize) -> [f32; 8],
+    valid: impl Fn(usize) -> bool,
+    mut on_hit: impl FnMut(usize, f32),
+) {
+    let mut vb = [0f32; 8];
+    for (i, v) in vb.iter_mut().enumerate().take(m) {
+        if valid(i) {
+            *v = f32::from_bits(u32::MAX);
+        }
+    }
+    let live = F8::new(vb);
+    if live.none() {
+        return;
+    }
+    let v3 = |f: usize| Vec3x8::new(F8::new(load(f)), F8::new(load(f + 1)), F8::new(load(f + 2)));
+    let (org, dir, tnear, tfar) = (v3(0), v3(4), F8::new(load(3)), F8::new(load(8)));
+    let r = fast8(&e.fast, org, dir, tnear, tfar, live);
+    let (hit, unsure) = (r.hit.to_bitmask(), r.unsure.to_bitmask());
+    if hit | unsure == 0 {
+        return;
+    }
+    let t = r.t.to_array();
+    let mut bits = hit | unsure;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        if hit & (1 << i) != 0 {
+            on_hit(i, t[i]);
+        } else {
+            let (o, d) = (org.lane(i), dir.lane(i));
+            if let Some(t) = e.hit(o.to_array(), d.to_array(), tnear.as_array()[i], tfar.as_array()[i]) {
+                on_hit(i, t);
+            }
+        }
+    }
+}
+
+/// Old (f64 per lane) and new (f32 packet) intersection of one ellipsoid, for `benches/ellipsoid.rs`.
+#[doc(hidden)]
+pub mod bench {
+    use super::{packet_hits, Ellipsoid};
+    use glam::Mat4;
+
+    /// One ellipsoid, the unit sphere under `object_to_world`.
+    pub struct Prim(Ellipsoid);
+
+    /// 8 rays in Embree field order (0-2 org, 3 tnear, 4-6 dir, 8 tfar).
+    pub type Packet = [[f32; 8]; 9];
+
+    impl Prim {
+        /// None if the map is singular.
+        pub fn new(object_to_world: &Mat4) -> Option<Self> {
+            Ellipsoid::new(object_to_world).map(Self)
+        }
+        /// The f64 path lane by lane; returns the number of hits and the sum of their distances.
+        pub fn scalar64(&self, p: &Packet) -> (u32, f32) {
+            let (mut n, mut s) = (0, 0.0);
+            for i in 0..8 {
+                let l = |f: usize| p[f][i];
+                if let Some(t) = self.0.hit([l(0), l(1), l(2)], [l(4), l(5), l(6)], l(3), l(8)) {
+                    n += 1;
+                    s += t;
+                }
+            }
+            (n, s)
+        }
+        /// The f32 packet path (with its f64 fallback); same result as [`Prim::scalar64`].
+        pub fn packet(&self, p: &Packet) -> (u32, f32) {
+            let (mut n, mut s) = (0, 0.0);
+            packet_hits(
+                &self.0,
+                8,
+                |f| p[f],
+                |_| true,
+                |_, t| {
+                    n += 1;
+                    s += t;
+                },
+            );
+            (n, s)
+        }
+        /// Lanes of `p` the f32 pass leaves to f64.
+        pub fn unsure(&self, p: &Packet) -> u32 {
+            use crate::simd::{mask_all, Vec3x8, F8};
+            let v3 = |f: usize| Vec3x8::new(F8::new(p[f]), F8::new(p[f + 1]), F8::new(p[f + 2]));
+            let r = super::fast8(&self.0.fast, v3(0), v3(4), F8::new(p[3]), F8::new(p[8]), mask_all());
+            r.unsure.to_bitmask().count_ones()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat4, Quat, Vec3};
+
+    /// Tolerance on hit distances against the f64 path: |t - t64| <= REL |t64|.
+    const REL: f32 = 1e-5;
+
+    /// xorshift64*: deterministic, no dependency.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32) / (1u64 << 24) as f32
+        }
+        fn sym(&mut self) -> f32 {
+            2.0 * self.next() - 1.0
+        }
+        fn dir(&mut self) -> Vec3 {
+            loop {
+                let v = Vec3::new(self.sym(), self.sym(), self.sym());
+                if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                    return v.normalize();
+                }
+            }
+        }
+    }
+
+    #[derive(Clone, Copy, Debug)]
+    struct Ray {
+        o: Vec3,
+        d: Vec3,
+        tn: f32,
+        tf: f32,
+    }
+
+    /// Packet answer of the first `rays.len() <= 8` lanes (lane subsets through `valid`).
+    fn packet(e: &Ellipsoid, rays: &[Ray], valid: impl Fn(usize) -> bool) -> [Option<f32>; 8] {
+        let mut fields = [[0f32; 8]; 9];
+        for (i, r) in rays.iter().enumerate() {
+            let v = [r.o.x, r.o.y, r.o.z, r.tn, r.d.x, r.d.y, r.d.z, 0.0, r.tf];
+            for f in 0..9 {
+                fields[f][i] = v[f];
+            }
+        }
+        let mut out = [None; 8];
+        packet_hits(
+            e,
+            rays.len(),
+            |f| fields[f],
+            valid,
+            |i, t| {
+                assert!(out[i].is_none(), "lane {i} reported twice");
+                out[i] = Some(t);
+            },
+        );
+        out
+    }
+
+    /// The normal the renderer computes (scene::build gather): from the hit point, in f32.
+    fn normal(m: &Mat4, r: &Ray, t: f32) -> Vec3 {
+        let w2o = m.inverse();
+        let n = glam::Mat3::from_mat4(w2o).transpose();
+        (n * w2o.transform_point3(r.d.mul_add(Vec3::splat(t), r.o))).normalize_or_zero()
+    }
+
+    #[derive(Default, Debug)]
+    struct Stats {
+        rays: usize,
+        hits: usize,
+        unsure: usize,
+        max_rel: f32,
+        max_normal: f32,
+    }
+
+    /// Checks every ray against the f64 path in packets of 8: same hit/miss, |t - t64| <= REL t64,
+    /// and (when `normal_tol` is given) renderer normals within it.
+    fn check(m: &Mat4, rays: &[Ray], normal_tol: Option<f32>) -> Stats {
+        let e = Ellipsoid::new(m).expect("invertible");
+        let mut st = Stats::default();
+        for chunk in rays.chunks(8) {
+            let got = packet(&e, chunk, |_| true);
+            let mut fields = [[0f32; 8]; 9];
+            for (i, r) in chunk.iter().enumerate() {
+                let v = [r.o.x, r.o.y, r.o.z, r.tn, r.d.x, r.d.y, r.d.z, 0.0, r.tf];
+                for f in 0..9 {
+                    fields[f][i] = v[f];
+                }
+            }
+            let v3 = |f: usize| Vec3x8::new(F8::new(fields[f]), F8::new(fields[f + 1]), F8::new(fields[f + 2]));
+            let live = crate::simd::mask_first(chunk.len());
+            let fr = fast8(&e.fast, v3(0), v3(4), F8::new(fields[3]), F8::new(fields[8]), live);
+            st.unsure += fr.unsure.to_bitmask().count_ones() as usize;
+            for (i, r) in chunk.iter().enumerate() {
+                let want = e.hit(r.o.to_array(), r.d.to_array(), r.tn, r.tf);
+                st.rays += 1;
+                match (got[i], want) {
+                    (None, None) => {}
+                    (Some(t), Some(t64)) => {
+                        st.hits += 1;
+                        let rel = (t - t64).abs() / t64.abs().max(f32::MIN_POSITIVE);
+                        st.max_rel = st.max_rel.max(rel);
+                        assert!(rel <= REL, "t {t} vs f64 {t64} (rel {rel:e}) for {r:?} under {m:?}");
+                        assert!(t > r.tn && t < r.tf);
+                        if let Some(tol) = normal_tol {
+                            let dn = (normal(m, r, t) - normal(m, r, t64)).length();
+                            st.max_normal = st.max_normal.max(dn);
+                            assert!(dn <= tol, "normal off by {dn:e} for {r:?}");
+                        }
+                    }
+                    (g, w) => panic!("hit/miss disagree: packet {g:?}, f64 {w:?} for {r:?} under {m:?}"),
+                }
+            }
+        }
+        st
+    }
+
+    fn sphere(c: Vec3, r: f32) -> Mat4 {
+        Mat4::from_translation(c) * Mat4::from_rotation_y(0.4) * Mat4::from_scale(Vec3::splat(r))
+    }
+
+    fn ellipsoid(c: Vec3, axes: Vec3) -> Mat4 {
+        Mat4::from_translation(c)
+            * Mat4::from_quat(Quat::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.9))
+            * Mat4::from_scale(axes)
+    }
+
+    /// Rays from `eye` towards random points of the ellipsoid's bounding ball of radius `rad`
+    /// about `c` (scaled 1.3: a mix of hits and misses), unit directions.
+    fn aimed(rng: &mut Rng, n: usize, eye: Vec3, c: Vec3, rad: f32) -> Vec<Ray> {
+        (0..n)
+            .map(|_| {
+                let target = c + rng.dir() * (rad * 1.3 * rng.next().cbrt());
+                Ray { o: eye, d: (target - eye).normalize(), tn: 0.0, tf: f32::INFINITY }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn camera_like_rays_agree_with_f64() {
+        let mut rng = Rng(1);
+        let c = Vec3::new(0.3, 0.3, 0.2);
+        let m = sphere(c, 0.3);
+        let st = check(&m, &aimed(&mut rng, 100_000, Vec3::new(0.0, 1.0, 3.0), c, 0.3), Some(1e-4));
+        eprintln!("camera-like sphere: {st:?}");
+        assert!(st.hits > 30_000);
+        let m = ellipsoid(c, Vec3::new(0.3, 0.6, 0.2));
+        let st = check(&m, &aimed(&mut rng, 100_000, Vec3::new(0.0, 1.0, 3.0), c, 0.6), Some(1e-4));
+        eprintln!("camera-like ellipsoid: {st:?}");
+        assert!(st.unsure * 5 < st.rays, "f64 fallback should be rare: {st:?}");
+    }
+
+    #[test]
+    fn random_rays_agree_with_f64() {
+        let mut rng = Rng(2);
+        for k in 0..4 {
+            let c = Vec3::new(rng.sym(), rng.sym(), rng.sym()) * 5.0;
+            let axes = Vec3::new(0.2 + rng.next(), 0.2 + rng.next(), 0.2 + rng.next());
+            let m = if k % 2 == 0 { sphere(c, axes.x) } else { ellipsoid(c, axes) };
+            let rays: Vec<Ray> = (0..25_000)
+                .map(|_| {
+                    let o = c + Vec3::new(rng.sym(), rng.sym(), rng.sym()) * 4.0;
+                    // Aim near the centre (many hits) or anywhere.
+                    let d = if rng.next() < 0.5 { (c + rng.dir() * 1.5 - o).normalize() } else { rng.dir() };
+                    let tn = if rng.next() < 0.2 { rng.next() * 3.0 } else { 0.0 };
+                    let tf = if rng.next() < 0.2 { tn + rng.next() * 8.0 } else { f32::INFINITY };
+                    // Unnormalized directions too: t is in units of |d|.
+                    let s = if rng.next() < 0.3 { 0.1 + 10.0 * rng.next() } else { 1.0 };
+                    Ray { o, d: d * s, tn: tn / s, tf: tf / s }
+                })
+                .collect();
+            let st = check(&m, &rays, None);
+            eprintln!("random {k}: {st:?}");
+        }
+    }
+
+    #[test]
+    fn grazing_rays_agree_with_f64() {
+        // Rays along z at distance 1 +- eps from the axis of a unit-ish sphere: tangent +- eps.
+        for &r in &[1.0f32, 0.37] {
+            let c = Vec3::new(0.25, -0.5, 0.0);
+            let m = sphere(c, r);
+            let mut rays = Vec::new();
+            let eps_list = (1..=40i32).flat_map(|k| [-1.0f32, 1.0].map(|s| s * 2f32.powi(-k / 2))).chain([0.0]);
+            for eps in eps_list {
+                for ang in 0..8 {
+                    let phi = ang as f32 * 0.785;
+                    let off = Vec3::new(phi.cos(), phi.sin(), 0.0) * (r * (1.0 + eps));
+                    rays.push(Ray { o: c + off - Vec3::Z * (3.0 * r), d: Vec3::Z, tn: 0.0, tf: f32::INFINITY });
+                }
+            }
+            let st = check(&m, &rays, Some(1e-2));
+            eprintln!("grazing r={r}: {st:?}");
+            assert!(st.unsure > 0, "near-tangent rays must go to f64");
+        }
+        // The same for an ellipsoid, tangent planes found in object space.
+        let m = ellipsoid(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 2.0, 0.1));
+        let mut rays = Vec::new();
+        for k in 1..40 {
+            for s in [-1.0f32, 1.0] {
+                let eps = s * 2f32.powi(-k / 2);
+                let (oo, dd) = (Vec3::new(1.0 + eps, 0.0, -5.0), Vec3::Z);
+                rays.push(Ray { o: m.transform_point3(oo), d: m.transform_vector3(dd), tn: 0.0, tf: f32::INFINITY });
+            }
+        }
+        check(&m, &rays, None);
+    }
+
+    #[test]
+    fn far_away_rays_agree_with_f64() {
+        let mut rng = Rng(3);
+        for &dist in &[1e4f32, 1e5, 1e6] {
+            let c = Vec3::new(1.0, 2.0, -3.0);
+            for m in [sphere(c, 0.5), ellipsoid(c, Vec3::new(0.5, 0.3, 0.8))] {
+                let mut rays = Vec::new();
+                for _ in 0..4000 {
+                    let eye = c + rng.dir() * (dist * 0.8);
+                    rays.extend(aimed(&mut rng, 1, eye, c, 0.8));
+                }
+                let st = check(&m, &rays, None);
+                eprintln!("far {dist:e}: {st:?}");
+                assert!(st.hits > 0);
+            }
+        }
+    }
+
+    #[test]
+    fn rays_from_inside_agree_with_f64() {
+        let mut rng = Rng(4);
+        let c = Vec3::new(-2.0, 0.5, 1.0);
+        for m in [sphere(c, 2.0), ellipsoid(c, Vec3::new(2.0, 0.5, 1.0))] {
+            let rays: Vec<Ray> = (0..20_000)
+                .map(|_| {
+                    let o = m.transform_point3(rng.dir() * 0.99 * rng.next());
+                    Ray { o, d: rng.dir(), tn: 0.0, tf: f32::INFINITY }
+                })
+                .collect();
+            let st = check(&m, &rays, Some(1e-3));
+            assert_eq!(st.hits, st.rays, "every ray from inside hits");
+        }
+    }
+
+    #[test]
+    fn tiny_and_huge_radii_agree_with_f64() {
+        let mut rng = Rng(5);
+        for &r in &[1e-4f32, 1e4] {
+            for c in [Vec3::ZERO, Vec3::new(3.0, -1.0, 2.0) * r, Vec3::new(1e3, 2e3, -5e2)] {
+                for m in [sphere(c, r), ellipsoid(c, Vec3::new(r, 0.5 * r, 2.0 * r))] {
+                    let eye = c + Vec3::new(1.0, 2.0, 5.0) * r;
+                    let st = check(&m, &aimed(&mut rng, 4000, eye, c, 2.0 * r), None);
+                    eprintln!("r {r:e} at {c}: {st:?}");
+                    assert!(st.hits > 0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn extreme_axis_ratios_agree_with_f64() {
+        let mut rng = Rng(6);
+        let c = Vec3::new(0.5, 0.5, 0.5);
+        for axes in [Vec3::new(1.0, 1.0, 1e-4), Vec3::new(1e-4, 1.0, 1e-4), Vec3::new(1e2, 1e-2, 1.0)] {
+            for m in [Mat4::from_translation(c) * Mat4::from_scale(axes), ellipsoid(c, axes)] {
+                let eye = c + Vec3::new(0.3, 0.2, 1.0) * 5.0 * axes.max_element();
+                let st = check(&m, &aimed(&mut rng, 20_000, eye, c, axes.max_element()), None);
+                eprintln!("axes {axes}: {st:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn interval_boundaries_agree_with_f64() {
+        // Unit sphere at 5 on the z axis: roots at 4 and 6 for rays from the origin.
+        let m = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0));
+        let mut rays = Vec::new();
+        for root in [4.0f32, 6.0] {
+            for k in -12..=12 {
+                let x = root + k as f32 * root * f32::EPSILON;
+                let ray = |tn, tf| Ray { o: Vec3::ZERO, d: Vec3::Z, tn, tf };
+                rays.push(ray(x, f32::INFINITY));
+                rays.push(ray(0.0, x));
+                rays.push(ray(x, x + 0.5));
+            }
+        }
+        rays.push(Ray { o: Vec3::ZERO, d: Vec3::Z, tn: 5.0, tf: 5.0 });
+        rays.push(Ray { o: Vec3::ZERO, d: Vec3::Z, tn: 6.0, tf: 4.0 });
+        let st = check(&m, &rays, None);
+        eprintln!("boundaries: {st:?}");
+    }
+
+    #[test]
+    fn any_lane_count_and_mask_agree_with_f64() {
+        let mut rng = Rng(7);
+        let c = Vec3::new(0.0, 0.0, 4.0);
+        let m = sphere(c, 1.0);
+        let e = Ellipsoid::new(&m).unwrap();
+        let rays = aimed(&mut rng, 8, Vec3::ZERO, c, 1.0);
+        for n in 1..=8 {
+            for mask in [0xffu32, 0x55, 0xaa, 0x01, 0x80, 0x00] {
+                let got = packet(&e, &rays[..n], |i| mask & (1 << i) != 0);
+                for i in 0..8 {
+                    let want = if i < n && mask & (1 << i) != 0 {
+                        let r = &rays[i];
+                        e.hit(r.o.to_array(), r.d.to_array(), r.tn, r.tf)
+                    } else {
+                        None
+                    };
+                    assert_eq!(got[i].is_some(), want.is_some(), "n {n} mask {mask:#x} lane {i}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_rays_never_report_nan() {
+        let m = sphere(Vec3::new(0.0, 0.0, 3.0), 1.0);
+        let e = Ellipsoid::new(&m).unwrap();
+        let (n, inf) = (f32::NAN, f32::INFINITY);
+        let rays = [
+            Ray { o: Vec3::ZERO, d: Vec3::ZERO, tn: 0.0, tf: inf },
+            Ray { o: Vec3::new(n, 0.0, 0.0), d: Vec3::Z, tn: 0.0, tf: inf },
+            Ray { o: Vec3::ZERO, d: Vec3::new(0.0, n, 1.0), tn: 0.0, tf: inf },
+            Ray { o: Vec3::ZERO, d: Vec3::Z, tn: n, tf: inf },
+            Ray { o: Vec3::ZERO, d: Vec3::Z, tn: 0.0, tf: n },
+            Ray { o: Vec3::splat(1e30), d: Vec3::Z, tn: 0.0, tf: inf },
+            Ray { o: Vec3::ZERO, d: Vec3::Z * 1e-30, tn: 0.0, tf: inf },
+            Ray { o: Vec3::ZERO, d: Vec3::Z * 1e30, tn: 0.0, tf: inf },
+        ];
+        let got = packet(&e, &rays, |_| true);
+        for (i, r) in rays.iter().enumerate() {
+            let want = e.hit(r.o.to_array(), r.d.to_array(), r.tn, r.tf);
+            assert_eq!(got[i].is_some(), want.is_some(), "lane {i}: {r:?}");
+            assert!(got[i].is_none_or(|t| t.is_finite()), "lane {i}");
+        }
+    }
+}
