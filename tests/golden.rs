@@ -4,7 +4,7 @@
 //! pixel sample 0 through the pixel centre for `.test` scenes) moved every case; the `-jittered`
 //! cases opt out and kept the hashes recorded before them. The SIMD f32 sphere/ellipsoid
 //! intersection ([3 of 5]: hit distances within 1e-5 relative of the old f64 ones) then moved every
-//! case whose scene has a sphere (11 of 20; the 9 sphere-free ones kept their bits, which shows the
+//! case whose scene has a sphere (14 of 20; the 6 sphere-free ones kept their bits, which shows the
 //! restructured code paths unchanged). History: `git log -p tests/golden.rs`. Print the current table with
 //! `STRATA_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture`.
 
