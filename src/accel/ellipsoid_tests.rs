@@ -1,0 +1,337 @@
+//! Tests of the SIMD ellipsoid intersection against the f64 oracle (`Ellipsoid::hit`).
+
+use super::*;
+use glam::{Mat4, Quat, Vec3};
+
+/// Tolerance on hit distances against the f64 path: |t - t64| <= REL |t64|.
+const REL: f32 = 1e-5;
+
+/// xorshift64*: deterministic, no dependency.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32) / (1u64 << 24) as f32
+    }
+    fn sym(&mut self) -> f32 {
+        2.0 * self.next() - 1.0
+    }
+    fn dir(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(self.sym(), self.sym(), self.sym());
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
+            }
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Ray {
+    o: Vec3,
+    d: Vec3,
+    tn: f32,
+    tf: f32,
+}
+
+/// Packet answer of the first `rays.len() <= 8` lanes (lane subsets through `valid`).
+fn packet(e: &Ellipsoid, rays: &[Ray], valid: impl Fn(usize) -> bool) -> [Option<f32>; 8] {
+    let mut fields = [[0f32; 8]; 9];
+    for (i, r) in rays.iter().enumerate() {
+        let v = [r.o.x, r.o.y, r.o.z, r.tn, r.d.x, r.d.y, r.d.z, 0.0, r.tf];
+        for f in 0..9 {
+            fields[f][i] = v[f];
+        }
+    }
+    let mut out = [None; 8];
+    packet_hits(
+        e,
+        rays.len(),
+        |f| fields[f],
+        valid,
+        |i, t| {
+            assert!(out[i].is_none(), "lane {i} reported twice");
+            out[i] = Some(t);
+        },
+    );
+    out
+}
+
+/// The normal the renderer computes (scene::build gather): from the hit point, in f32.
+fn normal(m: &Mat4, r: &Ray, t: f32) -> Vec3 {
+    let w2o = m.inverse();
+    let n = glam::Mat3::from_mat4(w2o).transpose();
+    (n * w2o.transform_point3(r.d.mul_add(Vec3::splat(t), r.o))).normalize_or_zero()
+}
+
+#[derive(Default, Debug)]
+struct Stats {
+    rays: usize,
+    hits: usize,
+    unsure: usize,
+    max_rel: f32,
+    max_normal: f32,
+}
+
+/// Checks every ray against the f64 path in packets of 8: same hit/miss, |t - t64| <= REL t64,
+/// and (when `normal_tol` is given) renderer normals within it.
+fn check(m: &Mat4, rays: &[Ray], normal_tol: Option<f32>) -> Stats {
+    let e = Ellipsoid::new(m).expect("invertible");
+    let mut st = Stats::default();
+    for chunk in rays.chunks(8) {
+        let got = packet(&e, chunk, |_| true);
+        let mut fields = [[0f32; 8]; 9];
+        for (i, r) in chunk.iter().enumerate() {
+            let v = [r.o.x, r.o.y, r.o.z, r.tn, r.d.x, r.d.y, r.d.z, 0.0, r.tf];
+            for f in 0..9 {
+                fields[f][i] = v[f];
+            }
+        }
+        let v3 = |f: usize| Vec3x8::new(F8::new(fields[f]), F8::new(fields[f + 1]), F8::new(fields[f + 2]));
+        let live = crate::simd::mask_first(chunk.len());
+        let fr = fast8(&e.fast, v3(0), v3(4), F8::new(fields[3]), F8::new(fields[8]), live);
+        st.unsure += fr.unsure.to_bitmask().count_ones() as usize;
+        for (i, r) in chunk.iter().enumerate() {
+            let want = e.hit(r.o.to_array(), r.d.to_array(), r.tn, r.tf);
+            st.rays += 1;
+            match (got[i], want) {
+                (None, None) => {}
+                (Some(t), Some(t64)) => {
+                    st.hits += 1;
+                    let rel = (t - t64).abs() / t64.abs().max(f32::MIN_POSITIVE);
+                    st.max_rel = st.max_rel.max(rel);
+                    assert!(rel <= REL, "t {t} vs f64 {t64} (rel {rel:e}) for {r:?} under {m:?}");
+                    assert!(t > r.tn && t < r.tf);
+                    if let Some(tol) = normal_tol {
+                        let dn = (normal(m, r, t) - normal(m, r, t64)).length();
+                        st.max_normal = st.max_normal.max(dn);
+                        assert!(dn <= tol, "normal off by {dn:e} for {r:?}");
+                    }
+                }
+                (g, w) => panic!("hit/miss disagree: packet {g:?}, f64 {w:?} for {r:?} under {m:?}"),
+            }
+        }
+    }
+    st
+}
+
+fn sphere(c: Vec3, r: f32) -> Mat4 {
+    Mat4::from_translation(c) * Mat4::from_rotation_y(0.4) * Mat4::from_scale(Vec3::splat(r))
+}
+
+fn ellipsoid(c: Vec3, axes: Vec3) -> Mat4 {
+    Mat4::from_translation(c)
+        * Mat4::from_quat(Quat::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.9))
+        * Mat4::from_scale(axes)
+}
+
+/// Rays from `eye` towards random points of the ellipsoid's bounding ball of radius `rad`
+/// about `c` (scaled 1.3: a mix of hits and misses), unit directions.
+fn aimed(rng: &mut Rng, n: usize, eye: Vec3, c: Vec3, rad: f32) -> Vec<Ray> {
+    (0..n)
+        .map(|_| {
+            let target = c + rng.dir() * (rad * 1.3 * rng.next().cbrt());
+            Ray { o: eye, d: (target - eye).normalize(), tn: 0.0, tf: f32::INFINITY }
+        })
+        .collect()
+}
+
+#[test]
+fn camera_like_rays_agree_with_f64() {
+    let mut rng = Rng(1);
+    let c = Vec3::new(0.3, 0.3, 0.2);
+    let m = sphere(c, 0.3);
+    let st = check(&m, &aimed(&mut rng, 100_000, Vec3::new(0.0, 1.0, 3.0), c, 0.3), Some(1e-4));
+    eprintln!("camera-like sphere: {st:?}");
+    assert!(st.hits > 30_000);
+    let m = ellipsoid(c, Vec3::new(0.3, 0.6, 0.2));
+    let st = check(&m, &aimed(&mut rng, 100_000, Vec3::new(0.0, 1.0, 3.0), c, 0.6), Some(1e-4));
+    eprintln!("camera-like ellipsoid: {st:?}");
+    assert!(st.unsure * 5 < st.rays, "f64 fallback should be rare: {st:?}");
+}
+
+#[test]
+fn random_rays_agree_with_f64() {
+    let mut rng = Rng(2);
+    for k in 0..4 {
+        let c = Vec3::new(rng.sym(), rng.sym(), rng.sym()) * 5.0;
+        let axes = Vec3::new(0.2 + rng.next(), 0.2 + rng.next(), 0.2 + rng.next());
+        let m = if k % 2 == 0 { sphere(c, axes.x) } else { ellipsoid(c, axes) };
+        let rays: Vec<Ray> = (0..25_000)
+            .map(|_| {
+                let o = c + Vec3::new(rng.sym(), rng.sym(), rng.sym()) * 4.0;
+                // Aim near the centre (many hits) or anywhere.
+                let d = if rng.next() < 0.5 { (c + rng.dir() * 1.5 - o).normalize() } else { rng.dir() };
+                let tn = if rng.next() < 0.2 { rng.next() * 3.0 } else { 0.0 };
+                let tf = if rng.next() < 0.2 { tn + rng.next() * 8.0 } else { f32::INFINITY };
+                // Unnormalized directions too: t is in units of |d|.
+                let s = if rng.next() < 0.3 { 0.1 + 10.0 * rng.next() } else { 1.0 };
+                Ray { o, d: d * s, tn: tn / s, tf: tf / s }
+            })
+            .collect();
+        let st = check(&m, &rays, None);
+        eprintln!("random {k}: {st:?}");
+    }
+}
+
+#[test]
+fn grazing_rays_agree_with_f64() {
+    // Rays along z at distance 1 +- eps from the axis of a unit-ish sphere: tangent +- eps.
+    for &r in &[1.0f32, 0.37] {
+        let c = Vec3::new(0.25, -0.5, 0.0);
+        let m = sphere(c, r);
+        let mut rays = Vec::new();
+        let eps_list = (1..=40i32).flat_map(|k| [-1.0f32, 1.0].map(|s| s * 2f32.powi(-k / 2))).chain([0.0]);
+        for eps in eps_list {
+            for ang in 0..8 {
+                let phi = ang as f32 * 0.785;
+                let off = Vec3::new(phi.cos(), phi.sin(), 0.0) * (r * (1.0 + eps));
+                rays.push(Ray { o: c + off - Vec3::Z * (3.0 * r), d: Vec3::Z, tn: 0.0, tf: f32::INFINITY });
+            }
+        }
+        let st = check(&m, &rays, Some(1e-2));
+        eprintln!("grazing r={r}: {st:?}");
+        assert!(st.unsure > 0, "near-tangent rays must go to f64");
+    }
+    // The same for an ellipsoid, tangent planes found in object space.
+    let m = ellipsoid(Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 2.0, 0.1));
+    let mut rays = Vec::new();
+    for k in 1..40 {
+        for s in [-1.0f32, 1.0] {
+            let eps = s * 2f32.powi(-k / 2);
+            let (oo, dd) = (Vec3::new(1.0 + eps, 0.0, -5.0), Vec3::Z);
+            rays.push(Ray { o: m.transform_point3(oo), d: m.transform_vector3(dd), tn: 0.0, tf: f32::INFINITY });
+        }
+    }
+    check(&m, &rays, None);
+}
+
+#[test]
+fn far_away_rays_agree_with_f64() {
+    let mut rng = Rng(3);
+    for &dist in &[1e4f32, 1e5, 1e6] {
+        let c = Vec3::new(1.0, 2.0, -3.0);
+        for m in [sphere(c, 0.5), ellipsoid(c, Vec3::new(0.5, 0.3, 0.8))] {
+            let mut rays = Vec::new();
+            for _ in 0..4000 {
+                let eye = c + rng.dir() * (dist * 0.8);
+                rays.extend(aimed(&mut rng, 1, eye, c, 0.8));
+            }
+            let st = check(&m, &rays, None);
+            eprintln!("far {dist:e}: {st:?}");
+            assert!(st.hits > 0);
+        }
+    }
+}
+
+#[test]
+fn rays_from_inside_agree_with_f64() {
+    let mut rng = Rng(4);
+    let c = Vec3::new(-2.0, 0.5, 1.0);
+    for m in [sphere(c, 2.0), ellipsoid(c, Vec3::new(2.0, 0.5, 1.0))] {
+        let rays: Vec<Ray> = (0..20_000)
+            .map(|_| {
+                let o = m.transform_point3(rng.dir() * 0.99 * rng.next());
+                Ray { o, d: rng.dir(), tn: 0.0, tf: f32::INFINITY }
+            })
+            .collect();
+        let st = check(&m, &rays, Some(1e-3));
+        assert_eq!(st.hits, st.rays, "every ray from inside hits");
+    }
+}
+
+#[test]
+fn tiny_and_huge_radii_agree_with_f64() {
+    let mut rng = Rng(5);
+    for &r in &[1e-4f32, 1e4] {
+        for c in [Vec3::ZERO, Vec3::new(3.0, -1.0, 2.0) * r, Vec3::new(1e3, 2e3, -5e2)] {
+            for m in [sphere(c, r), ellipsoid(c, Vec3::new(r, 0.5 * r, 2.0 * r))] {
+                let eye = c + Vec3::new(1.0, 2.0, 5.0) * r;
+                let st = check(&m, &aimed(&mut rng, 4000, eye, c, 2.0 * r), None);
+                eprintln!("r {r:e} at {c}: {st:?}");
+                assert!(st.hits > 0);
+            }
+        }
+    }
+}
+
+#[test]
+fn extreme_axis_ratios_agree_with_f64() {
+    let mut rng = Rng(6);
+    let c = Vec3::new(0.5, 0.5, 0.5);
+    for axes in [Vec3::new(1.0, 1.0, 1e-4), Vec3::new(1e-4, 1.0, 1e-4), Vec3::new(1e2, 1e-2, 1.0)] {
+        for m in [Mat4::from_translation(c) * Mat4::from_scale(axes), ellipsoid(c, axes)] {
+            let eye = c + Vec3::new(0.3, 0.2, 1.0) * 5.0 * axes.max_element();
+            let st = check(&m, &aimed(&mut rng, 20_000, eye, c, axes.max_element()), None);
+            eprintln!("axes {axes}: {st:?}");
+        }
+    }
+}
+
+#[test]
+fn interval_boundaries_agree_with_f64() {
+    // Unit sphere at 5 on the z axis: roots at 4 and 6 for rays from the origin.
+    let m = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0));
+    let mut rays = Vec::new();
+    for root in [4.0f32, 6.0] {
+        for k in -12..=12 {
+            let x = root + k as f32 * root * f32::EPSILON;
+            let ray = |tn, tf| Ray { o: Vec3::ZERO, d: Vec3::Z, tn, tf };
+            rays.push(ray(x, f32::INFINITY));
+            rays.push(ray(0.0, x));
+            rays.push(ray(x, x + 0.5));
+        }
+    }
+    rays.push(Ray { o: Vec3::ZERO, d: Vec3::Z, tn: 5.0, tf: 5.0 });
+    rays.push(Ray { o: Vec3::ZERO, d: Vec3::Z, tn: 6.0, tf: 4.0 });
+    let st = check(&m, &rays, None);
+    eprintln!("boundaries: {st:?}");
+}
+
+#[test]
+fn any_lane_count_and_mask_agree_with_f64() {
+    let mut rng = Rng(7);
+    let c = Vec3::new(0.0, 0.0, 4.0);
+    let m = sphere(c, 1.0);
+    let e = Ellipsoid::new(&m).unwrap();
+    let rays = aimed(&mut rng, 8, Vec3::ZERO, c, 1.0);
+    for n in 1..=8 {
+        for mask in [0xffu32, 0x55, 0xaa, 0x01, 0x80, 0x00] {
+            let got = packet(&e, &rays[..n], |i| mask & (1 << i) != 0);
+            for i in 0..8 {
+                let want = if i < n && mask & (1 << i) != 0 {
+                    let r = &rays[i];
+                    e.hit(r.o.to_array(), r.d.to_array(), r.tn, r.tf)
+                } else {
+                    None
+                };
+                assert_eq!(got[i].is_some(), want.is_some(), "n {n} mask {mask:#x} lane {i}");
+            }
+        }
+    }
+}
+
+#[test]
+fn degenerate_rays_never_report_nan() {
+    let m = sphere(Vec3::new(0.0, 0.0, 3.0), 1.0);
+    let e = Ellipsoid::new(&m).unwrap();
+    let (n, inf) = (f32::NAN, f32::INFINITY);
+    let rays = [
+        Ray { o: Vec3::ZERO, d: Vec3::ZERO, tn: 0.0, tf: inf },
+        Ray { o: Vec3::new(n, 0.0, 0.0), d: Vec3::Z, tn: 0.0, tf: inf },
+        Ray { o: Vec3::ZERO, d: Vec3::new(0.0, n, 1.0), tn: 0.0, tf: inf },
+        Ray { o: Vec3::ZERO, d: Vec3::Z, tn: n, tf: inf },
+        Ray { o: Vec3::ZERO, d: Vec3::Z, tn: 0.0, tf: n },
+        Ray { o: Vec3::splat(1e30), d: Vec3::Z, tn: 0.0, tf: inf },
+        Ray { o: Vec3::ZERO, d: Vec3::Z * 1e-30, tn: 0.0, tf: inf },
+        Ray { o: Vec3::ZERO, d: Vec3::Z * 1e30, tn: 0.0, tf: inf },
+    ];
+    let got = packet(&e, &rays, |_| true);
+    for (i, r) in rays.iter().enumerate() {
+        let want = e.hit(r.o.to_array(), r.d.to_array(), r.tn, r.tf);
+        assert_eq!(got[i].is_some(), want.is_some(), "lane {i}: {r:?}");
+        assert!(got[i].is_none_or(|t| t.is_finite()), "lane {i}");
+    }
+}
