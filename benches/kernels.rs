@@ -55,8 +55,13 @@ fn kernels(c: &mut Criterion) {
         // Interleaved timing in one run, so both kernels see the same machine load; CPU seconds of
         // the pool's one worker (nested `install` runs inline there), so other processes on a
         // shared machine are not charged.
-        let cpu =
-            |it: &strata::integrator::Integrator| pool.install(|| strata::measure::thread_seconds(|| drop(run(it))));
+        let cpu = |it: &strata::integrator::Integrator| {
+            pool.install(|| {
+                strata::measure::thread_seconds(|| {
+                    std::hint::black_box(run(it));
+                })
+            })
+        };
         let (mut ts, mut tg) = (Vec::new(), Vec::new());
         for _ in 0..7 {
             ts.push(cpu(&spec));

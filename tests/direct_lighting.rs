@@ -91,14 +91,13 @@ fn analyticdirect_matches_independent_quadrature() {
     assert!(checked >= 40, "only {checked} pixels hit the plane");
 }
 
+/// Per-pixel RGB values in f64.
+type Rgb64 = Vec<[f64; 3]>;
+
 /// Renders `scene` with the sampled `direct` integrator and with `analyticdirect` over identical
 /// camera rays (same spp, pixel sampler and seed); returns (direct film means, its variance of the
 /// mean, analytic means).
-fn direct_and_exact(
-    scene: std::path::PathBuf,
-    spp: u32,
-    sampler: Option<SamplerKind>,
-) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<[f64; 3]>) {
+fn direct_and_exact(scene: std::path::PathBuf, spp: u32, sampler: Option<SamplerKind>) -> (Rgb64, Rgb64, Rgb64) {
     let mut o = opts(scene, 80, 60, spp);
     o.light_sampler = sampler;
     let f = film(&o);

@@ -35,12 +35,16 @@
 //!    |d'| by eta relative, plus rounding <= 8u (|b| + h): E_t. A lane goes to f64 if any root is
 //!    within E_t of tnear or tfar (the interval test could flip), or if the chosen root has
 //!    E_t > TAU |t|.
+//!
 //! Hence every lane answered in f32 has the same hit/miss and root choice as the exact
 //! computation and |t - t_exact| <= TAU |t| + u|t| (final rounding); the f64 path is within a few
 //! f64 ulps of exact and rounds to f32 (u), so |t - t64| <= 1e-5 |t64| holds. Rays exactly (or,
 //! at the f32 bound, nearly) tangent, starting on the surface, coming from so far away that
 //! u |o'| is comparable to 1 (1e6 radii), or with a degenerate/non-finite direction land in f64.
 //! NaN anywhere makes every comparison false and sends the lane to f64, which rejects it.
+
+// Index loops over small fixed matrices (the Jacobi rotations) read as the maths does.
+#![allow(clippy::needless_range_loop)]
 
 use super::user_geometry::Ellipsoid;
 use crate::simd::{Mask8, Vec3x8, F8};
