@@ -9,10 +9,10 @@
 //! expression wherever it is defined (wi.z, wo.z > 0); elsewhere the caller sets f = 0.
 
 use super::{Lobe, Material, Material8};
+use crate::bsdf::desc::BrdfKind;
 use crate::sampling::{
     dot, fmadd, ggx_a2, ggx_a2_x8, ggx_d, ggx_d_x8, mul_add3, normalize_or_zero, sample_ggx_half, sample_ggx_half_x8,
 };
-use crate::scene::desc::BrdfKind;
 use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;
 
@@ -76,7 +76,7 @@ impl Lobe for Ggx {
     const BIT: u32 = 2;
     const NAME: &'static str = "ggx";
     const KIND: BrdfKind = BrdfKind::Ggx;
-    fn used_by(m: &crate::scene::desc::Material) -> bool {
+    fn used_by(m: &crate::bsdf::desc::Material) -> bool {
         // Its Fresnel term makes a lobe even with ks = 0.
         m.brdf == BrdfKind::Ggx
     }

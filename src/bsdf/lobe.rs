@@ -15,7 +15,7 @@
 //! [`AllLobes`], its tests (and, for a faster specialized kernel, one line in `with_lobe_set!`).
 
 use super::material::{Material, Material8};
-use crate::scene::desc::BrdfKind;
+use crate::bsdf::desc::BrdfKind;
 use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;
 
@@ -28,7 +28,7 @@ pub trait Lobe {
     /// The material model using this lobe.
     const KIND: BrdfKind;
     /// Whether a scene material needs this lobe compiled in (an exactly zero lobe does not).
-    fn used_by(m: &crate::scene::desc::Material) -> bool;
+    fn used_by(m: &crate::bsdf::desc::Material) -> bool;
     /// (f_spec RGB before the horizon test, pdf of [`Lobe::sample`] at wi).
     fn eval_pdf(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32);
     /// wi drawn from the lobe for u in [0,1)^2 (may lie below the horizon).
@@ -55,7 +55,7 @@ pub trait LobeSet: 'static {
     /// Eight-lane sample: on the `spec` lanes of each lobe of the set, its sample replaces `wi`.
     fn sample_x8(m: &Material8, wo: Vec3x8, u: [F8; 2], spec: Mask8, wi: Vec3x8) -> Vec3x8;
     /// The lobes of the set that `m` uses, as [`Lobes`] bits.
-    fn used_by(m: &crate::scene::desc::Material) -> u32;
+    fn used_by(m: &crate::bsdf::desc::Material) -> u32;
     /// Appends the names of the lobes whose bit is in `bits`, in list order.
     fn names(bits: u32, out: &mut Vec<&'static str>);
     /// Whether lobe `L` is in the set.
@@ -83,7 +83,7 @@ impl LobeSet for () {
     fn sample_x8(_: &Material8, _: Vec3x8, _: [F8; 2], _: Mask8, wi: Vec3x8) -> Vec3x8 {
         wi
     }
-    fn used_by(_: &crate::scene::desc::Material) -> u32 {
+    fn used_by(_: &crate::bsdf::desc::Material) -> u32 {
         0
     }
     fn names(_: u32, _: &mut Vec<&'static str>) {}
@@ -126,7 +126,7 @@ impl<H: Lobe + 'static, T: LobeSet> LobeSet for (H, T) {
         }
         T::sample_x8(m, wo, u, spec, wi)
     }
-    fn used_by(m: &crate::scene::desc::Material) -> u32 {
+    fn used_by(m: &crate::bsdf::desc::Material) -> u32 {
         (if H::used_by(m) { H::BIT } else { 0 }) | T::used_by(m)
     }
     fn names(bits: u32, out: &mut Vec<&'static str>) {
@@ -164,7 +164,7 @@ impl Lobes {
     pub const ALL: Self = Self(<AllLobes as LobeSet>::BITS);
 
     /// The lobes of a set of materials.
-    pub fn of<'a>(materials: impl IntoIterator<Item = &'a crate::scene::desc::Material>) -> Self {
+    pub fn of<'a>(materials: impl IntoIterator<Item = &'a crate::bsdf::desc::Material>) -> Self {
         Self(materials.into_iter().fold(0, |b, m| b | AllLobes::used_by(m)))
     }
 

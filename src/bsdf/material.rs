@@ -26,8 +26,8 @@ pub struct Material {
     pub kind: BrdfKind,
 }
 
-impl From<&crate::scene::desc::Material> for Material {
-    fn from(m: &crate::scene::desc::Material) -> Self {
+impl From<&crate::bsdf::desc::Material> for Material {
+    fn from(m: &crate::bsdf::desc::Material) -> Self {
         Self { kd: m.diffuse, ks: m.specular, shininess: m.shininess, alpha: m.roughness, kind: m.brdf }
     }
 }

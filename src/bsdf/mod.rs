@@ -30,7 +30,8 @@ mod phong;
 #[cfg(test)]
 mod tests;
 
-pub use crate::scene::desc::{BrdfKind, ImportanceSampling};
+pub mod desc;
+pub use desc::{BrdfKind, ImportanceSampling};
 pub use ggx::Ggx;
 pub use lobe::{AllLobes, Diffuse, DiffuseGgx, DiffusePhong, Lobe, LobeSet, Lobes};
 pub use material::{Material, Material8};

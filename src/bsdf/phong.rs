@@ -6,7 +6,7 @@
 
 use super::{Lobe, Material, Material8};
 use crate::sampling::{cos_pow, cos_pow_x8, dot, fmadd, sample_phong_lobe, sample_phong_lobe_x8, INV_2PI};
-use crate::scene::desc::BrdfKind;
+use crate::bsdf::desc::BrdfKind;
 use crate::simd::{frame_from_normal, Frame8, Mask8, Vec3x8, F8};
 use glam::Vec3;
 
@@ -66,7 +66,7 @@ impl Lobe for Phong {
     const BIT: u32 = 1;
     const NAME: &'static str = "phong";
     const KIND: BrdfKind = BrdfKind::Phong;
-    fn used_by(m: &crate::scene::desc::Material) -> bool {
+    fn used_by(m: &crate::bsdf::desc::Material) -> bool {
         m.brdf == BrdfKind::Phong && m.specular != Vec3::ZERO
     }
     #[inline]

@@ -5,6 +5,7 @@
 //! spheres, which keep their object-to-world matrix (a unit sphere at the origin maps to the
 //! ellipsoid). Radiance in linear RGB.
 
+pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;
 
@@ -32,18 +33,6 @@ pub enum Nee {
     On,
     /// Light and BRDF sampling combined with the power heuristic.
     Mis,
-}
-
-/// `importancesampling hemisphere|cosine|brdf`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum ImportanceSampling {
-    /// Uniform hemisphere.
-    #[default]
-    Hemisphere,
-    /// Cosine-weighted hemisphere.
-    Cosine,
-    /// Mixture of the BRDF's lobes.
-    Brdf,
 }
 
 /// Implements the format's spelling of a keyword enum: `NAMES` (name, value) in the order the
@@ -80,49 +69,6 @@ spelled!(
     "direction sampling strategy",
     [("hemisphere", Hemisphere), ("cosine", Cosine), ("brdf", Brdf)]
 );
-
-/// `brdf phong|ggx`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum BrdfKind {
-    /// Modified Phong.
-    #[default]
-    Phong,
-    /// GGX microfacet with Schlick Fresnel.
-    Ggx,
-}
-
-/// Material state in force when a primitive was declared.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Material {
-    /// kd (default 0)
-    pub diffuse: Vec3,
-    /// ks (default 0)
-    pub specular: Vec3,
-    /// Phong exponent s (default 1)
-    pub shininess: f32,
-    /// Emitted radiance added at every hit (default 0)
-    pub emission: Vec3,
-    /// Ambient term, raytracer only (default 0.2)
-    pub ambient: Vec3,
-    /// BRDF model (default Phong)
-    pub brdf: BrdfKind,
-    /// GGX alpha, used as is (default 1)
-    pub roughness: f32,
-}
-
-impl Default for Material {
-    fn default() -> Self {
-        Self {
-            diffuse: Vec3::ZERO,
-            specular: Vec3::ZERO,
-            shininess: 1.0,
-            emission: Vec3::ZERO,
-            ambient: Vec3::splat(0.2),
-            brdf: BrdfKind::Phong,
-            roughness: 1.0,
-        }
-    }
-}
 
 /// Look-at pinhole camera; `fovy_deg` is the full vertical field of view in degrees.
 #[derive(Clone, Copy, Debug, PartialEq)]
