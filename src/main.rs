@@ -209,6 +209,11 @@ struct RenderArgs {
     /// .obj scenes). spp 1 with centre is the course's deterministic image.
     #[arg(long, value_parser = parse_first_sample)]
     first_sample: Option<strata::integrator::FirstSample>,
+    /// Path tracer NEE light selection: all (every light, `lightsamples` points each; the CSE168
+    /// convention, default for .test scenes), uniform (one light, the historical path-tracer choice;
+    /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
+    #[arg(long, value_name = "NAME")]
+    light_selection: Option<strata::integrator::LightSelection>,
 }
 
 impl RenderArgs {
@@ -242,6 +247,7 @@ impl RenderArgs {
             limits: limits_of(&self.limits),
             quantize: self.quantize,
             first_sample: self.first_sample,
+            light_selection: self.light_selection,
         }
     }
 }

@@ -49,15 +49,15 @@ const CASES: &[(&str, &str, &str, u64)] = &[
     ("hw3-cornellNEE-sobol", "hw3/cornellNEE.test", "--spp 4 --pixel-sampler sobol", 0x4387c4fc92d531fe),
     ("hw3-cornellRR", "hw3/cornellRR.test", "--spp 4", 0x1fbe1a104c02a06d),
     ("hw4-cornellBRDF-pmj", "hw4/cornellBRDF.test", "--spp 4 --pixel-sampler pmj02", 0x8a04928fb9c8e01b),
-    ("hw4-ggx-mis", "hw4/ggx.test", "--spp 4", 0xe3273aab8a62d575),
-    ("hw4-mis", "hw4/mis.test", "--spp 4", 0xa65f6b07c9dbedb7),
+    ("hw4-ggx-mis", "hw4/ggx.test", "--spp 4", 0x93ba0e18a11f4a68),
+    ("hw4-mis", "hw4/mis.test", "--spp 4", 0x445dd7b160307f32),
     (
         "hw4-cornellMIS-nee-on",
         "hw4/cornellMIS.test",
         "--spp 4 --nee on --importance-sampling cosine",
         0x69f6dd3ad3d89c61,
     ),
-    ("obj-cornell-emissive", "scenes/cornell_obj.test", "--spp 4", 0x8a8665a49e31f025),
+    ("obj-cornell-emissive", "scenes/cornell_obj.test", "--spp 4", 0x4798e53cda601853),
     (
         "builtin-path-clamp",
         "scenes/cornell_diffuse_path.test",
@@ -77,7 +77,8 @@ const CASES: &[(&str, &str, &str, u64)] = &[
         "--spp 4 --pixel-sampler sobol --first-sample jittered",
         0xda6c8f50e35fc908,
     ),
-    ("hw4-mis-jittered", "hw4/mis.test", "--spp 4 --first-sample jittered", 0x1dbacee0868e3c4a),
+    ("hw4-mis-jittered", "hw4/mis.test", "--spp 4 --first-sample jittered", 0x3567631a30ce3493),
+    ("hw4-mis-uniform", "hw4/mis.test", "--spp 4 --light-selection uniform", 0xa65f6b07c9dbedb7),
 ];
 
 #[test]

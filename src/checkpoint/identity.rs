@@ -87,6 +87,7 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("gamma", json!(d.gamma)),
         ("clamp", json!(it.clamp)),
         ("first_sample", json!(it.first_sample.name())),
+        ("light_selection", json!(it.light_selection.name())),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
@@ -127,6 +128,7 @@ pub fn header_metadata(h: &Header) -> Metadata {
         ("strata.light_samples".into(), opt("light_samples")),
         ("strata.layout".into(), opt("layout")),
         ("strata.first_sample".into(), opt("first_sample")),
+        ("strata.light_selection".into(), opt("light_selection")),
         ("strata.quantize".into(), opt("quantize")),
         ("strata.render_seconds".into(), format!("{:.6}", h.render_seconds)),
         ("strata.cpu_seconds".into(), format!("{:.6}", h.cpu_seconds)),

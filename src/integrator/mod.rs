@@ -14,6 +14,7 @@
 use crate::accel::{Hits8, RayHit8};
 pub use crate::camera::FirstSample;
 use crate::camera::{Camera, PixelPacket};
+pub use crate::light::select::{LightSampler, LightSelection};
 use crate::sampler::{GridTable, PointSet, SamplerKind};
 use crate::scene::build::Scene;
 use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
@@ -67,6 +68,11 @@ pub struct Integrator {
     pub clamp: Option<f32>,
     /// where pixel sample 0 goes ([`FirstSample`]; `new` gives `Jittered`)
     pub first_sample: FirstSample,
+    /// path tracer: how NEE chooses lights (`new` gives [`LightSelection::Uniform`], the path
+    /// tracer's historical choice; see [`Integrator::set_light_selection`])
+    pub light_selection: LightSelection,
+    /// the light sampler of `light_selection` over the scene's emitters (shared by the threads)
+    pub light_sampler: std::sync::Arc<LightSampler>,
 }
 
 impl Integrator {
@@ -97,7 +103,15 @@ impl Integrator {
             kernel: Kernel::for_scene(scene),
             clamp: None,
             first_sample: FirstSample::Jittered,
+            light_selection: LightSelection::Uniform,
+            light_sampler: std::sync::Arc::new(LightSampler::new(&scene.emitters.list, LightSelection::Uniform)),
         }
+    }
+
+    /// Switches NEE's light selection to `selection`, building its sampler over `scene`'s emitters.
+    pub fn set_light_selection(&mut self, scene: &Scene, selection: LightSelection) {
+        self.light_selection = selection;
+        self.light_sampler = std::sync::Arc::new(LightSampler::new(&scene.emitters.list, selection));
     }
 
     /// The same integrator for `spp` samples per pixel: the per-pixel layouts (pixel jitter, path

@@ -20,6 +20,8 @@ use super::direct::material;
 use super::{Integrator, RayKind};
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
+use crate::light::emitters::LightSample8;
+use crate::light::select::LightSelection;
 use crate::sampler::permute_x8;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
@@ -49,12 +51,25 @@ struct PathLane {
     beta: Vec3,
     /// solid-angle pdf with which `d` was sampled (for the MIS weight of emission found along it)
     pdf: f32,
+    /// the previous vertex's shading point and normal as NEE used them (for a point-dependent
+    /// light selection's pmf in the MIS weight of emission found along `d`)
+    prev_p: Vec3,
+    prev_n: Vec3,
 }
 
 impl PathLane {
     /// Padding lane: traced inactive, contributes nothing, never continues.
-    const DEAD: Self =
-        Self { slot: u32::MAX, pixel: 0, sample: 0, o: Vec3::ZERO, d: Vec3::Z, beta: Vec3::ZERO, pdf: 0.0 };
+    const DEAD: Self = Self {
+        slot: u32::MAX,
+        pixel: 0,
+        sample: 0,
+        o: Vec3::ZERO,
+        d: Vec3::Z,
+        beta: Vec3::ZERO,
+        pdf: 0.0,
+        prev_p: Vec3::ZERO,
+        prev_n: Vec3::Z,
+    };
 }
 
 impl ShadowLane {
@@ -122,6 +137,8 @@ impl Integrator {
         let TileCtx { scene, camera, pks, tracer, scratch } = ctx;
         let sc = &mut scratch.path;
         let nee = self.nee;
+        let sel = self.light_selection;
+        let n_all = self.light_set.n().max(1);
         let n_lights = scene.emitters.len() as u32;
         let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
         sc.radiance.clear();
@@ -145,6 +162,8 @@ impl Integrator {
                         d: dirs[i],
                         beta: Vec3::ONE,
                         pdf: 0.0,
+                        prev_p: Vec3::ZERO,
+                        prev_n: Vec3::Z,
                     });
                 }
             }
@@ -185,7 +204,18 @@ impl Integrator {
                     Nee::On => F8::splat(if v == 1 { 1.0 } else { 0.0 }),
                     Nee::Mis if v == 1 => F8::ONE,
                     Nee::Mis => {
-                        let p_light = light_pdf_at_hit(scene, &sh, rh, is_light);
+                        let p_light = if sel == LightSelection::Uniform {
+                            light_pdf_at_hit(scene, &sh, rh, is_light)
+                        } else {
+                            let pp = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].prev_p));
+                            let pn = Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].prev_n));
+                            let pmf = match sel {
+                                // N points on every light: multi-sample MIS against N p_light.
+                                LightSelection::All => F8::splat(n_all as f32),
+                                _ => self.light_sampler.pmf_x8(pp, pn, sh.light, is_light),
+                            };
+                            light_pdf_at_hit_pmf(scene, &sh, rh, is_light, pmf)
+                        };
                         power_heuristic_x8(prev_pdf, p_light, is_light)
                     }
                 };
@@ -217,23 +247,27 @@ impl Integrator {
 
                 if nee_here {
                     let (u, w) = self.path_point(pixel, s, dims);
-                    // One light chosen by `scene.emitters.all` (uniform among quads, by power with
-                    // emissive triangles), one point on it, uniform in area.
-                    let ls = scene.emitters.sample_x8(u_choice, u, w, shade);
-                    let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
-                    let to = y - sh.p;
-                    let d2 = to.length_squared();
-                    let inv_d = F8::ONE / d2.sqrt();
-                    let wi = to.scale(inv_d);
-                    let cos_i = sh.n.dot(wi);
-                    let cos_l = -ln.dot(wi);
-                    let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
-                    if lit.any() {
+                    let mut push = |ls: LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
+                        let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
+                        let to = y - sh.p;
+                        let d2 = to.length_squared();
+                        let inv_d = F8::ONE / d2.sqrt();
+                        let wi = to.scale(inv_d);
+                        let cos_i = sh.n.dot(wi);
+                        let cos_l = -ln.dot(wi);
+                        let lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                        if lit.none() {
+                            return;
+                        }
                         let (f, pdf_b) = mat.eval_pdf_k::<L>(self.strategy, wo, frame.to_local(wi), lit);
                         // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
-                        let g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
+                        let mut g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
+                        if let Some(k) = scale {
+                            g *= k;
+                        }
                         let w_light = if nee == Nee::Mis {
                             let p_light = d2 / (area * cos_l * inv_pmf);
+                            let p_light = if let Some(k) = mis_n { p_light * k } else { p_light };
                             power_heuristic_x8(p_light, pdf_b, lit)
                         } else {
                             F8::ONE
@@ -253,6 +287,35 @@ impl Integrator {
                                     contrib: cs[i],
                                 });
                             }
+                        }
+                    };
+                    match sel {
+                        // One light chosen by `scene.emitters.all` (uniform among quads, by power
+                        // with emissive triangles), one point on it, uniform in area: the
+                        // historical path, kept bit-identical.
+                        LightSelection::Uniform => {
+                            push(scene.emitters.sample_x8(u_choice, u, w, shade), None, None, shade)
+                        }
+                        // Every light, N points each (a lattice rotated by (u, w)), each weighted
+                        // 1/N and, with MIS, against N p_light.
+                        LightSelection::All => {
+                            let (scale, mis_n) = if n_all > 1 {
+                                (Some(F8::splat(1.0 / n_all as f32)), Some(F8::splat(n_all as f32)))
+                            } else {
+                                (None, None)
+                            };
+                            for e in &scene.emitters.list {
+                                for j in 0..n_all {
+                                    let (uj, wj) = lattice_point(u, w, j, n_all);
+                                    push(e.sample_x8(uj, wj), scale, mis_n, shade);
+                                }
+                            }
+                        }
+                        LightSelection::Power | LightSelection::Spatial => {
+                            let (idx, pmf) = self.light_sampler.sample_x8(u_choice, sh.p, sh.n, shade);
+                            let ok = shade & pmf.simd_gt(F8::ZERO);
+                            let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
+                            push(scene.emitters.place_x8(idx, inv_pmf, u, w), None, None, ok);
                         }
                     }
                 }
@@ -275,6 +338,7 @@ impl Integrator {
                         let wi = frame.to_world(wi_l);
                         let (alive_b, os, ds, bs, ps) =
                             (mask_to_bools(alive), o.to_lanes(), wi.to_lanes(), nb.to_lanes(), pdf.to_array());
+                        let (sps, sns) = (sh.p.to_lanes(), sh.n.to_lanes());
                         let (pix, smp) = (pixel.to_array(), s.to_array());
                         for i in 0..8 {
                             if alive_b[i] {
@@ -286,6 +350,8 @@ impl Integrator {
                                     d: ds[i],
                                     beta: bs[i],
                                     pdf: ps[i],
+                                    prev_p: sps[i],
+                                    prev_n: sns[i],
                                 });
                             }
                         }
@@ -361,3 +427,39 @@ fn light_pdf_at_hit(scene: &Scene, sh: &crate::scene::build::SurfaceHit8, rh: &R
     let p = t * t / (area * cos_l * inv_pmf);
     is_light.select(p, F8::ZERO)
 }
+
+/// Solid-angle pdf of NEE at a light hit for a light chosen with probability `pmf` (per lane):
+/// pmf d^2 / (A cos_l); zero where `is_light` is off or `pmf` is 0.
+#[inline]
+fn light_pdf_at_hit_pmf(
+    scene: &Scene,
+    sh: &crate::scene::build::SurfaceHit8,
+    rh: &RayHit8,
+    is_light: Mask8,
+    pmf: F8,
+) -> F8 {
+    let ids = sh.light.to_array();
+    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
+    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
+    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
+    let t = F8::new(rh.ray.tfar);
+    let cos_l = ln.dot(sh.wo);
+    let p = pmf * t * t / (area * cos_l);
+    is_light.select(p, F8::ZERO)
+}
+
+/// Point `j` of `n` on one light for `all`: a Fibonacci-like rank-1 lattice rotated by `(u, w)`
+/// (every point uniform on the unit square; point 0 is `(u, w)` itself).
+#[inline]
+fn lattice_point(u: F8, w: F8, j: u32, n: u32) -> (F8, F8) {
+    if j == 0 {
+        return (u, w);
+    }
+    let fr = |x: F8| x - x.floor();
+    let a = F8::splat(j as f32 / n as f32);
+    let b = F8::splat((j as f32 * 0.618_034).fract());
+    (fr(u + a).min(F8::splat(ONE_MINUS)), fr(w + b).min(F8::splat(ONE_MINUS)))
+}
+
+/// Largest f32 below 1.
+const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;

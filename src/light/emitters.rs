@@ -340,7 +340,7 @@ impl Emitters {
         LightSample { y: e.point(u, v), normal: e.normal, radiance: e.radiance, area: e.area, inv_pmf, light: i }
     }
 
-    fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
+    pub(crate) fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let ids = idx.to_array();
         let es = ids.map(|i| &self.list[i as usize]);
         let la = Vec3x8::from_lanes(es.map(|e| e.a));

@@ -74,6 +74,8 @@ pub struct RenderOptions {
     pub quantize: Option<crate::film::Quantize>,
     /// where pixel sample 0 goes (`--first-sample`; default [`default_first_sample`])
     pub first_sample: Option<crate::camera::FirstSample>,
+    /// path tracer NEE's light selection (`--light-selection`; default [`default_light_selection`])
+    pub light_selection: Option<crate::light::select::LightSelection>,
 }
 
 /// The PNG quantizer of `opts`: `--quantize`, else truncation like the CSE168 course's writer for
@@ -93,5 +95,15 @@ pub fn default_first_sample(opts: &RenderOptions) -> crate::camera::FirstSample 
     opts.first_sample.unwrap_or(match &opts.scene {
         Some(p) if super::scene::is_obj(p) => FirstSample::Jittered,
         _ => FirstSample::Centre,
+    })
+}
+
+/// NEE's light selection for `opts`: `--light-selection`, else `all` (every light, the CSE168
+/// course's convention) for `.test` scenes and the built-in one, `uniform` for `.obj` scenes.
+pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::LightSelection {
+    use crate::light::select::LightSelection;
+    opts.light_selection.unwrap_or(match &opts.scene {
+        Some(p) if super::scene::is_obj(p) => LightSelection::Uniform,
+        _ => LightSelection::All,
     })
 }

@@ -101,6 +101,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     }
     integrator.clamp = opts.clamp;
     integrator.first_sample = super::options::default_first_sample(opts);
+    integrator.set_light_selection(&scene, super::options::default_light_selection(opts));
     Ok((scene, integrator))
 }
 

@@ -42,6 +42,7 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "clamp": out.integrator.clamp,
         "biased": out.integrator.clamp.is_some(),
         "first_sample": out.integrator.first_sample.name(),
+        "light_selection": out.integrator.light_selection.name(),
         "quantize": out.header.options.get("quantize"),
         "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
         "kernel": out.integrator.kernel.name(d.integrator),
@@ -59,8 +60,9 @@ pub fn summary(out: &RenderOutput) -> String {
         IntegratorKind::Direct => format!(" (light {} x{})", it.light_set.kind().name(), it.light_set.n()),
         IntegratorKind::PathTracer => {
             format!(
-                " (nee {}, {} sampling, rr {}, maxdepth {})",
+                " (nee {}, lights {}, {} sampling, rr {}, maxdepth {})",
                 it.nee.name(),
+                it.light_selection.name(),
                 it.strategy.name(),
                 if it.russian_roulette { "on" } else { "off" },
                 it.max_depth
