@@ -269,7 +269,7 @@ proptest! {
         check(&text, Path::new("random.test"), &Limits::default())?;
         // Tight limits exercise every cap's error path on the same inputs.
         let tight = Limits { max_pixels: 64, max_side: 16, max_vertices: 4, max_primitives: 3, max_spp: 8, max_depth: 3,
-            max_light_samples: 2, max_transform_depth: 2 };
+            max_light_samples: 2, max_transform_depth: 2, ..Limits::default() };
         check(&text, Path::new("random.test"), &tight)?;
     }
 
@@ -331,6 +331,7 @@ fn resource_caps_name_the_limit_and_how_to_raise_it() {
         max_depth: 4,
         max_light_samples: 3,
         max_transform_depth: 1,
+        ..Limits::default()
     };
     let cases = [
         ("size 11 10", "max_pixels", "size 10 10"),

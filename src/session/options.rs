@@ -74,6 +74,11 @@ pub struct RenderOptions {
     pub quantize: Option<crate::film::Quantize>,
     /// where pixel sample 0 goes (`--first-sample`; default [`default_first_sample`])
     pub first_sample: Option<crate::camera::FirstSample>,
+    /// `--no-default-light`: an OBJ scene without emitters stays unlit (default: a light is added)
+    pub no_default_light: bool,
+    /// set while the pass loop runs (a signal then stops after the pass and checkpoints; outside
+    /// it the binary exits at once with code 130)
+    pub rendering: Option<Arc<AtomicBool>>,
 }
 
 /// The PNG quantizer of `opts`: `--quantize`, else truncation like the CSE168 course's writer for
