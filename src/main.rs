@@ -3,6 +3,8 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use strata::sampler::SamplerKind;
 use strata::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use strata::session::{self, RenderOptions};
@@ -214,6 +216,10 @@ struct RenderArgs {
     /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
     #[arg(long, value_name = "NAME")]
     light_selection: Option<strata::integrator::LightSelection>,
+    /// Keep an OBJ scene without emitters unlit (by default an area light is added above and
+    /// behind the camera, announced on stderr).
+    #[arg(long)]
+    no_default_light: bool,
 }
 
 impl RenderArgs {
@@ -248,6 +254,8 @@ impl RenderArgs {
             quantize: self.quantize,
             first_sample: self.first_sample,
             light_selection: self.light_selection,
+            no_default_light: self.no_default_light,
+            rendering: None,
         }
     }
 }
@@ -330,7 +338,12 @@ fn main() -> ExitCode {
             let quiet = args.quiet;
             let mut opts = args.options();
             match session::stop_on_signals() {
-                Ok(flag) => opts.stop = Some(flag),
+                Ok(flag) => {
+                    let rendering = Arc::new(AtomicBool::new(false));
+                    exit_on_signal_outside_render(Arc::clone(&flag), Arc::clone(&rendering));
+                    opts.stop = Some(flag);
+                    opts.rendering = Some(rendering);
+                }
                 Err(e) => eprintln!("strata: {e}; Ctrl-C will not checkpoint"),
             }
             match session::run_render(&opts) {
@@ -418,6 +431,18 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// A signal before the pass loop starts (scene loading, BVH build, thread start) exits at once
+/// with code 130; once it runs, the loop stops after its pass, checkpoints and writes the image.
+fn exit_on_signal_outside_render(stop: Arc<AtomicBool>, rendering: Arc<AtomicBool>) {
+    std::thread::spawn(move || loop {
+        if stop.load(Ordering::SeqCst) && !rendering.load(Ordering::SeqCst) {
+            eprintln!("strata: interrupted before rendering started; nothing written");
+            std::process::exit(130);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    });
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -269,7 +269,7 @@ proptest! {
         check(&text, Path::new("random.test"), &Limits::default())?;
         // Tight limits exercise every cap's error path on the same inputs.
         let tight = Limits { max_pixels: 64, max_side: 16, max_vertices: 4, max_primitives: 3, max_spp: 8, max_depth: 3,
-            max_light_samples: 2, max_transform_depth: 2 };
+            max_light_samples: 2, max_transform_depth: 2, ..Limits::default() };
         check(&text, Path::new("random.test"), &tight)?;
     }
 
@@ -331,6 +331,7 @@ fn resource_caps_name_the_limit_and_how_to_raise_it() {
         max_depth: 4,
         max_light_samples: 3,
         max_transform_depth: 1,
+        ..Limits::default()
     };
     let cases = [
         ("size 11 10", "max_pixels", "size 10 10"),
@@ -386,5 +387,167 @@ fn cli_limit_flag_raises_caps_and_overrides_are_capped() {
     assert!(!ok && err.contains("<built-in cornell>:3:") && err.contains("--limit max_side=N"), "{err}");
     let (ok, err) = run(&with(&["--limit", "bogus=1"]));
     assert!(!ok && err.contains("unknown limit") && err.contains("max_transform_depth"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Runs `strata ARGS` in `dir`; kills it and fails if it takes more than `secs` seconds.
+fn run_within(dir: &Path, args: &[&str], secs: u64) -> (Option<i32>, String) {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(secs);
+    while child.try_wait().unwrap().is_none() {
+        if std::time::Instant::now() > deadline {
+            child.kill().ok();
+            child.wait().ok();
+            panic!("strata {args:?} still running after {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("strata-hostile-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `--threads` far above the cores is refused before any thread starts, naming the limit;
+/// `--limit max_threads=N` raises it.
+#[test]
+fn cli_threads_above_the_cap_are_refused() {
+    let dir = scratch("threads");
+    let (code, err) =
+        run_within(&dir, &["render", "--threads", "100000", "--spp", "1", "--size", "8x8", "-o", "t"], 20);
+    assert!(code == Some(1) && err.contains("--threads 100000") && err.contains("--limit max_threads=N"), "{err}");
+    let (code, err) = run_within(
+        &dir,
+        &["render", "--threads", "3", "--limit", "max_threads=3", "--spp", "1", "--size", "8x8", "-o", "t"],
+        60,
+    );
+    assert_eq!(code, Some(0), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A missing output or checkpoint directory fails before rendering: at a spp that would take
+/// minutes, the command returns at once and names the directory.
+#[test]
+fn cli_unwritable_outputs_fail_before_rendering() {
+    let dir = scratch("paths");
+    let missing = dir.join("no-such-dir");
+    let m = missing.display().to_string();
+    let slow = ["render", "--spp", "100000", "--size", "256x256", "--threads", "1"];
+    let cases: [Vec<String>; 3] = [
+        vec!["-o".into(), format!("{m}/img")],
+        vec!["-o".into(), "img".into(), "--checkpoint".into(), format!("{m}/c.ckpt")],
+        vec!["-o".into(), "img".into(), "--stats".into(), format!("{m}/s.json")],
+    ];
+    for extra in cases {
+        let args: Vec<&str> = slow.iter().copied().chain(extra.iter().map(String::as_str)).collect();
+        let (code, err) = run_within(&dir, &args, 20);
+        assert!(code == Some(1) && err.contains(&m) && err.contains("cannot write"), "{extra:?}: {err}");
+    }
+    assert!(!dir.join("img.png").exists(), "nothing was rendered");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A sampler asked for more points than it has distinct ones is refused, naming the limit and
+/// Sobol; at its period it renders.
+#[test]
+fn cli_sampler_past_its_period_is_refused() {
+    let dir = scratch("period");
+    let base = ["render", "--size", "4x4", "--threads", "1", "-o", "p"];
+    let with = |extra: &[&'static str]| base.iter().copied().chain(extra.iter().copied()).collect::<Vec<_>>();
+    let (code, err) = run_within(&dir, &with(&["--spp", "8192", "--pixel-sampler", "pmj02"]), 20);
+    assert!(code == Some(1) && err.contains("pmj02 has 4096 distinct points") && err.contains("8192 spp"), "{err}");
+    assert!(err.contains("--pixel-sampler sobol"), "{err}");
+    let light = with(&["--integrator", "direct", "--spp", "64", "--light-samples", "128", "--light-sampler", "pmj02"]);
+    let (code, err) = run_within(&dir, &light, 20);
+    assert!(code == Some(1) && err.contains("4096") && err.contains("--light-sampler sobol"), "{err}");
+    let (code, err) = run_within(&dir, &with(&["--spp", "4096", "--pixel-sampler", "pmj02"]), 120);
+    assert_eq!(code, Some(0), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// SIGTERM while a big OBJ is still loading exits promptly with code 130 and writes nothing
+/// (before, the render started, traced a pass of nothing and wrote an image and a checkpoint).
+#[test]
+fn cli_sigterm_during_loading_exits_promptly() {
+    let dir = scratch("signal");
+    let (code, err) = run_within(&dir, &["gen-mesh", "big.obj", "--triangles", "2000000"], 120);
+    assert_eq!(code, Some(0), "{err}");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args(["render", "big.obj", "--spp", "1", "--size", "8x8", "--threads", "1", "-o", "big"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    let sent = std::time::Instant::now();
+    let kill = std::process::Command::new("kill").args(["-TERM", &child.id().to_string()]).status().unwrap();
+    assert!(kill.success());
+    while child.try_wait().unwrap().is_none() && sent.elapsed().as_secs() < 10 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let exited = child.try_wait().unwrap();
+    if exited.is_none() {
+        child.kill().ok();
+    }
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(exited.is_some(), "still running 10 s after SIGTERM: {err}");
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted before rendering started"), "{err}");
+    assert!(!dir.join("big.png").exists() && !dir.join("big.ckpt").exists(), "nothing written");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// An OBJ without emitters gets a default light (announced), so it renders lit; with
+/// `--no-default-light` it stays black. `.test` scenes get none.
+#[test]
+fn unlit_obj_gets_a_default_light() {
+    let dir = scratch("light");
+    let obj = dir.join("model.obj");
+    let (code, err) = run_within(&dir, &["gen-mesh", "model.obj", "--triangles", "2000"], 60);
+    assert_eq!(code, Some(0), "{err}");
+    std::fs::remove_file(dir.join("model.mtl")).ok(); // no materials: no emitters
+    let opts = |no_default_light| strata::session::RenderOptions {
+        scene: Some(obj.clone()),
+        size: Some((32, 24)),
+        spp: Some(4),
+        threads: 1,
+        no_default_light,
+        ..Default::default()
+    };
+    let mean = |o| {
+        let f = strata::session::render_to_film(&o).unwrap().film;
+        let m = f.mean();
+        m.iter().map(|p| f64::from(p[0] + p[1] + p[2]) / 3.0).sum::<f64>() / m.len() as f64
+    };
+    let lit = mean(opts(false));
+    assert!(lit > 0.05, "mean {lit} with the default light");
+    assert_eq!(mean(opts(true)), 0.0, "--no-default-light keeps it unlit");
+    let (code, err) = run_within(&dir, &["render", "model.obj", "--spp", "1", "--size", "8x8", "-o", "m"], 60);
+    assert!(code == Some(0) && err.contains("no light; added a default area light"), "{err}");
+    let (_, err) = run_within(&dir, &["render", "--spp", "1", "--size", "8x8", "-o", "c"], 60);
+    assert!(!err.contains("default area light"), "{err}");
+    // The real-world unlit models of the issue (hold-out corpus, if present).
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpora/obj-wild");
+    for m in ["scan-stanford-bunny/stanford-bunny.obj", "sponza-dabrovic-2005/sponza.obj"] {
+        let p = corpus.join(m);
+        if !p.exists() {
+            eprintln!("skipped: {} not found", p.display());
+            continue;
+        }
+        let o = strata::session::RenderOptions { scene: Some(p), ..opts(false) };
+        let lit = mean(o);
+        assert!(lit > 0.05, "{m}: mean {lit} with the default light");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -19,6 +19,8 @@ pub struct Limits {
     pub max_light_samples: u32,
     /// Maximum nesting of `pushTransform`.
     pub max_transform_depth: usize,
+    /// Maximum `--threads` (default 4x the cores).
+    pub max_threads: usize,
 }
 
 impl Default for Limits {
@@ -32,6 +34,7 @@ impl Default for Limits {
             max_depth: 1_000_000,
             max_light_samples: 1 << 20,
             max_transform_depth: 4096,
+            max_threads: 4 * std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
     }
 }
@@ -67,7 +70,7 @@ pub enum LimitError {
 
 impl Limits {
     /// Names of the limits, as `--limit NAME=VALUE` spells them (the field names).
-    pub const NAMES: [&'static str; 8] = [
+    pub const NAMES: [&'static str; 9] = [
         "max_pixels",
         "max_side",
         "max_vertices",
@@ -76,6 +79,7 @@ impl Limits {
         "max_depth",
         "max_light_samples",
         "max_transform_depth",
+        "max_threads",
     ];
 
     /// Sets one limit from `NAME=VALUE` (the `--limit` flag); VALUE is a non-negative integer that
@@ -101,6 +105,7 @@ impl Limits {
             "max_depth" => self.max_depth = range(i32::MAX as u64)? as i32,
             "max_light_samples" => self.max_light_samples = range(u32::MAX.into())? as u32,
             "max_transform_depth" => self.max_transform_depth = range(usize::MAX as u64)? as usize,
+            "max_threads" => self.max_threads = range(usize::MAX as u64)? as usize,
             _ => return Err(LimitError::Unknown(name.to_string())),
         }
         Ok(())

@@ -104,6 +104,30 @@ pub enum SessionError {
     /// The stats JSON did not serialize.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+    /// An output directory (image, checkpoint, stats) cannot be written; found before rendering.
+    #[error("{}: cannot write there ({source}); checked before rendering, nothing was traced", dir.display())]
+    NotWritable {
+        /// the directory
+        dir: PathBuf,
+        /// the I/O error of the probe file
+        source: std::io::Error,
+    },
+    /// A sampler asked for more points than it has distinct ones.
+    #[error(
+        "{sampler} has {period} distinct points per pixel; {asked} would repeat them (use --{flag} {alternative})"
+    )]
+    SamplerPeriod {
+        /// the sampler's name
+        sampler: &'static str,
+        /// its distinct points per (pixel, dim)
+        period: u64,
+        /// what was asked, as a phrase ("8192 spp")
+        asked: String,
+        /// the flag choosing the sampler, without dashes
+        flag: &'static str,
+        /// a sampler without that limit
+        alternative: &'static str,
+    },
     /// A signal handler could not be installed.
     #[error("signal handler: {0}")]
     Signal(std::io::Error),

@@ -9,8 +9,10 @@
 //! - [`output`] — output naming, EXR metadata, [`run_render`];
 //! - [`stats`] — the `--stats` JSON and the summary line;
 //! - [`rays`] — `strata rays`;
+//! - [`checks`] — command-line checks before rendering, the default light;
 //! - [`error`] — [`SessionError`].
 
+pub mod checks;
 pub mod error;
 pub mod options;
 pub mod output;

@@ -76,6 +76,11 @@ pub struct RenderOptions {
     pub first_sample: Option<crate::camera::FirstSample>,
     /// path tracer NEE's light selection (`--light-selection`; default [`default_light_selection`])
     pub light_selection: Option<crate::light::select::LightSelection>,
+    /// `--no-default-light`: an OBJ scene without emitters stays unlit (default: a light is added)
+    pub no_default_light: bool,
+    /// set while the pass loop runs (a signal then stops after the pass and checkpoints; outside
+    /// it the binary exits at once with code 130)
+    pub rendering: Option<Arc<AtomicBool>>,
 }
 
 /// The PNG quantizer of `opts`: `--quantize`, else truncation like the CSE168 course's writer for

@@ -92,6 +92,9 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
     let mut s = if film.samples().is_empty() { target.start } else { film.samples().end };
     let mut pass = render::SAMPLE_BATCH;
     let mut interrupted = false;
+    if let Some(r) = &opts.rendering {
+        r.store(true, Ordering::SeqCst);
+    }
     while s < target.end {
         if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
             interrupted = true;

@@ -59,6 +59,14 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
         }
         desc.max_depth = d;
     }
+    if matches!(&opts.scene, Some(p) if is_obj(p)) && !opts.no_default_light && !super::checks::has_emitter(&desc) {
+        let name = opts.scene.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
+        if super::checks::add_default_light(&mut desc) {
+            eprintln!(
+                "strata: note: {name} has no light; added a default area light (disable with --no-default-light)"
+            );
+        }
+    }
     Ok(desc)
 }
 
@@ -79,6 +87,7 @@ pub fn parse_camera(s: &str) -> Result<CameraDesc, SessionError> {
 
 /// Parses, checks and builds the scene and the integrator of `opts`.
 pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError> {
+    super::checks::check_command_line(opts)?;
     let desc = load_scene(opts)?;
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {
@@ -93,6 +102,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
             "max_light_samples",
         ));
     }
+    super::checks::check_sampler_periods(opts, &desc, spp)?;
     let scene = Scene::build(desc).map_err(|e| SessionError::Scene(e.to_string()))?;
     let mut integrator =
         Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
