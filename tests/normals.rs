@@ -166,8 +166,8 @@ fn icosphere(levels: u32, normals: bool) -> String {
 #[test]
 fn icosphere_with_normals_is_closer_to_the_analytic_sphere() {
     let d = tmpdir("normals-ico");
-    std::fs::write(d.join("smooth.obj"), icosphere(2, true)).unwrap();
-    std::fs::write(d.join("flat.obj"), icosphere(2, false)).unwrap();
+    std::fs::write(d.join("smooth.obj"), icosphere(3, true)).unwrap();
+    std::fs::write(d.join("flat.obj"), icosphere(3, false)).unwrap();
     // Light from the front-right-top: the lit side faces the camera, the terminator is off-centre.
     let l = DVec3::new(0.4, 0.3, 1.0).normalize();
     let smooth = render(wrapper(&d, "smooth.test", "smooth.obj", l, ""), 1, 1);
@@ -183,7 +183,7 @@ fn icosphere_with_normals_is_closer_to_the_analytic_sphere() {
                 continue;
             }
             let p = o + dir * (-b - disc.sqrt());
-            if p.z < 0.35 {
+            if p.z < 0.6 {
                 continue;
             }
             let i = (y * W + x) as usize;
@@ -196,9 +196,9 @@ fn icosphere_with_normals_is_closer_to_the_analytic_sphere() {
     }
     let (rms_s, rms_f) = ((err_s / n as f64).sqrt(), (err_f / n as f64).sqrt());
     eprintln!("icosphere vs analytic sphere over {n} pixels: rms {rms_s:.4} with normals, {rms_f:.4} faceted");
-    assert!(n > 300, "{n} pixels");
-    assert!(rms_s < 0.4 * rms_f, "with normals rms {rms_s}, faceted {rms_f}");
-    assert!(rms_s < 0.02, "with normals rms {rms_s}");
+    assert!(n > 250, "{n} pixels");
+    assert!(rms_s < 0.25 * rms_f, "with normals rms {rms_s}, faceted {rms_f}");
+    assert!(rms_s < 0.005, "with normals rms {rms_s}");
 }
 
 /// Normals pointing into the surface are read up to sign (the image is the faceted one); normals
@@ -214,7 +214,7 @@ fn inward_and_grazing_normals_give_no_artifacts() {
         format!("{quad}vn -1 -1 0.05\nvn 1 -1 0.05\nvn 1 1 -0.05\nvn -1 1 0.05\nf 1//1 2//2 3//3\nf 1//1 3//3 4//4\n");
     std::fs::write(d.join("grazing.obj"), grazing).unwrap();
     let l = DVec3::new(0.3, -0.2, 1.0).normalize();
-    let light = "quadLight -0.5 -0.5 2 1 0 0 0 1 0 5 5 5";
+    let light = "quadLight 1.2 -0.5 1.5 1 0 0 0 1 0 5 5 5";
     let integrators = [
         ("", 1),
         (&*format!("integrator direct\n{light}"), 16),
@@ -233,6 +233,33 @@ fn inward_and_grazing_normals_give_no_artifacts() {
         }
         let lit = |img: &[[f64; 3]]| img.iter().filter(|p| p[0] > 1e-3).count();
         assert!(lit(&flat) > 500, "{settings:?}: {} lit pixels", lit(&flat));
-        assert!(lit(&grazing) > lit(&flat) / 2, "{settings:?}: grazing normals black out the quad");
+        assert!(lit(&grazing) > 0, "{settings:?}: grazing normals black out the quad");
+    }
+}
+
+/// Normals go to world space by the inverse transpose of the `.test` transform (a non-uniform
+/// scale tilts them the other way from the surface); the table is padded for earlier triangles
+/// and absent for meshes without `vn`.
+#[test]
+fn normals_follow_the_inverse_transpose_of_the_transform() {
+    use strata::scene::parse::{parse_file, Limits};
+    let d = tmpdir("normals-xform");
+    std::fs::write(d.join("n.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 1 1 0\nf 1//1 2//1 3//1\n").unwrap();
+    std::fs::write(d.join("flat.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let scene = |body: &str| {
+        let p = d.join("s.test");
+        std::fs::write(&p, format!("camera 0 0 3 0 0 0 0 1 0 45\n{body}")).unwrap();
+        parse_file(&p, &Limits::default()).unwrap()
+    };
+    let flat = scene("obj flat.obj\n");
+    assert!(flat.triangle_normals.is_empty(), "no table without vn");
+    let s = scene("vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\ntri 0 1 2\nscale 2 1 1\nobj n.obj\nobj flat.obj\n");
+    assert_eq!(s.triangles.len(), 3);
+    assert_eq!(s.triangle_normals.len(), 2, "padded for the tri before, none for the flat mesh after");
+    assert_eq!(s.triangle_normals[0], [Vec3::ZERO; 3]);
+    // Under scale (2, 1, 1), the normal (1, 1, 0) becomes (1/2, 1, 0), normalised.
+    let expect = Vec3::new(0.5, 1.0, 0.0).normalize();
+    for n in s.triangle_normals[1] {
+        assert!((n - expect).length() < 1e-6, "{n} vs {expect}");
     }
 }
