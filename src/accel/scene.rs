@@ -338,6 +338,10 @@ pub struct Hits8 {
     pub geom: U8,
     /// instance geometry id or INVALID_ID
     pub inst: U8,
+    /// Embree barycentric u of the hit (triangles: p = (1-u-v) v0 + u v1 + v v2)
+    pub u: F8,
+    /// Embree barycentric v of the hit
+    pub v: F8,
 }
 
 impl Hits8 {
@@ -347,6 +351,14 @@ impl Hits8 {
         let geom = U8::new(rh.hit.geom_id);
         let valid_bits = !geom.simd_eq(U8::splat(INVALID_ID));
         let hit = traced & F8::from_bits(valid_bits);
-        Self { hit, t: F8::new(rh.ray.tfar), prim: U8::new(rh.hit.prim_id), geom, inst: U8::new(rh.hit.inst_id[0]) }
+        Self {
+            hit,
+            t: F8::new(rh.ray.tfar),
+            prim: U8::new(rh.hit.prim_id),
+            geom,
+            inst: U8::new(rh.hit.inst_id[0]),
+            u: F8::new(rh.hit.u),
+            v: F8::new(rh.hit.v),
+        }
     }
 }

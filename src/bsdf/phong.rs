@@ -5,8 +5,8 @@
 //! Lambertian over the whole hemisphere of n.
 
 use super::{Lobe, Material, Material8};
-use crate::sampling::{cos_pow, cos_pow_x8, dot, fmadd, sample_phong_lobe, sample_phong_lobe_x8, INV_2PI};
 use crate::bsdf::desc::BrdfKind;
+use crate::sampling::{cos_pow, cos_pow_x8, dot, fmadd, sample_phong_lobe, sample_phong_lobe_x8, INV_2PI};
 use crate::simd::{frame_from_normal, Frame8, Mask8, Vec3x8, F8};
 use glam::Vec3;
 

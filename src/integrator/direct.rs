@@ -77,7 +77,9 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 let wi = to.scale(inv_d);
                 let cos_i = sh.n.dot(wi);
                 let cos_l = -ls.normal.dot(wi);
-                let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                // Smooth-shaded lanes: the light must also be above the geometric surface.
+                let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+                let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves;
                 if lit.none() {
                     continue;
                 }
@@ -89,7 +91,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                     Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
                 });
                 // Shadow packet from the offset point towards the light sample, stopping short.
-                let o = sh.n.mul_add(sc.eps[i], sh.p);
+                let o = sh.ng.mul_add(sc.eps[i], sh.p);
                 let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
                 let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
                 sc.shadow.push((ray, lit));

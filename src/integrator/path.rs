@@ -236,7 +236,10 @@ impl Integrator {
                 let wo = frame.to_local(sh.wo);
                 let mat = material(&sh);
                 let eps = scene.offset_eps(sh.p);
-                let o = sh.n.mul_add(eps, sh.p);
+                // Offsets along the geometric normal (the shading one may point into the surface).
+                let o = sh.ng.mul_add(eps, sh.p);
+                // Smooth-shaded lanes: directions must also leave the geometric surface.
+                let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
                 // (light choice, lobe choice): drawn only where one of them is used (several
                 // lights, or BRDF sampling's lobe pick); skipping it changes no other dimension.
                 let (u_choice, u_lobe) = if n_lights > 1 || self.strategy == ImportanceSampling::Brdf {
@@ -255,7 +258,8 @@ impl Integrator {
                         let wi = to.scale(inv_d);
                         let cos_i = sh.n.dot(wi);
                         let cos_l = -ln.dot(wi);
-                        let lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                        let lit =
+                            ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
                         if lit.none() {
                             return;
                         }
@@ -325,7 +329,12 @@ impl Integrator {
                     let u2 = self.path_point(pixel, s, dims + 2);
                     let (wi_l, pdf, f) = mat.sample_k::<L>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
                     let cos = wi_l.z;
-                    let ok = shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO);
+                    let wi = frame.to_world(wi_l);
+                    let ok = shade
+                        & pdf.simd_gt(F8::ZERO)
+                        & cos.simd_gt(F8::ZERO)
+                        & f.max_elem().simd_gt(F8::ZERO)
+                        & leaves(wi);
                     let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
                     let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
                     if self.russian_roulette {
@@ -335,7 +344,6 @@ impl Integrator {
                         nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
                     }
                     if alive.any() {
-                        let wi = frame.to_world(wi_l);
                         let (alive_b, os, ds, bs, ps) =
                             (mask_to_bools(alive), o.to_lanes(), wi.to_lanes(), nb.to_lanes(), pdf.to_array());
                         let (sps, sns) = (sh.p.to_lanes(), sh.n.to_lanes());

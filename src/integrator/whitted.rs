@@ -43,8 +43,12 @@ pub fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, tracer: &mut T
             break;
         }
         // Mirror ray from the offset hit point.
+        // Mirror about the shading normal; where that would go into the geometric surface
+        // (smooth-shaded lanes only), about the geometric normal instead.
         let r = sh.n.scale(F8::splat(2.0) * sh.n.dot(sh.wo)) - sh.wo;
-        let org = sh.n.mul_add(scene.offset_eps(sh.p), sh.p);
+        let r_geo = sh.ng.scale(F8::splat(2.0) * sh.ng.dot(sh.wo)) - sh.wo;
+        let r = Vec3x8::select(sh.smooth & !sh.ng.dot(r).simd_gt(F8::ZERO), r_geo, r);
+        let org = sh.ng.mul_add(scene.offset_eps(sh.p), sh.p);
         let mut rh = RayHit8::default();
         let active = rh.ray.set(org, r, F8::ZERO, F8::splat(f32::INFINITY), alive);
         let traced = tracer.intersect(&mut rh, RayKind::Bounce, active);
@@ -60,7 +64,7 @@ pub fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, tracer: &mut T
 fn local_shading(scene: &Scene, sh: &SurfaceHit8, alive: Mask8, tracer: &mut Tracer) -> Vec3x8 {
     let mut acc = masked(sh.ambient, alive);
     let eps = scene.offset_eps(sh.p);
-    let o = sh.n.mul_add(eps, sh.p);
+    let o = sh.ng.mul_add(eps, sh.p);
     let mut shade = |wi: Vec3x8, to: Vec3x8, tfar: F8, colour: Vec3x8, tracer: &mut Tracer| {
         let f = blinn_phong(sh, wi, alive);
         let lit = alive & f.max_elem().simd_gt(F8::ZERO);

@@ -4,6 +4,16 @@
 //! Conventions: world space; `ng` is the unit geometric normal as declared ((v1-v0)x(v2-v0) for
 //! triangles, outward for ellipsoids); shading uses the normal flipped to face the incoming ray
 //! (surfaces are shaded two-sided, so meshes of either winding render; lights stay one-sided).
+//!
+//! Shading normals: a triangle with per-corner normals (`SceneDesc::triangle_normals`, OBJ `vn`)
+//! is shaded with `ns = normalize((1-u-v) n0 + u n1 + v n2)` at Embree's barycentrics (u, v),
+//! turned to the side of the geometric normal facing the ray (so `vn` are read as directions up to
+//! sign, as the two-sided geometric normal is). **Consistency guard:** where the ray arrives from
+//! below that shading normal (`ns . wo <= 0`, although above the geometric one), or the
+//! interpolation vanishes, the hit falls back to the geometric normal (no bending): a hit is never
+//! shaded from the back of its shading frame. The geometric normal `ng` stays in the record for ray
+//! offsets and for the side tests of integrators ([`SurfaceHit8::smooth`] marks the lanes where
+//! the two differ); light emission and facing use the geometric normals of the lights.
 
 use crate::accel::{self, Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
 use crate::light::emitters::{Emitter, Emitters};
@@ -73,8 +83,14 @@ pub struct SurfaceHit8 {
     pub valid: Mask8,
     /// hit position, world space
     pub p: Vec3x8,
-    /// unit geometric normal flipped to face the incoming ray (n . wo >= 0)
+    /// unit shading normal facing the incoming ray (n . wo >= 0): the geometric normal `ng`, or on
+    /// `smooth` lanes the interpolated vertex normal (see the module docs)
     pub n: Vec3x8,
+    /// unit geometric normal flipped to face the incoming ray (ng . wo >= 0): for ray offsets
+    pub ng: Vec3x8,
+    /// lanes shaded with an interpolated vertex normal (`n` may differ from `ng`); integrators
+    /// also require `ng . wi > 0` there for a direction to leave the surface
+    pub smooth: Mask8,
     /// unit direction towards the viewer (-ray direction)
     pub wo: Vec3x8,
     /// diffuse reflectance kd
@@ -279,6 +295,9 @@ impl Scene {
         let ps = p.to_lanes();
         let dirs = dir.to_lanes();
         let mut ng = [Vec3::Z; 8];
+        let mut ns = [Vec3::Z; 8];
+        let mut smooth = [false; 8];
+        let (bu, bv) = (hits.u.to_array(), hits.v.to_array());
         let mut kd = [Vec3::ZERO; 8];
         let mut ks = [Vec3::ZERO; 8];
         let mut emitted = [Vec3::ZERO; 8];
@@ -293,6 +312,7 @@ impl Scene {
                 continue;
             }
             let prim = prim[i] as usize;
+            let mut vertex_normal = None;
             let (n, mat) = match geom[i] {
                 GEOM_TRIANGLES => {
                     let l = self.tri_light[prim];
@@ -302,6 +322,10 @@ impl Scene {
                         if q.normal.dot(dirs[i]) < 0.0 {
                             le[i] = q.radiance;
                         }
+                    }
+                    if let Some(c) = self.desc.triangle_normals.get(prim).filter(|c| c[0] != Vec3::ZERO) {
+                        let (u, v) = (bu[i], bv[i]);
+                        vertex_normal = Some(c[0] * (1.0 - u - v) + c[1] * u + c[2] * v);
                     }
                     (self.tri_normal[prim], self.tri_material[prim])
                 }
@@ -316,6 +340,15 @@ impl Scene {
             let m = &self.materials[mat as usize];
             // Shade two-sided: flip the normal to face the incoming ray.
             ng[i] = if n.dot(dirs[i]) > 0.0 { -n } else { n };
+            ns[i] = ng[i];
+            if let Some(s) = vertex_normal.map(Vec3::normalize_or_zero) {
+                let s = if s.dot(ng[i]) < 0.0 { -s } else { s };
+                // The guard: the ray must arrive from above the shading normal too.
+                if s.dot(-dirs[i]) > 0.0 {
+                    ns[i] = s;
+                    smooth[i] = true;
+                }
+            }
             kd[i] = m.diffuse;
             ks[i] = m.specular;
             shin[i] = m.shininess;
@@ -327,7 +360,9 @@ impl Scene {
         SurfaceHit8 {
             valid: hits.hit,
             p,
-            n: Vec3x8::from_lanes(ng),
+            n: Vec3x8::from_lanes(ns),
+            ng: Vec3x8::from_lanes(ng),
+            smooth: crate::simd::mask_from_bools(smooth),
             wo: -dir,
             kd: Vec3x8::from_lanes(kd),
             ks: Vec3x8::from_lanes(ks),

@@ -179,6 +179,10 @@ pub struct SceneDesc {
     pub materials: Vec<Material>,
     /// triangles, world space
     pub triangles: Vec<TriangleDesc>,
+    /// per-corner unit shading normals (OBJ `vn`, world space) of `triangles[i]` at index i, in
+    /// the corner order of its `v`; `[Vec3::ZERO; 3]` or a missing entry (the table may be shorter
+    /// than `triangles`, and is empty when no triangle has normals) means none: faceted shading
+    pub triangle_normals: Vec<[Vec3; 3]>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -242,6 +246,11 @@ impl SceneDesc {
             t.v.iter().for_each(|&v| h.vec3(v));
             h.vec3(t.radiance);
         }
+        // Only when present, so that the hash of a scene without normals is unchanged.
+        if !self.triangle_normals.is_empty() {
+            h.word(self.triangle_normals.len() as u32);
+            self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
+        }
         h.0
     }
 }
@@ -268,6 +277,7 @@ impl Default for SceneDesc {
             spheres: Vec::new(),
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),
+            triangle_normals: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
         }

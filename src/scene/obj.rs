@@ -4,8 +4,9 @@
 //! The OBJ is read by [`parse_obj`] (here, not `tobj`: real-world files need repairs `tobj` cannot
 //! make); MTL libraries are checked by [`locate_mtl_error`] and read by `tobj::load_mtl_buf`.
 //! Faces are triangulated as fans `(c0, ci, ci+1)`, as `tobj` does. Positions are used for
-//! geometry; vertex normals (`vn`) are kept in [`ObjMesh::normals`] / [`ObjMesh::face_normals`]
-//! (unit length, validated) but not yet used for shading (the geometric normal is); texture
+//! geometry; vertex normals (`vn`, validated, unit length: [`ObjMesh::normals`] /
+//! [`ObjMesh::face_normals`]) become per-corner shading normals ([`place`]; see
+//! `scene::build` for interpolation and the consistency guard); texture
 //! coordinates are read, checked and ignored. Materials, per face:
 //! - a face whose MTL material has a non-zero `Ke` is an area light: radiance `Ke`, emitted on one
 //!   side only, towards `(v1 - v0) x (v2 - v0)` of its (transformed) vertices, i.e. the side from
@@ -807,7 +808,7 @@ pub fn scene_from_obj_with_warnings(path: &Path, limits: &Limits) -> Result<(Sce
     }
     let current = whole_scene_material();
     let mut index_of = std::collections::HashMap::new();
-    place(&mesh, &current, Ok, &mut desc, &mut |m: Material, d: &mut SceneDesc| {
+    place(&mesh, &current, Ok, glam::DMat3::IDENTITY, &mut desc, &mut |m: Material, d: &mut SceneDesc| {
         let key: Vec<u32> = [m.diffuse, m.specular, m.emission, m.ambient]
             .iter()
             .flat_map(|v| v.to_array())
@@ -825,10 +826,14 @@ pub fn scene_from_obj_with_warnings(path: &Path, limits: &Limits) -> Result<(Sce
 
 /// Adds `mesh` to `desc`: every face's vertices through `to_world`, emissive faces to
 /// `emissive_triangles`, the others to `triangles` with the material `intern` returns an index for.
+/// Vertex normals go through `normal_matrix` (see [`normal_matrix`]), renormalised, into
+/// `desc.triangle_normals` (padded with "none" up to the triangle they belong to); a triangle whose
+/// normals do not all survive (zero after the transform) is faceted; emissive faces ignore them.
 pub fn place(
     mesh: &ObjMesh,
     current: &Material,
     to_world: impl Fn(Vec3) -> Result<Vec3, LineError>,
+    normal_matrix: glam::DMat3,
     desc: &mut SceneDesc,
     intern: &mut dyn FnMut(Material, &mut SceneDesc) -> Result<u32, LineError>,
 ) -> Result<(), LineError> {
@@ -836,7 +841,9 @@ pub fn place(
     // One resolved material index per MTL material (and one for "none"), computed on first use.
     let mut resolved: Vec<Option<u32>> = vec![None; mesh.materials.len() + 1];
     let world: Vec<Vec3> = mesh.positions.iter().map(|&p| to_world(p)).collect::<Result<_, _>>()?;
-    for (f, &mi) in mesh.faces.iter().zip(&mesh.face_material) {
+    let normals: Vec<Vec3> =
+        mesh.normals.iter().map(|&n| (normal_matrix * n.as_dvec3()).as_vec3().normalize_or_zero()).collect();
+    for (k, (f, &mi)) in mesh.faces.iter().zip(&mesh.face_material).enumerate() {
         let v = f.map(|i| world[i as usize]);
         let mtl = mesh.materials.get(mi as usize);
         if let Some(radiance) = mtl.and_then(MtlMaterial::emission) {
@@ -853,9 +860,30 @@ pub fn place(
                 i
             }
         };
+        let corner = |c: u32| normals.get(c as usize).copied().unwrap_or(Vec3::ZERO);
+        let ns = mesh.face_normals.get(k).map_or([Vec3::ZERO; 3], |c| c.map(corner));
+        if ns.iter().all(|n| *n != Vec3::ZERO) {
+            desc.triangle_normals.resize(desc.triangles.len(), [Vec3::ZERO; 3]);
+            desc.triangle_normals.push(ns);
+        }
         desc.triangles.push(TriangleDesc { v, material });
     }
     Ok(())
+}
+
+/// The matrix taking object-space normals to world space under the affine `m`: the cofactor
+/// matrix of its linear part, `det * inverse transpose`, times the sign of `det` (so the direction
+/// is that of the inverse transpose; the length is renormalised by the caller). Defined for any `m`
+/// (zero for a singular one of rank < 2).
+pub fn normal_matrix(m: &glam::DMat4) -> glam::DMat3 {
+    let l = glam::DMat3::from_mat4(*m);
+    let (a, b, c) = (l.x_axis, l.y_axis, l.z_axis);
+    let cof = glam::DMat3::from_cols(b.cross(c), c.cross(a), a.cross(b));
+    if l.determinant() < 0.0 {
+        -cof
+    } else {
+        cof
+    }
 }
 
 /// A procedural test mesh of at least `min_triangles` triangles: a bumpy torus (2 n x n quads, no

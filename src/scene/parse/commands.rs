@@ -120,7 +120,8 @@ impl Parser<'_> {
             .into());
         }
         let (matrix, current, lookup) = (self.matrix, self.material, &mut self.material_lookup);
-        obj::place(&mesh, &current, |p| to_world(&matrix, p), &mut self.desc, &mut |m, d| {
+        let normals = obj::normal_matrix(&matrix);
+        obj::place(&mesh, &current, |p| to_world(&matrix, p), normals, &mut self.desc, &mut |m, d| {
             intern_material(lookup, d, &m)
         })
         .map_err(|e| LineError(format!("obj '{}': {e}", show(name))))
