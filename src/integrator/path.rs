@@ -98,6 +98,7 @@ impl Integrator {
     /// Stratified 2D point of dimension `dim` for pixel sample `s`, strata shuffled per (pixel, dim).
     #[inline]
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
+        let _p = crate::profile::scope(crate::profile::Phase::SamplerPath);
         let n = self.spp;
         let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
         let k = permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)));
@@ -219,7 +220,10 @@ impl Integrator {
                     let (u, w) = self.path_point(pixel, s, dims);
                     // One light chosen by `scene.emitters.all` (uniform among quads, by power with
                     // emissive triangles), one point on it, uniform in area.
-                    let ls = scene.emitters.sample_x8(u_choice, u, w, shade);
+                    let ls = {
+                        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                        scene.emitters.sample_x8(u_choice, u, w, shade)
+                    };
                     let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
                     let to = y - sh.p;
                     let d2 = to.length_squared();
