@@ -113,6 +113,19 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Break the worker threads' time into phases (sampler by dimension group, emitter sampling,
+    /// Embree intersect/occluded, hit gather, accumulation, other) with % of render, ns per sample
+    /// and ns per ray; the overhead is measured by rendering the same job unprofiled, interleaved.
+    Profile {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Also write the profile as JSON to this file.
+        #[arg(long = "json", value_name = "FILE")]
+        json_file: Option<PathBuf>,
+        /// Renders per mode (profiling off and on, interleaved); the fastest of each counts.
+        #[arg(long, default_value_t = strata::session::profile::REPEATS)]
+        repeats: usize,
+    },
 }
 
 #[derive(clap::Args)]
@@ -421,6 +434,19 @@ fn main() -> ExitCode {
                 } else {
                     println!("{}", session::rates_table(&name, &rates));
                 }
+            })
+        }
+        Cmd::Profile { args, json_file, repeats } => {
+            let quiet = args.quiet;
+            session::run_profile(&args.options(), repeats).map_err(|e| e.to_string()).and_then(|p| {
+                if let Some(f) = &json_file {
+                    let text = serde_json::to_string_pretty(&p).map_err(|e| e.to_string())?;
+                    std::fs::write(f, text).map_err(|e| format!("{}: {e}", f.display()))?;
+                }
+                if !quiet {
+                    println!("{}", session::profile_table(&p));
+                }
+                Ok(())
             })
         }
     };

@@ -30,6 +30,10 @@ pub struct RenderStats {
     pub threads: usize,
     /// CPU seconds the worker threads spent rendering tiles, summed over the workers
     pub cpu_seconds: f64,
+    /// nanoseconds per [`crate::profile::Phase`] summed over the workers (zero unless profiling)
+    pub phase_ns: [u64; crate::profile::N_PHASES],
+    /// nanoseconds between tile start and end summed over the tiles (zero unless profiling)
+    pub profiled_ns: u64,
 }
 
 impl RenderStats {
@@ -88,16 +92,22 @@ pub fn render_counted(
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     let start = Instant::now();
     let film_in: &Film = film;
-    let results: Vec<(TileResult, Counters, f64)> = pool.install(|| {
+    type Done = (TileResult, Counters, f64, [u64; crate::profile::N_PHASES], u64);
+    let results: Vec<Done> = pool.install(|| {
         tiles
             .par_iter()
             .map_init(Scratch::default, |scratch, &(tx, ty)| {
                 let t0 = cpu_time::ThreadTime::now();
+                let profiling = crate::profile::enabled();
+                let w0 = profiling.then(Instant::now);
+                crate::profile::tile_begin();
                 let mut counters = Counters::default();
                 let mut r = TileResult::from_film(film_in, tx * TILE, ty * TILE);
                 render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
+                let phases = crate::profile::tile_end();
+                let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
                 tiles_done.fetch_add(1, Ordering::Relaxed);
-                (r, counters, t0.elapsed().as_secs_f64())
+                (r, counters, t0.elapsed().as_secs_f64(), phases, wall)
             })
             .collect()
     });
@@ -110,9 +120,13 @@ pub fn render_counted(
     let n = film.pixels();
     film.drop_block_data(); // the tiles hold the continued blocks: peak memory 2x the state, not 3x
     let mut data = vec![[0.0; 6]; blocks.len() * n];
-    for (tile, c, busy) in &results {
+    for (tile, c, busy, phases, wall) in &results {
         stats.counters.merge(c);
         stats.cpu_seconds += busy;
+        stats.profiled_ns += wall;
+        for (a, b) in stats.phase_ns.iter_mut().zip(phases) {
+            *a += b;
+        }
         debug_assert_eq!(tile.blocks, blocks);
         tile.store(&mut data, w, n);
     }
@@ -181,6 +195,7 @@ fn render_tile(
         // still accumulated in increasing order.
         let batch = start..samples.end.min(start + SAMPLE_BATCH);
         integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None);
+        let _acc = crate::profile::scope(crate::profile::Phase::Accumulate);
         for (s, per_sample) in batch.clone().zip(radiance.chunks_exact(packets.len())) {
             // The block structure is the same for every pixel: one binary-counter step.
             let depth = tile.blocks.len();

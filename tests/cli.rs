@@ -160,3 +160,34 @@ fn path_tracer_flags_override_the_scene_and_reject_unknown_names() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("unknown importance sampling `phong`"), "{err}");
 }
+
+/// `strata profile` prints the phase table and writes the JSON contract's keys.
+#[test]
+fn profile_prints_phases_and_writes_json() {
+    let d = tmpdir("profile");
+    let json = d.join("profile.json");
+    let r = strata()
+        .args(["profile", "--size", "40x32", "--spp", "2", "--threads", "2", "--repeats", "1", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let out = String::from_utf8_lossy(&r.stdout);
+    assert!(out.contains("embree intersect") && out.contains("ns/sample") && out.contains("overhead"), "{out}");
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for key in ["total_seconds", "phases", "overhead", "phase_sum_ratio", "bit_identical", "samples", "rays"] {
+        assert!(j.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(j["samples"], 40 * 32 * 2);
+    assert_eq!(j["bit_identical"], true);
+    let phases = j["phases"].as_array().unwrap();
+    assert!(phases.iter().any(|p| p["name"].as_str().unwrap().starts_with("sampler")));
+    for p in phases {
+        for key in ["name", "seconds", "share", "ns_per_sample", "ns_per_ray"] {
+            assert!(p.get(key).is_some(), "phase without {key}: {p}");
+        }
+    }
+    let sum: f64 = phases.iter().map(|p| p["seconds"].as_f64().unwrap()).sum();
+    let total = j["total_seconds"].as_f64().unwrap();
+    assert!((sum / total - 1.0).abs() < 0.02, "phases {sum} of {total}");
+}

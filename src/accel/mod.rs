@@ -33,7 +33,7 @@ mod user_geometry;
 
 pub use device::{AccelError, Device};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
-pub use ftz::set_ftz_daz;
+pub use ftz::{set_ftz_daz, timestamp};
 pub use scene::{Hits8, Scene, SceneBuilder};
 
 /// Embree's invalid geometry / instance id.

@@ -32,7 +32,10 @@ impl<'a> Tracer<'a> {
         if let Some(l) = self.log.as_deref_mut() {
             if kind == RayKind::Camera { &mut l.camera } else { &mut l.bounce }.push((*rh, active));
         }
-        let traced = self.scene.accel.intersect8(rh, kind == RayKind::Camera, active);
+        let traced = {
+            let _p = crate::profile::scope(crate::profile::Phase::EmbreeIntersect);
+            self.scene.accel.intersect8(rh, kind == RayKind::Camera, active)
+        };
         self.counters.packet(kind, traced);
         traced
     }
@@ -52,7 +55,10 @@ impl<'a> Tracer<'a> {
         if let Some(l) = self.log.as_deref_mut() {
             l.shadow.push((*ray, active));
         }
-        let occluded = self.scene.accel.occluded8(ray, active);
+        let occluded = {
+            let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
+            self.scene.accel.occluded8(ray, active)
+        };
         self.counters.packet(RayKind::Shadow, active);
         occluded
     }

@@ -29,6 +29,7 @@ impl Group<'_> {
     /// A point on the group's light(s) for the unit-square sample (u, v).
     #[inline]
     fn sample(self, scene: &Scene, u: F8, v: F8, active: Mask8) -> LightSample8 {
+        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
         match self {
             Group::Quad(e) => e.sample_x8(u, v),
             Group::Triangles => scene.emitters.sample_triangles_x8(u, v, active),
@@ -59,7 +60,10 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
         sc.acc.clear();
         sc.acc.resize(pks.len(), Vec3x8::ZERO);
         sc.streams.clear();
-        sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
+        {
+            let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
+            sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
+        }
         for k in 0..n_light {
             sc.shadow.clear();
             sc.contrib.clear();
@@ -69,7 +73,10 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 if shade.none() {
                     continue;
                 }
-                let (u, v) = sc.streams[i].point(k);
+                let (u, v) = {
+                    let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
+                    sc.streams[i].point(k)
+                };
                 let ls = group.sample(scene, u, v, shade);
                 let to = ls.y - sh.p;
                 let d2 = to.length_squared();

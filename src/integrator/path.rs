@@ -113,6 +113,7 @@ impl Integrator {
     /// Stratified 2D point of dimension `dim` for pixel sample `s`, strata shuffled per (pixel, dim).
     #[inline]
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
+        let _p = crate::profile::scope(crate::profile::Phase::SamplerPath);
         let n = self.spp;
         let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
         let k = permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)));
@@ -298,7 +299,11 @@ impl Integrator {
                         // with emissive triangles), one point on it, uniform in area: the
                         // historical path, kept bit-identical.
                         LightSelection::Uniform => {
-                            push(scene.emitters.sample_x8(u_choice, u, w, shade), None, None, shade)
+                            let ls = {
+                                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                scene.emitters.sample_x8(u_choice, u, w, shade)
+                            };
+                            push(ls, None, None, shade)
                         }
                         // Every light, N points each (a lattice rotated by (u, w)), each weighted
                         // 1/N and, with MIS, against N p_light.
@@ -311,15 +316,23 @@ impl Integrator {
                             for e in &scene.emitters.list {
                                 for j in 0..n_all {
                                     let (uj, wj) = lattice_point(u, w, j, n_all);
-                                    push(e.sample_x8(uj, wj), scale, mis_n, shade);
+                                    let ls = {
+                                        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                        e.sample_x8(uj, wj)
+                                    };
+                                    push(ls, scale, mis_n, shade);
                                 }
                             }
                         }
                         LightSelection::Power | LightSelection::Spatial => {
-                            let (idx, pmf) = self.light_sampler.sample_x8(u_choice, sh.p, sh.n, shade);
-                            let ok = shade & pmf.simd_gt(F8::ZERO);
-                            let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
-                            push(scene.emitters.place_x8(idx, inv_pmf, u, w), None, None, ok);
+                            let (ls, ok) = {
+                                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                let (idx, pmf) = self.light_sampler.sample_x8(u_choice, sh.p, sh.n, shade);
+                                let ok = shade & pmf.simd_gt(F8::ZERO);
+                                let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
+                                (scene.emitters.place_x8(idx, inv_pmf, u, w), ok)
+                            };
+                            push(ls, None, None, ok);
                         }
                     }
                 }

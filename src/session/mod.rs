@@ -10,6 +10,7 @@
 //! - [`stats`] — the `--stats` JSON and the summary line;
 //! - [`rays`] — `strata rays`;
 //! - [`checks`] — command-line checks before rendering, the default light;
+//! - [`profile`] — `strata profile`;
 //! - [`error`] — [`SessionError`].
 
 pub mod checks;
@@ -17,6 +18,7 @@ pub mod error;
 pub mod options;
 pub mod output;
 pub mod pass;
+pub mod profile;
 pub mod progress;
 pub mod rays;
 pub mod scene;
@@ -26,6 +28,7 @@ pub use error::SessionError;
 pub use options::{default_first_sample, default_quantize, RenderOptions, DEFAULT_CHECKPOINT_EVERY, DEFAULT_SCENE};
 pub use output::{metadata, output_stem, run_render};
 pub use pass::{render_to_film, stop_on_signals, RenderOutput};
+pub use profile::{profile_table, run_profile, Profile};
 pub use rays::{rates_table, run_rays};
 pub use scene::{is_obj, load_scene, parse_camera, prepare, scene_hash};
 pub use stats::{stats_json, summary};

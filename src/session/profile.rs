@@ -1,0 +1,160 @@
+//! `strata profile`: the worker threads' time split into phases ([`crate::profile`]), with the
+//! profiler's overhead measured in the same run (the same job rendered with profiling off,
+//! interleaved) and the profiled image checked bit-identical to the unprofiled one.
+
+use super::{prepare, RenderOptions, SessionError};
+use crate::film::Film;
+use crate::profile::{self, PHASES};
+use crate::render::{self, RenderStats};
+use serde::Serialize;
+
+/// Renders of each mode (profiling off, on), interleaved; the least CPU time of each counts.
+pub const REPEATS: usize = 3;
+
+/// One phase of a [`Profile`].
+#[derive(Clone, Debug, Serialize)]
+pub struct PhaseRow {
+    /// phase name (a name starting with `sampler` is sample generation)
+    pub name: String,
+    /// seconds summed over the worker threads
+    pub seconds: f64,
+    /// fraction of `total_seconds`
+    pub share: f64,
+    /// nanoseconds per camera sample (pixel x spp)
+    pub ns_per_sample: f64,
+    /// nanoseconds per ray traced (camera, bounce and shadow)
+    pub ns_per_ray: f64,
+}
+
+/// What `strata profile` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Profile {
+    /// scene file (or the built-in scene's name)
+    pub scene: String,
+    /// worker-thread seconds inside tiles of the profiled render (what the phases split)
+    pub total_seconds: f64,
+    /// the phases; their seconds sum to `total_seconds`
+    pub phases: Vec<PhaseRow>,
+    /// sum of the phases' seconds over `total_seconds` (1 up to clock rounding)
+    pub phase_sum_ratio: f64,
+    /// worker-thread CPU seconds of the fastest profiled render
+    pub cpu_seconds_profiled: f64,
+    /// worker-thread CPU seconds of the fastest unprofiled render
+    pub cpu_seconds_unprofiled: f64,
+    /// measured overhead of profiling: profiled / unprofiled CPU seconds - 1
+    pub overhead: f64,
+    /// the profiled image is bit-identical to the unprofiled one
+    pub bit_identical: bool,
+    /// camera samples (pixels x spp)
+    pub samples: u64,
+    /// rays traced per render
+    pub rays: u64,
+    /// worker threads
+    pub threads: usize,
+    /// renders per mode, interleaved
+    pub repeats: usize,
+}
+
+fn render_once(
+    scene: &crate::scene::build::Scene,
+    it: &crate::integrator::Integrator,
+    pool: &rayon::ThreadPool,
+    on: bool,
+) -> (RenderStats, Vec<[f32; 3]>) {
+    profile::set_enabled(on);
+    let mut film = Film::new(scene.desc.width, scene.desc.height);
+    let st = render::render(scene, it, &mut film, 0..it.spp, pool);
+    profile::set_enabled(false);
+    (st, film.mean())
+}
+
+/// `strata profile`: renders the job `repeats` times with profiling off and on, interleaved, and
+/// returns the phase split of the fastest profiled render.
+pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, SessionError> {
+    let (scene, integrator) = prepare(opts)?;
+    let pool = render::thread_pool(opts.threads)?;
+    let repeats = repeats.max(1);
+    let (mut off, mut on): (Option<RenderStats>, Option<RenderStats>) = (None, None);
+    let mut bit_identical = true;
+    let mut first_image: Option<Vec<[f32; 3]>> = None;
+    for _ in 0..repeats {
+        for mode in [false, true] {
+            let (st, img) = render_once(&scene, &integrator, &pool, mode);
+            match &first_image {
+                None => first_image = Some(img),
+                Some(f) => bit_identical &= bits(f) == bits(&img),
+            }
+            let best = if mode { &mut on } else { &mut off };
+            if best.as_ref().is_none_or(|b| st.cpu_seconds < b.cpu_seconds) {
+                *best = Some(st);
+            }
+        }
+    }
+    let (off, on) = (off.unwrap_or_default(), on.unwrap_or_default());
+    let samples = u64::from(scene.desc.width) * u64::from(scene.desc.height) * u64::from(integrator.spp);
+    let rays = on.counters.total_rays();
+    let total = on.profiled_ns as f64 * 1e-9;
+    let phases: Vec<PhaseRow> = PHASES
+        .iter()
+        .map(|&p| {
+            let s = on.phase_ns[p as usize] as f64 * 1e-9;
+            PhaseRow {
+                name: p.name().to_string(),
+                seconds: s,
+                share: s / total.max(1e-12),
+                ns_per_sample: s * 1e9 / samples.max(1) as f64,
+                ns_per_ray: s * 1e9 / rays.max(1) as f64,
+            }
+        })
+        .collect();
+    let sum: f64 = phases.iter().map(|p| p.seconds).sum();
+    Ok(Profile {
+        scene: scene.desc.source.display().to_string(),
+        total_seconds: total,
+        phase_sum_ratio: sum / total.max(1e-12),
+        phases,
+        cpu_seconds_profiled: on.cpu_seconds,
+        cpu_seconds_unprofiled: off.cpu_seconds,
+        overhead: on.cpu_seconds / off.cpu_seconds.max(1e-12) - 1.0,
+        bit_identical,
+        samples,
+        rays,
+        threads: on.threads,
+        repeats,
+    })
+}
+
+fn bits(img: &[[f32; 3]]) -> Vec<u32> {
+    img.iter().flatten().map(|v| v.to_bits()).collect()
+}
+
+/// The phase table `strata profile` prints.
+pub fn profile_table(p: &Profile) -> String {
+    let mut s = format!(
+        "{}: {} samples, {} rays, {} threads, {:.3} s in tiles (worker threads)\n",
+        p.scene, p.samples, p.rays, p.threads, p.total_seconds
+    );
+    s += &format!("{:<44} {:>9} {:>7} {:>10} {:>9}\n", "phase", "seconds", "%", "ns/sample", "ns/ray");
+    for r in &p.phases {
+        s += &format!(
+            "{:<44} {:>9.4} {:>6.1}% {:>10.1} {:>9.1}\n",
+            r.name,
+            r.seconds,
+            100.0 * r.share,
+            r.ns_per_sample,
+            r.ns_per_ray
+        );
+    }
+    let sampler: f64 = p.phases.iter().filter(|r| r.name.starts_with("sampler")).map(|r| r.share).sum();
+    s += &format!(
+        "sampler total {:.1}%; phases sum to {:.2}% of the total; overhead {:+.1}% (CPU {:.3} s profiled vs {:.3} s off, best of {}); image {}",
+        100.0 * sampler,
+        100.0 * p.phase_sum_ratio,
+        100.0 * p.overhead,
+        p.cpu_seconds_profiled,
+        p.cpu_seconds_unprofiled,
+        p.repeats,
+        if p.bit_identical { "bit-identical with profiling off" } else { "DIFFERS with profiling off" }
+    );
+    s
+}
