@@ -344,7 +344,33 @@ fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, String> {
     ImportanceSampling::parse(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
 }
 
+/// The build targets x86-64-v3 (see `.cargo/config.toml`): on a CPU without AVX2/FMA the first SIMD
+/// instruction would kill the process with SIGILL, so check before anything else runs.
+fn cpu_supported() -> Result<(), String> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let missing: Vec<&str> = [
+            ("avx2", std::arch::is_x86_feature_detected!("avx2")),
+            ("fma", std::arch::is_x86_feature_detected!("fma")),
+        ]
+        .into_iter()
+        .filter_map(|(name, ok)| (!ok).then_some(name))
+        .collect();
+        if !missing.is_empty() {
+            return Err(format!(
+                "this CPU lacks {} (strata is built for x86-64-v3: AVX2 and FMA, Intel Haswell / AMD Zen or newer); run it on a newer node",
+                missing.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
+    if let Err(msg) = cpu_supported() {
+        eprintln!("strata: {msg}");
+        return ExitCode::from(2);
+    }
     let cli = Cli::parse();
     let result = match cli.cmd {
         Cmd::Render(args) | Cmd::Reference(args) => {
