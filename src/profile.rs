@@ -202,9 +202,11 @@ mod tests {
         set_enabled(false);
         let sum: u64 = acc.iter().sum();
         assert!(sum <= total && sum as f64 > 0.99 * total as f64, "sum {sum} of {total}");
-        assert!(acc[Phase::SamplerPath as usize] >= 3_000_000);
+        // TSC ticks are converted with a rate calibrated against `Instant`: allow 5% for it.
+        let sp = acc[Phase::SamplerPath as usize];
+        assert!(sp >= 2_850_000, "inner scope: {sp} ns of 3 ms");
         let ei = acc[Phase::EmbreeIntersect as usize];
-        assert!((2_000_000..2_900_000).contains(&ei), "inner time not charged to the outer scope: {ei}");
-        assert!(acc[Phase::Other as usize] >= 1_000_000);
+        assert!((1_900_000..2_900_000).contains(&ei), "inner time not charged to the outer scope: {ei}");
+        assert!(acc[Phase::Other as usize] >= 950_000);
     }
 }

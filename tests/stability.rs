@@ -364,12 +364,12 @@ fn failed_renders_keep_existing_outputs_and_leave_no_temporaries() {
     assert!(e.contains("img.exr"), "{e}");
     assert_eq!(std::fs::read(dir.join("img.png")).unwrap(), png, "the old PNG survives");
     assert_eq!(std::fs::read(dir.join("old.exr")).unwrap(), exr);
-    // The output's parent is a regular file.
+    // The output's parent is a regular file: refused before rendering, naming the parent.
     let e = app::run_render(&RenderOptions { out: Some(dir.join("old.exr").join("x")), ..base.clone() })
         .err()
         .expect("bad parent")
         .to_string();
-    assert!(e.contains("x.exr"), "{e}");
+    assert!(e.contains("old.exr") && e.contains("cannot write there"), "{e}");
     let names: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.contains(".tmp-")), "temporary files left: {names:?}");

@@ -39,9 +39,12 @@ fn dir_of(f: &Path) -> PathBuf {
     }
 }
 
-/// Creates and removes a probe file in `dir`.
+/// Creates and removes a probe file in `dir` (named by process and a per-process counter, so
+/// renders running at once in one process or several never collide).
 fn check_writable(dir: &Path) -> Result<(), SessionError> {
-    let probe = dir.join(format!(".strata-write-probe-{}", std::process::id()));
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let probe = dir.join(format!(".strata-write-probe-{}-{n}", std::process::id()));
     let fail = |source| SessionError::NotWritable { dir: dir.to_path_buf(), source };
     if !dir.is_dir() {
         return Err(fail(std::io::Error::new(std::io::ErrorKind::NotFound, "no such directory")));
