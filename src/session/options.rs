@@ -87,28 +87,28 @@ pub struct RenderOptions {
 /// `.test` scenes (and the built-in one, a `.test`), rounding for `.obj` scenes (not course scenes).
 pub fn default_quantize(opts: &RenderOptions) -> crate::film::Quantize {
     use crate::film::Quantize;
-    opts.quantize.unwrap_or(match &opts.scene {
-        Some(p) if super::scene::is_obj(p) => Quantize::Round,
-        _ => Quantize::Truncate,
-    })
+    opts.quantize.unwrap_or(course_or_obj(opts, Quantize::Truncate, Quantize::Round))
 }
 
 /// Where pixel sample 0 goes for `opts`: `--first-sample`, else through the pixel centre like the
 /// CSE168 course code for `.test` scenes (and the built-in one), jittered for `.obj` scenes.
 pub fn default_first_sample(opts: &RenderOptions) -> crate::camera::FirstSample {
     use crate::camera::FirstSample;
-    opts.first_sample.unwrap_or(match &opts.scene {
-        Some(p) if super::scene::is_obj(p) => FirstSample::Jittered,
-        _ => FirstSample::Centre,
-    })
+    opts.first_sample.unwrap_or(course_or_obj(opts, FirstSample::Centre, FirstSample::Jittered))
 }
 
 /// NEE's light selection for `opts`: `--light-selection`, else `all` (every light, the CSE168
 /// course's convention) for `.test` scenes and the built-in one, `uniform` for `.obj` scenes.
 pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::LightSelection {
     use crate::light::select::LightSelection;
-    opts.light_selection.unwrap_or(match &opts.scene {
-        Some(p) if super::scene::is_obj(p) => LightSelection::Uniform,
-        _ => LightSelection::All,
-    })
+    opts.light_selection.unwrap_or(course_or_obj(opts, LightSelection::All, LightSelection::Uniform))
+}
+
+/// `course` for `.test` scenes (and the built-in one), `obj` for `.obj` scenes: the one rule behind
+/// the course-convention defaults.
+fn course_or_obj<T>(opts: &RenderOptions, course: T, obj: T) -> T {
+    match &opts.scene {
+        Some(p) if super::scene::is_obj(p) => obj,
+        _ => course,
+    }
 }
