@@ -53,6 +53,13 @@ enum Cmd {
         /// Output folder.
         #[arg(long, default_value = "compare")]
         out: PathBuf,
+        /// Write each variant's phase profile over all its runs (the keys of `strata profile
+        /// --json`, plus `variant`) as a JSON list to this file.
+        #[arg(long, value_name = "FILE")]
+        profile: Option<PathBuf>,
+        /// Write the variants' phase profiles as an SVG stacked bar chart (one bar per variant).
+        #[arg(long, value_name = "FILE")]
+        profile_svg: Option<PathBuf>,
     },
     /// Merge the part files of `render --samples A..B` shards (checkpoints) into OUT.exr and
     /// OUT.png, bit-identical to one render of the whole range; refuses parts of another render,
@@ -114,14 +121,18 @@ enum Cmd {
         json: bool,
     },
     /// Break the worker threads' time into phases (sampler by dimension group, emitter sampling,
-    /// Embree intersect/occluded, hit gather, accumulation, other) with % of render, ns per sample
-    /// and ns per ray; the overhead is measured by rendering the same job unprofiled, interleaved.
+    /// Embree intersect/occluded, user geometry, hit gather, BSDF sampling and eval, MIS,
+    /// accumulation, film, other) with % of render, ns per sample and ns per ray; the overhead is
+    /// measured by rendering the same job unprofiled, interleaved.
     Profile {
         #[command(flatten)]
         args: RenderArgs,
         /// Also write the profile as JSON to this file.
         #[arg(long = "json", value_name = "FILE")]
         json_file: Option<PathBuf>,
+        /// Also write the phases as an SVG stacked bar chart (shares in %, legend) to this file.
+        #[arg(long = "svg", value_name = "FILE")]
+        svg_file: Option<PathBuf>,
         /// Renders per mode (profiling off and on, interleaved); the fastest of each counts.
         #[arg(long, default_value_t = strata::session::profile::REPEATS)]
         repeats: usize,
@@ -182,6 +193,10 @@ struct RenderArgs {
     /// Write statistics as JSON to this file.
     #[arg(long)]
     stats: Option<PathBuf>,
+    /// Profile the render's phases (as `strata profile`, without its unprofiled re-render) and write
+    /// the profile JSON to this file; the image is bit-identical either way.
+    #[arg(long, value_name = "FILE")]
+    profile: Option<PathBuf>,
     /// Print nothing on success.
     #[arg(long, short = 'q')]
     quiet: bool,
@@ -248,6 +263,7 @@ impl RenderArgs {
             pixel_sampler: self.pixel_sampler,
             out: self.out,
             stats: self.stats,
+            profile: self.profile,
             integrator: self.integrator,
             progress: !self.quiet,
             general_kernel: self.kernel == "general",
@@ -418,8 +434,21 @@ fn main() -> ExitCode {
                 }
             })
         }
-        Cmd::Compare { scene, reference, variants, runs, budget, spp_ladder, size, threads, out } => {
-            run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out)
+        Cmd::Compare {
+            scene,
+            reference,
+            variants,
+            runs,
+            budget,
+            spp_ladder,
+            size,
+            threads,
+            out,
+            profile,
+            profile_svg,
+        } => {
+            let profile_out = ProfileOut { json: profile, svg: profile_svg };
+            run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out, &profile_out)
         }
         Cmd::GenMesh { out, triangles } => {
             let mesh = strata::scene::obj::procedural_mesh(triangles);
@@ -462,12 +491,21 @@ fn main() -> ExitCode {
                 }
             })
         }
-        Cmd::Profile { args, json_file, repeats } => {
+        Cmd::Profile { args, json_file, svg_file, repeats } => {
             let quiet = args.quiet;
+            // `--profile FILE` (a render flag) means the same here as `--json FILE`.
+            let json_file = json_file.or_else(|| args.profile.clone());
             session::run_profile(&args.options(), repeats).map_err(|e| e.to_string()).and_then(|p| {
                 if let Some(f) = &json_file {
                     let text = serde_json::to_string_pretty(&p).map_err(|e| e.to_string())?;
                     std::fs::write(f, text).map_err(|e| format!("{}: {e}", f.display()))?;
+                }
+                if let Some(f) = &svg_file {
+                    let svg = session::profile::profile_svg(
+                        &[(p.scene.as_str(), &p)],
+                        &format!("strata profile: {}", p.scene),
+                    );
+                    session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
                 }
                 if !quiet {
                     println!("{}", session::profile_table(&p));
@@ -497,6 +535,12 @@ fn exit_on_signal_outside_render(stop: Arc<AtomicBool>, rendering: Arc<AtomicBoo
     });
 }
 
+/// Where `compare` writes its variants' profiles (`--profile`, `--profile-svg`).
+struct ProfileOut {
+    json: Option<PathBuf>,
+    svg: Option<PathBuf>,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn run_compare(
     scene: Option<PathBuf>,
@@ -508,6 +552,7 @@ fn run_compare(
     size: Option<(u32, u32)>,
     threads: usize,
     out: &std::path::Path,
+    profile_out: &ProfileOut,
 ) -> Result<(), String> {
     let mut variants = Vec::new();
     for spec in specs {
@@ -531,13 +576,24 @@ fn run_compare(
         (None, Some(_)) => return Err("--spp-ladder: expected positive spp values".into()),
         (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
     };
-    let rows = strata::lab::compare(&variants, reference, runs, &mode).map_err(|e| e.to_string())?;
+    let (rows, profiles) =
+        strata::lab::compare_profiled(&variants, reference, runs, &mode).map_err(|e| e.to_string())?;
     let title = format!(
         "{} vs {}",
         scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
         reference.display()
     );
     let md = strata::lab::write_outputs(&rows, out, &title).map_err(|e| e.to_string())?;
+    if let Some(f) = &profile_out.json {
+        let text = serde_json::to_string_pretty(&profiles).map_err(|e| e.to_string())?;
+        session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
+    }
+    if let Some(f) = &profile_out.svg {
+        let entries: Vec<(&str, &session::Profile)> =
+            profiles.iter().map(|v| (v.variant.as_str(), &v.profile)).collect();
+        let svg = session::profile::profile_svg(&entries, &format!("phases per variant: {title}"));
+        session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
+    }
     println!("{md}");
     println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", out.display());
     Ok(())

@@ -4,11 +4,18 @@
 //! Time is exclusive: entering a [`scope`] charges the clock since the last switch to the phase
 //! that was running and makes the scope's phase current; leaving charges the scope and restores
 //! the outer phase. Every nanosecond between [`tile_begin`] and [`tile_end`] therefore lands in
-//! exactly one phase (code in no scope is [`Phase::Other`]: shading, BSDFs, warps, MIS), so the
-//! phases cover the tile; the clock is the CPU's time-stamp counter ([`crate::accel::timestamp`],
+//! exactly one phase (code in no scope is [`Phase::Other`]: shading arithmetic and ray setup), so
+//! the phases cover the tile. One phase nests below the scopes: Embree calls the sphere/ellipsoid
+//! callbacks from inside `rtcIntersect8`/`rtcOccluded8`, where no scope can be entered (`accel`
+//! sits below this module), so `accel::user_geometry` counts the callbacks' ticks itself
+//! ([`crate::accel::take_callback_ticks`]) and the switch out of an Embree phase moves them from
+//! that phase to [`Phase::UserGeometry`]. The clock is the CPU's time-stamp counter ([`crate::accel::timestamp`],
 //! a few ns a read), converted to nanoseconds with a rate calibrated against `Instant` when
 //! profiling is turned on, and the sum is checked against the tiles' `Instant` time measured
-//! independently. Scopes sit at batch granularity (one 8-lane packet call or one tile loop),
+//! independently. Work outside the tiles that a profile covers is timed with `Instant` and added
+//! to both the phase and the total: the film merge after the tiles ([`Phase::Film`], in
+//! `render`) and the image encoding of the commands that write one ([`Phase::Output`], in
+//! `session`). Scopes sit at batch granularity (one 8-lane packet call or one tile loop),
 //! never per lane. Profiling off (the default) costs one
 //! relaxed atomic load per scope; it never changes what is computed, so images are bit-identical.
 
@@ -20,7 +27,7 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(usize)]
 pub enum Phase {
-    /// code in no other phase: shading, BSDF sampling and eval, warps, MIS, ray setup
+    /// code in no other phase: shading arithmetic, ray setup, path bookkeeping
     Other = 0,
     /// sample generation of the pixel/camera dimensions
     SamplerPixel,
@@ -30,18 +37,32 @@ pub enum Phase {
     SamplerPath,
     /// emitter sampling (a point on a light from the unit-square sample)
     Emitter,
-    /// Embree closest-hit queries (camera and bounce packets), user geometry callbacks included
+    /// Embree closest-hit queries (camera and bounce packets), user geometry callbacks excluded
     EmbreeIntersect,
-    /// Embree occlusion queries (shadow packets)
+    /// Embree occlusion queries (shadow packets), user geometry callbacks excluded
     EmbreeOccluded,
     /// hit gather: Embree hit records (AoS) to SoA shading records
     Gather,
     /// accumulation of samples into the tile's dyadic blocks
     Accumulate,
+    /// BSDF sampling: lobe choice and the direction warp (path tracer)
+    BsdfSample,
+    /// BSDF evaluation: value and pdf for a given direction (NEE, direct lighting, Blinn-Phong)
+    BsdfEval,
+    /// multiple importance sampling weights where a BSDF-sampled ray hits a light (the light's
+    /// pdf and pmf there, power heuristic); the NEE side's few-flop weight stays in `Other`
+    Mis,
+    /// sphere/ellipsoid intersection callbacks, run by Embree inside its queries (with
+    /// `STRATA_SPHERES=embree`, spheres that are Embree sphere points stay in the Embree phases)
+    UserGeometry,
+    /// film: copying the film's blocks into a tile and merging the tiles back
+    Film,
+    /// encoding and writing the output images (commands that write them)
+    Output,
 }
 
 /// Number of phases.
-pub const N_PHASES: usize = 9;
+pub const N_PHASES: usize = 15;
 
 /// Every phase in table order.
 pub const PHASES: [Phase; N_PHASES] = [
@@ -51,8 +72,14 @@ pub const PHASES: [Phase; N_PHASES] = [
     Phase::Emitter,
     Phase::EmbreeIntersect,
     Phase::EmbreeOccluded,
+    Phase::UserGeometry,
     Phase::Gather,
+    Phase::BsdfSample,
+    Phase::BsdfEval,
+    Phase::Mis,
     Phase::Accumulate,
+    Phase::Film,
+    Phase::Output,
     Phase::Other,
 ];
 
@@ -60,7 +87,7 @@ impl Phase {
     /// The phase's name in tables and JSON (a name starting with `sampler` is sample generation).
     pub fn name(self) -> &'static str {
         match self {
-            Phase::Other => "other (shading, bsdf, warps, mis)",
+            Phase::Other => "other (shading, ray setup)",
             Phase::SamplerPixel => "sampler: pixel/camera",
             Phase::SamplerLight => "sampler: light",
             Phase::SamplerPath => "sampler: path (bounce, lobe, light choice)",
@@ -69,6 +96,12 @@ impl Phase {
             Phase::EmbreeOccluded => "embree occluded",
             Phase::Gather => "hit gather",
             Phase::Accumulate => "accumulate",
+            Phase::BsdfSample => "bsdf sampling (lobe choice, warp)",
+            Phase::BsdfEval => "bsdf eval (value, pdf)",
+            Phase::Mis => "mis weights",
+            Phase::UserGeometry => "user geometry (sphere/ellipsoid callbacks)",
+            Phase::Film => "film (tile copy and merge)",
+            Phase::Output => "output encode (exr, png)",
         }
     }
 }
@@ -77,10 +110,20 @@ static ENABLED: AtomicBool = AtomicBool::new(false);
 /// nanoseconds per tick, as f64 bits (0: not calibrated yet)
 static NS_PER_TICK: AtomicU64 = AtomicU64::new(0);
 
+/// A thread's profiler state, in one thread-local (one lookup per switch, no array copies).
+struct State {
+    /// the running phase
+    current: Cell<usize>,
+    /// tick of the last switch
+    since: Cell<u64>,
+    /// ticks per phase
+    acc: [Cell<u64>; N_PHASES],
+}
+
 thread_local! {
-    static CURRENT: Cell<usize> = const { Cell::new(0) };
-    static SINCE: Cell<u64> = const { Cell::new(0) };
-    static ACC: Cell<[u64; N_PHASES]> = const { Cell::new([0; N_PHASES]) };
+    static STATE: State = const {
+        State { current: Cell::new(0), since: Cell::new(0), acc: [const { Cell::new(0) }; N_PHASES] }
+    };
 }
 
 /// Turns profiling on or off for every thread (set it before a render, not during one). The first
@@ -95,6 +138,24 @@ pub fn set_enabled(on: bool) {
         NS_PER_TICK.store((ns / ticks.max(1) as f64).to_bits(), Ordering::SeqCst);
     }
     ENABLED.store(on, Ordering::SeqCst);
+    crate::accel::set_callback_timing(on);
+}
+
+/// Profiling held on until the guard drops (then off for every thread), so an early return
+/// never leaves it on.
+#[must_use = "profiling turns off when the guard drops"]
+pub struct Enabled(());
+
+impl Drop for Enabled {
+    fn drop(&mut self) {
+        set_enabled(false);
+    }
+}
+
+/// Turns profiling on (see [`set_enabled`]) until the returned guard drops.
+pub fn enable() -> Enabled {
+    set_enabled(true);
+    Enabled(())
 }
 
 /// Nanoseconds per tick of the profiler's clock (1 before calibration).
@@ -111,18 +172,25 @@ pub fn enabled() -> bool {
     ENABLED.load(Ordering::Relaxed)
 }
 
-/// Charges the ticks since the last switch to the current phase and makes `next` current.
+/// Charges the ticks since the last switch to the current phase and makes `next` current; the
+/// user-geometry callbacks' ticks counted meanwhile (inside the Embree call that just ended) go to
+/// [`Phase::UserGeometry`] instead.
 #[inline]
 fn switch(next: usize) -> usize {
     let now = crate::accel::timestamp();
-    let prev = CURRENT.with(|c| c.replace(next));
-    let since = SINCE.with(|s| s.replace(now));
-    ACC.with(|a| {
-        let mut v = a.get();
-        v[prev] += now.saturating_sub(since);
-        a.set(v);
-    });
-    prev
+    STATE.with(|st| {
+        let prev = st.current.replace(next);
+        let spent = now.saturating_sub(st.since.replace(now));
+        // Callbacks only run inside Embree calls: only a switch out of an Embree phase has any.
+        let embree = prev == Phase::EmbreeIntersect as usize || prev == Phase::EmbreeOccluded as usize;
+        let nested = if embree { crate::accel::take_callback_ticks().min(spent) } else { 0 };
+        let add = |i: usize, t: u64| st.acc[i].set(st.acc[i].get() + t);
+        add(prev, spent - nested);
+        if nested > 0 {
+            add(Phase::UserGeometry as usize, nested);
+        }
+        prev
+    })
 }
 
 /// A running phase; dropping it restores the outer phase.
@@ -153,9 +221,12 @@ pub fn scope(phase: Phase) -> Scope {
 #[inline]
 pub fn tile_begin() {
     if enabled() {
-        CURRENT.with(|c| c.set(0));
-        SINCE.with(|s| s.set(crate::accel::timestamp()));
-        ACC.with(|a| a.set([0; N_PHASES]));
+        crate::accel::take_callback_ticks();
+        STATE.with(|st| {
+            st.current.set(0);
+            st.acc.iter().for_each(|a| a.set(0));
+            st.since.set(crate::accel::timestamp());
+        });
     }
 }
 
@@ -167,7 +238,7 @@ pub fn tile_end() -> [u64; N_PHASES] {
     }
     switch(0);
     let k = ns_per_tick();
-    ACC.with(|a| a.replace([0; N_PHASES])).map(|t| (t as f64 * k) as u64)
+    STATE.with(|st| std::array::from_fn(|i| (st.acc[i].replace(0) as f64 * k) as u64))
 }
 
 #[cfg(test)]

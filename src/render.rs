@@ -32,11 +32,26 @@ pub struct RenderStats {
     pub cpu_seconds: f64,
     /// nanoseconds per [`crate::profile::Phase`] summed over the workers (zero unless profiling)
     pub phase_ns: [u64; crate::profile::N_PHASES],
-    /// nanoseconds between tile start and end summed over the tiles (zero unless profiling)
+    /// nanoseconds between tile start and end summed over the tiles, plus the film merge after
+    /// them (zero unless profiling): what the phases split
     pub profiled_ns: u64,
+    /// camera samples rendered (pixels x samples per pixel of this render)
+    pub samples: u64,
 }
 
 impl RenderStats {
+    /// Adds another render's times, counters, phases and samples to these (threads unchanged).
+    pub fn merge(&mut self, o: &RenderStats) {
+        self.seconds += o.seconds;
+        self.cpu_seconds += o.cpu_seconds;
+        self.counters.merge(&o.counters);
+        for (a, b) in self.phase_ns.iter_mut().zip(&o.phase_ns) {
+            *a += b;
+        }
+        self.profiled_ns += o.profiled_ns;
+        self.samples += o.samples;
+    }
+
     /// Rays traced per second over all kinds, in millions.
     pub fn mrays_per_sec(&self) -> f64 {
         self.counters.total_rays() as f64 / self.seconds.max(1e-12) / 1e6
@@ -88,6 +103,7 @@ pub fn render_counted(
     if samples.is_empty() {
         return stats;
     }
+    stats.samples = u64::from(w) * u64::from(h) * samples.len() as u64;
     let tiles_x = w.div_ceil(TILE);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     let start = Instant::now();
@@ -102,7 +118,10 @@ pub fn render_counted(
                 let w0 = profiling.then(Instant::now);
                 crate::profile::tile_begin();
                 let mut counters = Counters::default();
-                let mut r = TileResult::from_film(film_in, tx * TILE, ty * TILE);
+                let mut r = {
+                    let _f = crate::profile::scope(crate::profile::Phase::Film);
+                    TileResult::from_film(film_in, tx * TILE, ty * TILE)
+                };
                 render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
                 let phases = crate::profile::tile_end();
                 let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
@@ -112,6 +131,9 @@ pub fn render_counted(
             .collect()
     });
     stats.seconds = start.elapsed().as_secs_f64();
+    // The merge below runs on the calling thread, outside the tiles: timed with `Instant` into the
+    // film phase and the profiled total when profiling.
+    let merge_start = crate::profile::enabled().then(Instant::now);
     let first = if have.is_empty() { samples.start } else { have.start };
     let mut blocks = film.blocks().to_vec();
     samples.clone().for_each(|s| {
@@ -131,6 +153,11 @@ pub fn render_counted(
         tile.store(&mut data, w, n);
     }
     film.set_state(first..samples.end, blocks, data);
+    if let Some(t) = merge_start {
+        let ns = t.elapsed().as_nanos() as u64;
+        stats.phase_ns[crate::profile::Phase::Film as usize] += ns;
+        stats.profiled_ns += ns;
+    }
     stats
 }
 

@@ -35,6 +35,7 @@ pub use device::{AccelError, Device};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
 pub use ftz::{set_ftz_daz, timestamp};
 pub use scene::{Hits8, Scene, SceneBuilder};
+pub use user_geometry::{set_callback_timing, take_callback_ticks};
 
 /// Embree's invalid geometry / instance id.
 pub const INVALID_ID: u32 = u32::MAX;

@@ -4,7 +4,43 @@
 use super::ffi::RayQueryContext;
 use embree4_sys as sys;
 use glam::Mat4;
+use std::cell::Cell;
 use std::ffi::c_void;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Whether the callbacks time themselves (set by the phase profiler, `crate::profile`).
+static CALLBACK_TIMING: AtomicBool = AtomicBool::new(false);
+
+thread_local! {
+    /// Time-stamp ticks this thread spent in intersect/occluded callbacks since the last take.
+    static CALLBACK_TICKS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Turns the callbacks' self-timing on or off for every thread (the profiler's switch).
+pub fn set_callback_timing(on: bool) {
+    CALLBACK_TIMING.store(on, Ordering::SeqCst);
+}
+
+/// Returns and clears the ticks ([`super::timestamp`]) this thread spent in sphere/ellipsoid
+/// intersect and occluded callbacks since the last call (0 unless timing is on). The profiler
+/// moves them out of the Embree phase the callbacks ran in.
+#[inline]
+pub fn take_callback_ticks() -> u64 {
+    CALLBACK_TICKS.with(|c| c.replace(0))
+}
+
+/// Runs one callback invocation (a packet of up to N rays against one primitive), adding its
+/// ticks to this thread's count when timing is on.
+#[inline]
+fn timed(f: impl FnOnce()) {
+    if !CALLBACK_TIMING.load(Ordering::Relaxed) {
+        return f();
+    }
+    let t0 = super::timestamp();
+    f();
+    let dt = super::timestamp().wrapping_sub(t0);
+    CALLBACK_TICKS.with(|c| c.set(c.get() + dt));
+}
 
 /// One ellipsoid: the unit sphere under an affine map, stored as the world-to-object map in f64.
 #[derive(Clone, Copy, Debug)]
@@ -134,7 +170,7 @@ pub(super) unsafe extern "C" fn ellipsoid_intersect(args: *const sys::RTCInterse
     // SAFETY: Embree passes `valid` with N ints, `rayhit` as an RTCRayHitN of width N in the 4.4
     // layout (12 ray fields then 9 hit fields, one instance level), the user pointer set in
     // add_ellipsoids, and primID < the primitive count.
-    unsafe {
+    timed(|| unsafe {
         let a = &*args;
         let (n, base) = (a.N as usize, a.rayhit as *mut u32);
         let ctx = &*(a.context as *const RayQueryContext);
@@ -148,16 +184,16 @@ pub(super) unsafe extern "C" fn ellipsoid_intersect(args: *const sys::RTCInterse
             *soa(base, n, 19, lane) = ctx.inst_id[0];
             *soa(base, n, 20, lane) = ctx.inst_prim_id[0];
         });
-    }
+    })
 }
 
 pub(super) unsafe extern "C" fn ellipsoid_occluded(args: *const sys::RTCOccludedFunctionNArguments) {
     // SAFETY: as in ellipsoid_intersect, with `ray` an RTCRayN of width N (12 fields).
-    unsafe {
+    timed(|| unsafe {
         let a = &*args;
         let (n, base) = (a.N as usize, a.ray as *mut u32);
         each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, _| {
             *soa(base, n, 8, lane) = f32::NEG_INFINITY.to_bits();
         });
-    }
+    })
 }

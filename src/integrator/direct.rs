@@ -91,7 +91,10 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                     continue;
                 }
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-                let f = material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit);
+                let f = {
+                    let _p = crate::profile::scope(crate::profile::Phase::BsdfEval);
+                    material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
+                };
                 let g = cos_i * cos_l * inv_d * inv_d;
                 sc.contrib.push(match group {
                     Group::Quad(_) => f.scale(g),

@@ -205,6 +205,7 @@ impl Integrator {
                     Nee::On => F8::splat(if v == 1 { 1.0 } else { 0.0 }),
                     Nee::Mis if v == 1 => F8::ONE,
                     Nee::Mis => {
+                        let _p = crate::profile::scope(crate::profile::Phase::Mis);
                         let p_light = if sel == LightSelection::Uniform {
                             light_pdf_at_hit(scene, &sh, rh, is_light)
                         } else {
@@ -264,12 +265,17 @@ impl Integrator {
                         if lit.none() {
                             return;
                         }
-                        let (f, pdf_b) = mat.eval_pdf_k::<L>(self.strategy, wo, frame.to_local(wi), lit);
+                        let (f, pdf_b) = {
+                            let _p = crate::profile::scope(crate::profile::Phase::BsdfEval);
+                            mat.eval_pdf_k::<L>(self.strategy, wo, frame.to_local(wi), lit)
+                        };
                         // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
                         let mut g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
                         if let Some(k) = scale {
                             g *= k;
                         }
+                        // (The NEE side's weight is a few flops per lane: cheaper than a scope, so
+                        // it stays in `other`; the light-hit side below is timed as `mis weights`.)
                         let w_light = if nee == Nee::Mis {
                             let p_light = d2 / (area * cos_l * inv_pmf);
                             let p_light = if let Some(k) = mis_n { p_light * k } else { p_light };
@@ -340,7 +346,10 @@ impl Integrator {
                 // Continue the path: sample the BSDF, then Russian roulette.
                 if bounce_here {
                     let u2 = self.path_point(pixel, s, dims + 2);
-                    let (wi_l, pdf, f) = mat.sample_k::<L>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade);
+                    let (wi_l, pdf, f) = {
+                        let _p = crate::profile::scope(crate::profile::Phase::BsdfSample);
+                        mat.sample_k::<L>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade)
+                    };
                     let cos = wi_l.z;
                     let wi = frame.to_world(wi_l);
                     let ok = shade

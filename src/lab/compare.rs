@@ -4,9 +4,11 @@
 
 use super::{io_err, LabError};
 use crate::film::{self, Film};
-use crate::render;
+use crate::render::{self, RenderStats};
 use crate::report::{self, Row, RunStats, Series};
+use crate::session::profile::Profile;
 use crate::session::{self, RenderOptions};
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// One technique: a name and the render options that define it.
@@ -27,14 +29,37 @@ pub enum Mode {
     Budget(f64),
 }
 
+/// One variant's phase profile over all its runs and steps (`compare --profile`).
+#[derive(Clone, Debug, Serialize)]
+pub struct VariantProfile {
+    /// the variant's name
+    pub variant: String,
+    /// its profile (the keys of `strata profile --json`)
+    #[serde(flatten)]
+    pub profile: Profile,
+}
+
 /// Runs every variant `runs` times (seeds 1..=runs, independent streams) under `mode`, compares
 /// with the reference image and returns one row per (variant, ladder step).
 pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, LabError> {
+    compare_profiled(variants, reference, runs, mode).map(|(rows, _)| rows)
+}
+
+/// [`compare`] with the phase profiler on (it never changes an image): also returns each
+/// variant's profile over all its renders.
+pub fn compare_profiled(
+    variants: &[Variant],
+    reference: &Path,
+    runs: usize,
+    mode: &Mode,
+) -> Result<(Vec<Row>, Vec<VariantProfile>), LabError> {
     let img = film::read_exr(reference).map_err(io_err(reference))?;
     if runs < 2 {
         return Err(LabError::TooFewRuns { why: " (bias and variance need independent runs)" });
     }
     let mut rows = Vec::new();
+    let mut profiles = Vec::new();
+    let _profiling = crate::profile::enable();
     for v in variants {
         let (scene, integ) = session::prepare(&v.opts)?;
         if (scene.desc.width, scene.desc.height) != (img.width, img.height) {
@@ -47,6 +72,7 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
             });
         }
         let pool = render::thread_pool(v.opts.threads)?;
+        let mut all = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
         let steps: Vec<Option<u32>> = match mode {
             Mode::Ladder(l) => l.iter().map(|&s| Some(s)).collect(),
             Mode::Budget(_) => vec![None],
@@ -61,6 +87,7 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
                     (Some(spp), _) => {
                         it = it.resampled(Some(spp));
                         let st = render::render(&scene, &it, &mut film, 0..spp, &pool);
+                        all.merge(&st);
                         (st.seconds, spp)
                     }
                     (None, Mode::Budget(b)) => {
@@ -69,7 +96,9 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
                         it = it.resampled(None);
                         let (mut t, mut s) = (0.0, 0u32);
                         while t < *b {
-                            t += render::render(&scene, &it, &mut film, s..s + 1, &pool).seconds;
+                            let st = render::render(&scene, &it, &mut film, s..s + 1, &pool);
+                            all.merge(&st);
+                            t += st.seconds;
                             s += 1;
                         }
                         (t, s)
@@ -84,8 +113,10 @@ pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode)
                 .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
             rows.push(Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?);
         }
+        let profile = Profile::from_stats(&scene.desc.source.display().to_string(), &all);
+        profiles.push(VariantProfile { variant: v.name.clone(), profile });
     }
-    Ok(rows)
+    Ok((rows, profiles))
 }
 
 /// Writes rows.csv, rows.json, table.md and error.svg (RMSE against seconds, slope -1/2 guide)

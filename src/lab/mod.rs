@@ -6,7 +6,7 @@
 pub mod compare;
 pub mod experiments;
 
-pub use compare::{compare, write_outputs, Mode, Variant};
+pub use compare::{compare, compare_profiled, write_outputs, Mode, Variant, VariantProfile};
 
 use crate::report::ReportError;
 use crate::session::SessionError;

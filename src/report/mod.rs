@@ -7,13 +7,16 @@
 //!   confidence interval, variance, the MSE decomposition) and efficiency.
 //! - [`table`]: one [`table::Row`] per variant, written as CSV, JSON or a Markdown table.
 //! - [`plot`]: a self-contained log-log SVG of error against time with a convergence-rate guide.
+//! - [`bars`]: a stacked bar chart SVG (the phases of `strata profile`, one bar per variant).
 
+pub mod bars;
 pub mod contact;
 pub mod metrics;
 pub mod plot;
 pub mod runs;
 pub mod table;
 
+pub use bars::{stacked_bars_svg, Bar};
 pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, RunStats};
 pub use plot::{loglog_svg, LogScale, Series};
 pub use table::{to_csv, to_json, to_markdown, Row};

@@ -231,13 +231,13 @@ fn axis(scale: &LogScale, horizontal: bool) -> String {
 }
 
 /// Series colour: a colour-blind-safe palette, then hues spaced by the golden angle.
-fn colour(i: usize) -> String {
+pub(super) fn colour(i: usize) -> String {
     const PALETTE: [&str; 7] = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000"];
     PALETTE.get(i).map_or_else(|| format!("hsl({:.0}, 70%, 40%)", (i as f64 * 137.508) % 360.0), |c| c.to_string())
 }
 
 /// Escapes text for XML content and attribute values.
-fn escape(s: &str) -> String {
+pub(super) fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
         match c {

@@ -10,7 +10,7 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 /// Checks what the command line alone decides, before the scene is read: `--threads` within
-/// `max_threads`, and every directory the render will write to (image, checkpoint, stats)
+/// `max_threads`, and every directory the render will write to (image, checkpoint, stats, profile)
 /// writable (a probe file is created and removed), so that a bad path fails before any sample.
 pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
     let max = opts.limits.max_threads;
@@ -24,7 +24,7 @@ pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
         });
     }
     let stem = opts.out.as_ref().map(|o| stem_of(o)).unwrap_or_else(|| PathBuf::from("strata"));
-    let files = [Some(stem), opts.checkpoint.clone(), opts.resume.clone(), opts.stats.clone()];
+    let files = [Some(stem), opts.checkpoint.clone(), opts.resume.clone(), opts.stats.clone(), opts.profile.clone()];
     for f in files.iter().flatten() {
         check_writable(&dir_of(f))?;
     }

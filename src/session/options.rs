@@ -36,6 +36,9 @@ pub struct RenderOptions {
     pub out: Option<PathBuf>,
     /// JSON statistics file
     pub stats: Option<PathBuf>,
+    /// `--profile FILE`: profile the render's phases ([`crate::profile`]) and write the profile
+    /// JSON (the keys of `strata profile --json`) here
+    pub profile: Option<PathBuf>,
     /// integrator override
     pub integrator: Option<IntegratorKind>,
     /// print progress (spp done, Mrays/s, ETA) on stderr while rendering

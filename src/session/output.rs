@@ -28,9 +28,11 @@ pub fn metadata(out: &RenderOutput) -> Metadata {
     m
 }
 
-/// `strata render`: render, write OUT.exr (with a variance layer) and OUT.png, and the stats JSON.
+/// `strata render`: render, write OUT.exr (with a variance layer) and OUT.png, the stats JSON and,
+/// with `--profile`, the profile JSON (the phases of the render and of the image encoding).
 pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
     let mut out = render_to_film(opts)?;
+    let encode_start = std::time::Instant::now();
     let stem = output_stem(opts, &out.scene.desc);
     let (w, h) = (out.film.width, out.film.height);
     let mean = out.film.mean();
@@ -42,6 +44,14 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
     film::write_png_quantized(&png, w, h, &mean, out.scene.desc.gamma, super::options::default_quantize(opts))
         .map_err(|source| SessionError::Output { path: png.clone(), source })?;
     out.out = Some(stem);
+    if let Some(p) = &opts.profile {
+        // The encoding ran on this thread after the render: its own phase, added to the total.
+        let ns = encode_start.elapsed().as_nanos() as u64;
+        out.stats.phase_ns[crate::profile::Phase::Output as usize] += ns;
+        out.stats.profiled_ns += ns;
+        let profile = super::profile::Profile::from_stats(&out.scene.desc.source.display().to_string(), &out.stats);
+        super::profile::write_text(p, &serde_json::to_string_pretty(&profile)?)?;
+    }
     if let Some(p) = &opts.stats {
         let text = serde_json::to_string_pretty(&stats_json(&out))?;
         film::write_atomic(p, text.as_bytes()).map_err(|source| SessionError::Output { path: p.clone(), source })?;

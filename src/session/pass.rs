@@ -95,6 +95,8 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
     if let Some(r) = &opts.rendering {
         r.store(true, Ordering::SeqCst);
     }
+    // `--profile`: the phase profiler runs over every pass (it never changes the image).
+    let profiling = opts.profile.is_some().then(crate::profile::enable);
     while s < target.end {
         if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
             interrupted = true;
@@ -115,9 +117,7 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
             render::render_counted(&scene, &integrator, &mut film, s..s + n, &pool, tiles_done)
         });
         s += n;
-        stats.seconds += st.seconds;
-        stats.cpu_seconds += st.cpu_seconds;
-        stats.counters.merge(&st.counters);
+        stats.merge(&st);
         header.cpu_seconds += st.cpu_seconds;
         header.render_seconds += st.seconds;
         header.rays += st.counters.total_rays();
@@ -133,6 +133,7 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
             }
         }
     }
+    drop(profiling);
     progress.finish();
     let stem = output_stem(opts, &scene.desc);
     let final_ckpt = match ckpt_path {

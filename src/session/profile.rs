@@ -1,8 +1,11 @@
 //! `strata profile`: the worker threads' time split into phases ([`crate::profile`]), with the
 //! profiler's overhead measured in the same run (the same job rendered with profiling off,
-//! interleaved) and the profiled image checked bit-identical to the unprofiled one.
+//! interleaved) and the profiled image checked bit-identical to the unprofiled one. The same
+//! [`Profile`] (JSON) comes out of `render`/`reference --profile` and, per variant, `compare
+//! --profile` ([`Profile::from_stats`]), and [`profile_svg`] draws profiles as stacked bars.
 
 use super::{prepare, RenderOptions, SessionError};
+use crate::film;
 use crate::film::Film;
 use crate::profile::{self, PHASES};
 use crate::render::{self, RenderStats};
@@ -31,7 +34,8 @@ pub struct PhaseRow {
 pub struct Profile {
     /// scene file (or the built-in scene's name)
     pub scene: String,
-    /// worker-thread seconds inside tiles of the profiled render (what the phases split)
+    /// what the phases split: worker-thread seconds inside the tiles of the profiled render(s),
+    /// plus the film merges after them and the output encoding where the command writes images
     pub total_seconds: f64,
     /// the phases; their seconds sum to `total_seconds`
     pub phases: Vec<PhaseRow>,
@@ -39,20 +43,100 @@ pub struct Profile {
     pub phase_sum_ratio: f64,
     /// worker-thread CPU seconds of the fastest profiled render
     pub cpu_seconds_profiled: f64,
-    /// worker-thread CPU seconds of the fastest unprofiled render
-    pub cpu_seconds_unprofiled: f64,
-    /// measured overhead of profiling: profiled / unprofiled CPU seconds - 1
-    pub overhead: f64,
-    /// the profiled image is bit-identical to the unprofiled one
-    pub bit_identical: bool,
+    /// worker-thread CPU seconds of the fastest unprofiled render (`strata profile` only: null
+    /// where nothing was rendered unprofiled, as in `render --profile`)
+    pub cpu_seconds_unprofiled: Option<f64>,
+    /// measured overhead of profiling: profiled / unprofiled CPU seconds - 1 (`strata profile`
+    /// only, else null)
+    pub overhead: Option<f64>,
+    /// the profiled image is bit-identical to the unprofiled one (`strata profile` only, else null)
+    pub bit_identical: Option<bool>,
     /// camera samples (pixels x spp)
     pub samples: u64,
     /// rays traced per render
     pub rays: u64,
     /// worker threads
     pub threads: usize,
-    /// renders per mode, interleaved
+    /// renders per mode, interleaved (1 for a profile of one command's renders)
     pub repeats: usize,
+}
+
+impl Profile {
+    /// The phase split of `st` (one render, or several merged with [`RenderStats::merge`]) of
+    /// scene `scene`; the fields only `strata profile` measures (overhead, the unprofiled time,
+    /// bit identity) are None.
+    pub fn from_stats(scene: &str, st: &RenderStats) -> Profile {
+        let (samples, rays) = (st.samples, st.counters.total_rays());
+        let total = st.profiled_ns as f64 * 1e-9;
+        let phases: Vec<PhaseRow> = PHASES
+            .iter()
+            .map(|&p| {
+                let s = st.phase_ns[p as usize] as f64 * 1e-9;
+                PhaseRow {
+                    name: p.name().to_string(),
+                    seconds: s,
+                    share: s / total.max(1e-12),
+                    ns_per_sample: s * 1e9 / samples.max(1) as f64,
+                    ns_per_ray: s * 1e9 / rays.max(1) as f64,
+                }
+            })
+            .collect();
+        let sum: f64 = phases.iter().map(|p| p.seconds).sum();
+        Profile {
+            scene: scene.to_string(),
+            total_seconds: total,
+            phase_sum_ratio: sum / total.max(1e-12),
+            phases,
+            cpu_seconds_profiled: st.cpu_seconds,
+            cpu_seconds_unprofiled: None,
+            overhead: None,
+            bit_identical: None,
+            samples,
+            rays,
+            threads: st.threads,
+            repeats: 1,
+        }
+    }
+
+    /// Seconds in sample generation: the phases whose names start with `sampler`.
+    pub fn sampler_seconds(&self) -> f64 {
+        self.phases.iter().filter(|r| r.name.starts_with("sampler")).map(|r| r.seconds).sum()
+    }
+
+    /// Fraction of the profiled time in sample generation.
+    pub fn sampler_share(&self) -> f64 {
+        self.sampler_seconds() / self.total_seconds.max(1e-12)
+    }
+
+    /// Nanoseconds of sample generation per camera sample.
+    pub fn sampler_ns_per_sample(&self) -> f64 {
+        self.sampler_seconds() * 1e9 / self.samples.max(1) as f64
+    }
+}
+
+/// Profiles as a stacked bar chart (one bar per `(label, profile)`, its length the profiled
+/// nanoseconds per camera sample, one segment and legend entry per phase in table order).
+pub fn profile_svg(entries: &[(&str, &Profile)], title: &str) -> String {
+    let names: Vec<&str> = PHASES.iter().map(|p| p.name()).collect();
+    let bars: Vec<crate::report::Bar> = entries
+        .iter()
+        .map(|(label, p)| {
+            let ns = p.total_seconds * 1e9 / p.samples.max(1) as f64;
+            crate::report::Bar {
+                label: label.to_string(),
+                total: ns,
+                total_label: format!("{ns:.0} ns/sample, sampler {:.1}%", 100.0 * p.sampler_share()),
+                shares: names.iter().map(|n| p.phases.iter().find(|r| r.name == *n).map_or(0.0, |r| r.share)).collect(),
+            }
+        })
+        .collect();
+    crate::report::stacked_bars_svg(&bars, &names, title)
+}
+
+/// Writes `text` to `path` atomically (a profile's JSON or SVG).
+pub fn write_text(path: &std::path::Path, text: &str) -> Result<(), SessionError> {
+    film::write_atomic(path, text.as_bytes())
+        .map_err(|source| SessionError::Output { path: path.to_path_buf(), source })
 }
 
 fn render_once(
@@ -91,37 +175,12 @@ pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, Sess
         }
     }
     let (off, on) = (off.unwrap_or_default(), on.unwrap_or_default());
-    let samples = u64::from(scene.desc.width) * u64::from(scene.desc.height) * u64::from(integrator.spp);
-    let rays = on.counters.total_rays();
-    let total = on.profiled_ns as f64 * 1e-9;
-    let phases: Vec<PhaseRow> = PHASES
-        .iter()
-        .map(|&p| {
-            let s = on.phase_ns[p as usize] as f64 * 1e-9;
-            PhaseRow {
-                name: p.name().to_string(),
-                seconds: s,
-                share: s / total.max(1e-12),
-                ns_per_sample: s * 1e9 / samples.max(1) as f64,
-                ns_per_ray: s * 1e9 / rays.max(1) as f64,
-            }
-        })
-        .collect();
-    let sum: f64 = phases.iter().map(|p| p.seconds).sum();
-    Ok(Profile {
-        scene: scene.desc.source.display().to_string(),
-        total_seconds: total,
-        phase_sum_ratio: sum / total.max(1e-12),
-        phases,
-        cpu_seconds_profiled: on.cpu_seconds,
-        cpu_seconds_unprofiled: off.cpu_seconds,
-        overhead: on.cpu_seconds / off.cpu_seconds.max(1e-12) - 1.0,
-        bit_identical,
-        samples,
-        rays,
-        threads: on.threads,
-        repeats,
-    })
+    let mut p = Profile::from_stats(&scene.desc.source.display().to_string(), &on);
+    p.cpu_seconds_unprofiled = Some(off.cpu_seconds);
+    p.overhead = Some(on.cpu_seconds / off.cpu_seconds.max(1e-12) - 1.0);
+    p.bit_identical = Some(bit_identical);
+    p.repeats = repeats;
+    Ok(p)
 }
 
 fn bits(img: &[[f32; 3]]) -> Vec<u32> {
@@ -131,7 +190,7 @@ fn bits(img: &[[f32; 3]]) -> Vec<u32> {
 /// The phase table `strata profile` prints.
 pub fn profile_table(p: &Profile) -> String {
     let mut s = format!(
-        "{}: {} samples, {} rays, {} threads, {:.3} s in tiles (worker threads)\n",
+        "{}: {} samples, {} rays, {} threads, {:.3} s profiled (worker threads in tiles, film merge, output)\n",
         p.scene, p.samples, p.rays, p.threads, p.total_seconds
     );
     s += &format!("{:<44} {:>9} {:>7} {:>10} {:>9}\n", "phase", "seconds", "%", "ns/sample", "ns/ray");
@@ -145,16 +204,23 @@ pub fn profile_table(p: &Profile) -> String {
             r.ns_per_ray
         );
     }
-    let sampler: f64 = p.phases.iter().filter(|r| r.name.starts_with("sampler")).map(|r| r.share).sum();
     s += &format!(
-        "sampler total {:.1}%; phases sum to {:.2}% of the total; overhead {:+.1}% (CPU {:.3} s profiled vs {:.3} s off, best of {}); image {}",
-        100.0 * sampler,
-        100.0 * p.phase_sum_ratio,
-        100.0 * p.overhead,
-        p.cpu_seconds_profiled,
-        p.cpu_seconds_unprofiled,
-        p.repeats,
-        if p.bit_identical { "bit-identical with profiling off" } else { "DIFFERS with profiling off" }
+        "sampler total {:.1}% ({:.1} ns/sample); phases sum to {:.2}% of the total",
+        100.0 * p.sampler_share(),
+        p.sampler_ns_per_sample(),
+        100.0 * p.phase_sum_ratio
     );
+    if let (Some(overhead), Some(off)) = (p.overhead, p.cpu_seconds_unprofiled) {
+        s += &format!(
+            "; overhead {:+.1}% (CPU {:.3} s profiled vs {:.3} s off, best of {})",
+            100.0 * overhead,
+            p.cpu_seconds_profiled,
+            off,
+            p.repeats
+        );
+    }
+    if let Some(same) = p.bit_identical {
+        s += if same { "; image bit-identical with profiling off" } else { "; image DIFFERS with profiling off" };
+    }
     s
 }
