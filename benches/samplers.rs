@@ -253,7 +253,7 @@ fn equal_time(c: &mut Criterion) {
         }
         let r = &reference.as_ref().unwrap().1;
         let (imgs, _) = strata::lab::experiments::runs(opts, *spp, 8).unwrap();
-        let st = strata::lab::experiments::stats(&imgs, &r.rgb, &r.var, r.gamma, secs, *spp);
+        let st = strata::lab::experiments::run_stats(&imgs, r).unwrap();
         let vs = st.variance * secs;
         if first.map(|f| f.0) != Some(*table) {
             first = Some((table, vs));

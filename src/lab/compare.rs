@@ -127,7 +127,7 @@ pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, La
     let json = serde_json::to_string_pretty(&report::to_json(rows))?;
     let mut series: Vec<Series> = Vec::new();
     for r in rows {
-        let p = (r.seconds, r.mse.sqrt());
+        let p = (r.seconds, r.stats.mse.sqrt());
         match series.iter_mut().find(|s| s.name == r.variant) {
             Some(s) => s.points.push(p),
             None => series.push(Series { name: r.variant.clone(), points: vec![p] }),

@@ -16,12 +16,11 @@
 use super::{io_err, LabError};
 use crate::film::{self, Film};
 use crate::render;
-use crate::report::contact;
-pub use crate::report::runs::{g3, markdown, stats, Row, Stats};
-use crate::report::{self, Series};
+use crate::report::{self, contact, g3, markdown_table, ReferenceInfo, ReportError, Row, RunStats, Series, Style};
 use crate::sampler::SamplerKind;
 use crate::scene::desc::ImportanceSampling;
 use crate::session::{self, RenderOptions};
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Sizes and counts of one run of the experiments.
@@ -127,6 +126,25 @@ pub fn reference_spp(opts: &RenderOptions) -> Result<Reference, LabError> {
     Ok(Reference { rgb: f.mean(), var: f.variance_of_mean(), gamma, size: (f.width, f.height), seconds: t })
 }
 
+/// The statistics of K runs against a reference, with its own variance and gamma (the 8-bit
+/// statistics are on that gamma).
+pub fn run_stats(images: &[Vec<[f32; 3]>], reference: &Reference) -> Result<RunStats, ReportError> {
+    let info = ReferenceInfo { variance: Some(&reference.var), gamma: Some(reference.gamma) };
+    RunStats::against(images, &reference.rgb, info)
+}
+
+/// The row of `variant`: K runs at `spp`, `seconds` per run, against `reference`.
+fn measure(variant: &str, images: &Images, reference: &Reference, seconds: f64, spp: u32) -> Result<Row, LabError> {
+    let stats =
+        run_stats(images, reference).map_err(|source| LabError::VariantStats { variant: variant.into(), source })?;
+    Ok(Row::new(variant, seconds, f64::from(spp), &stats)?)
+}
+
+/// The variance of the 8-bit values of a row (computed for every row of the experiments).
+fn variance_8bit(row: &Row) -> f64 {
+    row.stats.eight_bit.map_or(f64::NAN, |e| e.variance)
+}
+
 fn scene_opts(cfg: &Config, rel: &str, aspect: f64) -> RenderOptions {
     let h = ((f64::from(cfg.width) / aspect).round() as u32).max(1);
     RenderOptions {
@@ -186,7 +204,7 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
                 log(cfg, &format!("direct {name}: {label} x{n}, {} runs", cfg.runs));
                 let o = RenderOptions { light_sampler: Some(kind), light_samples: Some(n), ..base.clone() };
                 let (imgs, secs) = runs(&o, 1, cfg.runs)?;
-                let st = stats(&imgs, &reference.rgb, &reference.var, reference.gamma, secs, 1);
+                let st = measure(label, &imgs, &reference, secs, 1)?.grouped("direct", name, format!("{n}"));
                 tiles.push(contact::tile_from_linear(
                     w,
                     h,
@@ -195,23 +213,17 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
                     reference.gamma,
                     vec![
                         format!("{} {n}", label.replace("grid-center", "grid-ctr")),
-                        format!("v8 {}", g3(st.variance_8bit)),
-                        format!("rb {}", g3(st.rms_bias)),
+                        format!("v8 {}", g3(variance_8bit(&st))),
+                        format!("rb {}", g3(st.stats.rms_bias)),
                     ],
                 ));
                 let sname = format!("{name} {label}");
-                let p = (f64::from(n), st.mse.sqrt());
+                let p = (f64::from(n), st.stats.mse.sqrt());
                 match series.iter_mut().find(|s| s.name == sname) {
                     Some(s) => s.points.push(p),
                     None => series.push(Series { name: sname, points: vec![p] }),
                 }
-                rows.push(Row {
-                    table: "direct".into(),
-                    scene: name.into(),
-                    variant: label.into(),
-                    setting: format!("{n}"),
-                    stats: st,
-                });
+                rows.push(st);
             }
         }
         let sheet =
@@ -323,7 +335,7 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             vec!["reference".into(), format!("{} spp", cfg.ref_spp)],
         )];
         let mut series = Vec::new();
-        let mut main: Vec<Stats> = Vec::new();
+        let mut main: Vec<Row> = Vec::new();
         for (label, o) in &case.variants {
             let spp = case.spp;
             let mut ladder: Vec<u32> = case.ladder.iter().copied().chain(std::iter::once(spp)).collect();
@@ -333,8 +345,8 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             for s in ladder {
                 log(cfg, &format!("path {}: {label} {s} spp, {} runs", case.key, cfg.runs));
                 let (imgs, secs) = runs(o, s, cfg.runs)?;
-                let st = stats(&imgs, &reference.rgb, &reference.var, reference.gamma, secs, s);
-                points.push((secs, st.mse.sqrt()));
+                let st = measure(label, &imgs, reference, secs, s)?;
+                points.push((secs, st.stats.mse.sqrt()));
                 if s == spp {
                     tiles.push(contact::tile_from_linear(
                         w,
@@ -342,37 +354,34 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
                         &imgs[0],
                         cfg.sheet_factor,
                         reference.gamma,
-                        vec![format!("{label} {s}"), format!("var {}", g3(st.variance)), format!("z {:.2}", st.z)],
+                        vec![
+                            format!("{label} {s}"),
+                            format!("var {}", g3(st.stats.variance)),
+                            format!("z {:.2}", st.stats.z),
+                        ],
                     ));
                     main.push(st);
                 }
             }
             series.push(Series { name: (*label).into(), points });
         }
-        for ((label, _), st) in case.variants.iter().zip(&main) {
-            rows.push(Row {
-                table: case.key.into(),
-                scene: case.scene.into(),
-                variant: (*label).into(),
-                setting: "equal spp".into(),
-                stats: st.clone(),
-            });
+        for st in &main {
+            rows.push(st.clone().grouped(case.key, case.scene, "equal spp"));
         }
         // Equal time: the faster technique gets the spp that costs what the slower one spent.
-        let (ta, tb) = (main[0].seconds / f64::from(main[0].spp), main[1].seconds / f64::from(main[1].spp));
+        let (ta, tb) = (main[0].seconds / main[0].spp, main[1].seconds / main[1].spp);
         let (fast, slow) = if ta <= tb { (0, 1) } else { (1, 0) };
         let budget = main[slow].seconds;
-        let per_spp = main[fast].seconds / f64::from(main[fast].spp);
+        let per_spp = main[fast].seconds / main[fast].spp;
         let eq_spp = ((budget / per_spp).round() as u32).max(1);
         let (label, o) = &case.variants[fast];
         log(cfg, &format!("path {}: equal time, {label} at {eq_spp} spp", case.key));
-        let (imgs, secs) =
-            if eq_spp == main[fast].spp { (Vec::new(), main[fast].seconds) } else { runs(o, eq_spp, cfg.runs)? };
-        let st = if imgs.is_empty() {
-            main[fast].clone()
+        let (imgs, secs) = if f64::from(eq_spp) == main[fast].spp {
+            (Vec::new(), main[fast].seconds)
         } else {
-            stats(&imgs, &reference.rgb, &reference.var, reference.gamma, secs, eq_spp)
+            runs(o, eq_spp, cfg.runs)?
         };
+        let st = if imgs.is_empty() { main[fast].clone() } else { measure(label, &imgs, reference, secs, eq_spp)? };
         if !imgs.is_empty() {
             tiles.push(contact::tile_from_linear(
                 w,
@@ -380,24 +389,11 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
                 &imgs[0],
                 cfg.sheet_factor,
                 reference.gamma,
-                vec![format!("{label} {eq_spp}"), "equal time".into(), format!("var {}", g3(st.variance))],
+                vec![format!("{label} {eq_spp}"), "equal time".into(), format!("var {}", g3(st.stats.variance))],
             ));
         }
-        let (sl, _) = &case.variants[slow];
-        rows.push(Row {
-            table: case.key.into(),
-            scene: case.scene.into(),
-            variant: (*sl).into(),
-            setting: "equal time".into(),
-            stats: main[slow].clone(),
-        });
-        rows.push(Row {
-            table: case.key.into(),
-            scene: case.scene.into(),
-            variant: (*label).into(),
-            setting: "equal time".into(),
-            stats: st,
-        });
+        rows.push(main[slow].clone().grouped(case.key, case.scene, "equal time"));
+        rows.push(st.grouped(case.key, case.scene, "equal time"));
         let sheet =
             contact::layout(&tiles, tiles.len(), Some(&format!("{}: {}, K={}", case.scene, case.title, cfg.runs)));
         let p = cfg.out.join(format!("path-{}.png", case.key));
@@ -428,12 +424,67 @@ pub fn run(cfg: &Config) -> Result<String, LabError> {
     let mut rows = direct(cfg)?;
     rows.extend(path(cfg)?);
     let md = markdown(&rows, cfg.runs, cfg.width, cfg.sheet_factor);
-    let json = serde_json::to_string_pretty(&rows)?;
+    let json = serde_json::to_string_pretty(&report::to_grouped_json(&rows))?;
     for (name, text) in [("results.md", &md), ("results.json", &json)] {
         let p: PathBuf = cfg.out.join(name);
         film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
     }
     Ok(md)
+}
+
+/// `results.md`: the Markdown tables of `rows` (K = `runs`, images `width` wide, sheets
+/// downsampled by `sheet_factor`), one per (table, scene, setting group), with ratios to the first
+/// row of each ([`report::table::EXPERIMENT_COLUMNS`]).
+pub fn markdown(rows: &[Row], runs: usize, width: u32, sheet_factor: u32) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Seed experiments (generated)\n\nRegenerate with `strata experiments` (see docs/experiments/README.md). K = {} runs per \
+         variant, images {} pixels wide. `var` is the across-run variance of a pixel value (mean over pixels and channels) in \
+         linear radiance, `var8` the same on the 8-bit gamma-encoded values 0..255; `MSE` against the reference (linear), `MSE8` the same in 8-bit units; `bias` \
+         the mean signed error with its standard error `se` (runs' spread plus the reference's own noise) and `z = bias/se`; \
+         `rms bias` the root mean squared per-pixel bias with the noise removed; `b-ratio = mean (m-r)^2 / mean (s^2/K + \
+         var_ref)`, about 1 when unbiased; `eff = 1/(MSE x s)`; ratios are to the first row of each block. Seconds are wall \
+         clock on a shared machine.\n",
+        runs, width
+    );
+    let (mut i, mut shown) = (0, Vec::<String>::new());
+    while i < rows.len() {
+        let r0 = &rows[i];
+        let group = |r: &Row| (r.table.clone(), r.scene.clone(), r.setting.clone());
+        let g0 = group(r0);
+        let mut j = i;
+        while j < rows.len() && group(&rows[j]) == g0 {
+            j += 1;
+        }
+        let (head, sheet) = if r0.table == "direct" {
+            (
+                format!("## Direct lighting, hw2 {}, {} light samples", r0.scene, r0.setting),
+                format!("direct-{}.png", r0.scene),
+            )
+        } else {
+            (format!("## {} `{}`, {}", r0.scene, r0.table, r0.setting), format!("path-{}.png", r0.table))
+        };
+        let _ = writeln!(md, "{head}\n");
+        if !shown.contains(&sheet) {
+            let caption = if r0.table == "direct" {
+                "Tiles: the reference, then run 1 of random, stratified, grid-center, halton; top row 9, bottom row 25 light \
+                 samples (`v8` = var8, `rb` = rms bias)."
+            } else {
+                "Tiles: the reference, then run 1 of each technique at equal spp, then the faster one at equal time."
+            };
+            let _ = writeln!(
+                md,
+                "![{sheet}]({sheet})\n\n{caption} Images box-downsampled by {} for the sheet.\n",
+                sheet_factor
+            );
+            shown.push(sheet);
+        }
+        md += &markdown_table(report::table::EXPERIMENT_COLUMNS, &rows[i..j], Style::Plain);
+        md.push('\n');
+        i = j;
+    }
+    md
 }
 
 /// `Path` of the corpus beside the crate or in `$STRATA_CSE168`.

@@ -5,6 +5,7 @@
 //! so a returned metric is always a finite number.
 
 use super::ReportError;
+use crate::film;
 use serde::Serialize;
 
 /// The offset in the relative MSE's denominator, as in pbrt: `(v - r)^2 / (r + REL_EPS)^2`.
@@ -42,17 +43,44 @@ pub fn efficiency(mse: f64, seconds: f64) -> Result<f64, ReportError> {
     Ok(if cost == 0.0 { f64::INFINITY } else { 1.0 / cost })
 }
 
-/// Statistics of K >= 2 independent runs of one technique against a reference.
+/// What is known of a reference besides its pixels, for [`RunStats::against`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ReferenceInfo<'a> {
+    /// per-value variance of the reference itself (its own noise); `None`: the reference is exact
+    pub variance: Option<&'a [[f32; 3]]>,
+    /// the PNG gamma: also compute the statistics of the 8-bit gamma-encoded values (what a PNG
+    /// shows); `None`: skip them
+    pub gamma: Option<f32>,
+}
+
+/// Error statistics of the 8-bit gamma-encoded values 0..255 (see [`RunStats::eight_bit`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EightBit {
+    /// mean over values of the unbiased across-run variance, in 8-bit units
+    pub variance: f64,
+    /// mean over runs of each run's MSE, in 8-bit units
+    pub mse: f64,
+}
+
+/// Statistics of K >= 2 independent runs of one technique against a reference: the one set of
+/// run statistics of `strata compare` and `strata experiments`.
 ///
 /// With values `x[k][i]` (run k, value i over all pixels and channels, M values), reference
-/// `r[i]`, across-run mean `m[i] = mean_k x[k][i]` and per-run mean error `e[k] = mean_i (x[k][i] - r[i])`:
+/// `r[i]` with its own per-value variance `v[i]` (0 for an exact reference), across-run mean
+/// `m[i] = mean_k x[k][i]` and per-run mean error `e[k] = mean_i (x[k][i] - r[i])`:
 /// - `bias = mean_i (m[i] - r[i]) = mean_k e[k]` (signed; errors of opposite sign cancel),
-/// - `bias_se = sqrt(s_e^2 / K)` with `s_e^2 = sum_k (e[k] - bias)^2 / (K - 1)`,
+/// - `bias_se = sqrt(s_e^2 / K + sum_i v[i] / M^2)` with `s_e^2 = sum_k (e[k] - bias)^2 / (K - 1)`
+///   (the runs' spread plus the reference's own noise, independent across values),
 /// - `bias_ci = bias -/+ t(0.975, K - 1) * bias_se` (two-sided 95%, Student t),
+/// - `z = bias / bias_se` (`+-inf` for a non-zero bias with no spread, 0 for none),
 /// - `variance = mean_i s[i]^2` with the unbiased `s[i]^2 = sum_k (x[k][i] - m[i])^2 / (K - 1)`,
 /// - `mse = mean_k mse(x[k], r)`, `rel_mse = mean_k rel_mse(x[k], r)`,
 /// - `bias_sq = mean_i (m[i] - r[i])^2 - variance / K`, the unbiased estimate of the mean squared
-///   per-value bias (it can come out slightly negative when the bias is small next to the noise).
+///   per-value bias (it can come out slightly negative when the bias is small next to the noise),
+/// - `rms_bias = sqrt(max(0, mean_i (m[i] - r[i])^2 - variance / K - mean_i v[i]))`, the root mean
+///   squared per-value bias with the noise of the runs and of the reference removed,
+/// - `bias_ratio = mean_i (m[i] - r[i])^2 / (variance / K + mean_i v[i])`: about 1 for an
+///   unbiased technique (infinite when the denominator is 0).
 ///
 /// Algebraically `mse = bias_sq + variance` exactly (per value,
 /// `mean_k (x - r)^2 = (m - r)^2 + (K - 1)/K * s^2`); [`RunStats::decomposition_residual`]
@@ -63,23 +91,38 @@ pub struct RunStats {
     pub runs: usize,
     /// mean signed error of the mean image
     pub bias: f64,
-    /// standard error of `bias`, from the spread of the per-run mean errors
+    /// standard error of `bias`: the spread of the per-run mean errors and the reference's noise
     pub bias_se: f64,
     /// two-sided 95% confidence interval of `bias`
     pub bias_ci: (f64, f64),
+    /// `bias / bias_se`
+    pub z: f64,
     /// unbiased estimate of the mean squared per-value bias
     pub bias_sq: f64,
+    /// root mean squared per-value bias, the noise of runs and reference removed
+    pub rms_bias: f64,
+    /// mean squared error of the mean image over the variance it would have without bias
+    pub bias_ratio: f64,
     /// mean over values of the unbiased across-run variance
     pub variance: f64,
     /// mean over runs of each run's MSE
     pub mse: f64,
     /// mean over runs of each run's relative MSE
     pub rel_mse: f64,
+    /// the variance and MSE of the 8-bit gamma-encoded values, when a gamma was given
+    pub eight_bit: Option<EightBit>,
 }
 
 impl RunStats {
-    /// Computes the statistics of `runs` (K >= 2 images) against `reference`; see [`RunStats`].
+    /// Computes the statistics of `runs` (K >= 2 images) against an exact `reference`; see
+    /// [`RunStats`].
     pub fn from_runs(runs: &[Vec<[f32; 3]>], reference: &[[f32; 3]]) -> Result<Self, ReportError> {
+        Self::against(runs, reference, ReferenceInfo::default())
+    }
+
+    /// Computes the statistics of `runs` (K >= 2 images) against `reference`, with what `info`
+    /// knows of it (its own per-value variance, a gamma for the 8-bit statistics); see [`RunStats`].
+    pub fn against(runs: &[Vec<[f32; 3]>], reference: &[[f32; 3]], info: ReferenceInfo) -> Result<Self, ReportError> {
         let k = runs.len();
         if k < 2 {
             return Err(ReportError::TooFewRuns(k));
@@ -88,31 +131,57 @@ impl RunStats {
         for (i, run) in runs.iter().enumerate() {
             check_image(run, &format!("run {i}"), reference.len())?;
         }
+        if let Some(v) = info.variance {
+            check_image(v, "reference variance", reference.len())?;
+        }
         let kf = k as f64;
         let per_run: Vec<ErrorMeans> = runs.iter().map(|run| error_means(run, reference)).collect();
         let over_runs = |f: fn(&ErrorMeans) -> f64| per_run.iter().map(f).sum::<f64>() / kf;
         let bias = over_runs(|e| e.err);
         let spread = per_run.iter().map(|e| (e.err - bias).powi(2)).sum::<f64>() / (kf - 1.0);
 
-        let (mut mean_sq_err, mut var_sum) = (0.0, 0.0);
+        let (mut mean_sq_err, mut var_sum, mut ref_var) = (0.0, 0.0, 0.0);
+        let (mut var8_sum, mut sq8_sum) = (0.0, 0.0);
         for (i, px) in reference.iter().enumerate() {
             for (c, &r) in px.iter().enumerate() {
                 let mean = runs.iter().map(|run| run[i][c] as f64).sum::<f64>() / kf;
                 var_sum += runs.iter().map(|run| (run[i][c] as f64 - mean).powi(2)).sum::<f64>();
                 mean_sq_err += (mean - r as f64).powi(2);
+                if let Some(v) = info.variance {
+                    ref_var += f64::from(v[i][c]);
+                }
+                if let Some(gamma) = info.gamma {
+                    let q = |v: f32| f64::from(film::to_u8(v, gamma));
+                    let mean8 = runs.iter().map(|run| q(run[i][c])).sum::<f64>() / kf;
+                    var8_sum += runs.iter().map(|run| (q(run[i][c]) - mean8).powi(2)).sum::<f64>();
+                    sq8_sum += runs.iter().map(|run| (q(run[i][c]) - q(r)).powi(2)).sum::<f64>();
+                }
             }
         }
         let m = 3.0 * reference.len() as f64;
         let variance = var_sum / (kf - 1.0) / m;
+        // Values' reference errors are independent: the variance of their mean is sum v / M^2.
+        let bias_se = (spread / kf + ref_var / (m * m)).sqrt();
+        let noise = variance / kf + ref_var / m;
         let mut stats = RunStats {
             runs: k,
             bias,
-            bias_se: (spread / kf).sqrt(),
+            bias_se,
             bias_ci: (bias, bias),
+            z: if bias_se > 0.0 {
+                bias / bias_se
+            } else if bias == 0.0 {
+                0.0
+            } else {
+                f64::INFINITY.copysign(bias)
+            },
             bias_sq: mean_sq_err / m - variance / kf,
+            rms_bias: (mean_sq_err / m - noise).max(0.0).sqrt(),
+            bias_ratio: if noise > 0.0 { mean_sq_err / m / noise } else { f64::INFINITY },
             variance,
             mse: over_runs(|e| e.sq),
             rel_mse: over_runs(|e| e.rel),
+            eight_bit: info.gamma.map(|_| EightBit { variance: var8_sum / (kf - 1.0) / m, mse: sq8_sum / kf / m }),
         };
         stats.bias_ci = stats.bias_ci_at(0.95);
         Ok(stats)
@@ -310,6 +379,48 @@ mod tests {
             assert!(close(st.bias_ci.0, b - half, 1e-9) && close(st.bias_ci.1, b + half, 1e-9));
             assert!(st.bias_ci.0 < b && b < st.bias_ci.1);
         }
+    }
+
+    #[test]
+    fn reference_noise_and_eight_bit_statistics_have_the_known_answers() {
+        let r = vec![[0.25f32, 0.5, 0.75]; 6];
+        let zero = vec![[0.0f32; 3]; 6];
+        fn with(var: &[[f32; 3]]) -> ReferenceInfo<'_> {
+            ReferenceInfo { variance: Some(var), gamma: Some(1.0) }
+        }
+        // Two runs at r - d and r + d: no bias, per-value variance 2 d^2, MSE d^2.
+        let d = 0.125f32;
+        let runs: Vec<Vec<[f32; 3]>> =
+            vec![r.iter().map(|p| p.map(|v| v - d)).collect(), r.iter().map(|p| p.map(|v| v + d)).collect()];
+        let s = RunStats::against(&runs, &r, with(&zero)).unwrap();
+        assert_eq!(s.runs, 2);
+        assert!((s.variance - 2.0 * f64::from(d * d)).abs() < 1e-12, "{}", s.variance);
+        assert!((s.mse - f64::from(d * d)).abs() < 1e-12);
+        assert_eq!((s.bias, s.z, s.rms_bias), (0.0, 0.0, 0.0));
+        // 8-bit (gamma 1, x 255, rounded): 0.125/0.375 -> 32/96, 0.375/0.625 -> 96/159,
+        // 0.625/0.875 -> 159/223; variance (a - b)^2 / 2 per channel.
+        let want = (64.0f64.powi(2) + 63.0f64.powi(2) + 64.0f64.powi(2)) / 2.0 / 3.0;
+        let e = s.eight_bit.unwrap();
+        assert!((e.variance - want).abs() < 1e-9, "{} vs {want}", e.variance);
+        assert!(RunStats::from_runs(&runs, &r).unwrap().eight_bit.is_none());
+        // Identical runs offset by b: zero variance, all error is bias, z infinite.
+        let b = 0.0625f32;
+        let off: Vec<[f32; 3]> = r.iter().map(|p| p.map(|v| v + b)).collect();
+        let s = RunStats::against(&[off.clone(), off.clone(), off], &r, with(&zero)).unwrap();
+        assert_eq!(s.variance, 0.0);
+        assert!((s.bias - f64::from(b)).abs() < 1e-12 && (s.rms_bias - f64::from(b)).abs() < 1e-9);
+        assert_eq!((s.z, s.bias_ratio), (f64::INFINITY, f64::INFINITY));
+        // The reference's own variance enters the standard error: M = 18 values of variance v
+        // give a mean with variance v / 18.
+        let v = 0.02f32;
+        let noisy = vec![[v; 3]; 6];
+        let runs: Vec<Vec<[f32; 3]>> = vec![r.clone(), r.clone()];
+        let s = RunStats::against(&runs, &r, with(&noisy)).unwrap();
+        assert!((s.bias_se - (f64::from(v) / 18.0).sqrt()).abs() < 1e-9, "{}", s.bias_se);
+        assert!(s.bias_ratio < 1e-12, "no error at all: ratio 0");
+        // A reference variance of the wrong size is an error, not a panic.
+        let e = RunStats::against(&runs, &r, with(&noisy[..5])).unwrap_err();
+        assert_eq!(e.to_string(), "size mismatch: reference variance has 5 pixels but the reference has 6");
     }
 
     #[test]

@@ -3,9 +3,12 @@
 //! Pure functions on images; nothing here renders. An image is linear RGB, row-major,
 //! `&[[f32; 3]]`, and every image compared with a reference must have the reference's pixel count.
 //!
-//! - [`metrics`]: MSE, relative MSE, statistics over K independent runs (bias with a Student-t
-//!   confidence interval, variance, the MSE decomposition) and efficiency.
-//! - [`table`]: one [`table::Row`] per variant, written as CSV, JSON or a Markdown table.
+//! - [`metrics`]: MSE, relative MSE, statistics over K independent runs ([`RunStats`]: bias with
+//!   its standard error, z and a Student-t confidence interval, variance, the MSE decomposition,
+//!   noise-corrected rms bias; optionally against a noisy reference and on 8-bit values) and
+//!   efficiency: the one statistics code path of `strata compare` and `strata experiments`.
+//! - [`table`]: one [`table::Row`] per variant and setting, and the one table writer (Markdown,
+//!   CSV, JSON) over column lists, for both commands.
 //! - [`plot`]: a self-contained log-log SVG of error against time with a convergence-rate guide.
 //! - [`bars`]: a stacked bar chart SVG (the phases of `strata profile`, one bar per variant).
 
@@ -13,13 +16,12 @@ pub mod bars;
 pub mod contact;
 pub mod metrics;
 pub mod plot;
-pub mod runs;
 pub mod table;
 
 pub use bars::{stacked_bars_svg, Bar};
-pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, RunStats};
+pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, EightBit, ReferenceInfo, RunStats};
 pub use plot::{loglog_svg, LogScale, Series};
-pub use table::{to_csv, to_json, to_markdown, Row};
+pub use table::{g3, markdown_table, to_csv, to_grouped_json, to_json, to_markdown, Column, Row, Style};
 
 use std::fmt;
 

@@ -18,6 +18,10 @@ const TAG_HALTON: u32 = 0x51a7_0003;
 #[derive(Clone, Copy, Debug)]
 pub struct Halton;
 
+/// Its entry in the registry [`super::SAMPLERS`].
+pub(super) const INFO: super::SamplerInfo =
+    super::SamplerInfo::new("halton", &[], "Owen-scrambled Halton (bases 2, 3)", &Halton).period(1 << 24);
+
 impl Layout for Halton {
     #[inline]
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {

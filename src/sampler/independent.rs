@@ -10,6 +10,10 @@ const TAG_INDEPENDENT: u32 = 0x51a7_0001;
 #[derive(Clone, Copy, Debug)]
 pub struct Independent;
 
+/// Its entry in the registry [`super::SAMPLERS`].
+pub(super) const INFO: super::SamplerInfo =
+    super::SamplerInfo::new("independent", &["random"], "independent uniform points", &Independent).note("random");
+
 impl Layout for Independent {
     #[inline]
     fn point<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {

@@ -6,8 +6,9 @@
 //! fresh, independent set. Nothing depends on thread count, tile order or call order, so renders
 //! are bit-identical however they are scheduled.
 //!
-//! Layouts: each is one file implementing [`Layout`] and one line of [`SAMPLERS`], the registry
-//! that the `.test` parser, the CLI (`--pixel-sampler`, `--light-sampler`, their help text) and the
+//! Layouts: each is one file implementing [`Layout`] and exporting its `SamplerInfo` const(s),
+//! plus one line of the `registry!` list here (which declares the module and adds its entries to
+//! [`SAMPLERS`]), the registry that the `.test` parser, the CLI (`--pixel-sampler`, `--light-sampler`, their help text) and the
 //! tests read; [`SamplerKind`] is a handle into it. Stratification is across `k` *within one set*:
 //! to stratify the camera jitter over a pixel's spp samples, call with `n = spp, k = s,
 //! sample = 0`. Sequence layouts (halton, sobol, pmj02) use the global index `sample * n + k`.
@@ -32,13 +33,6 @@ mod lanes;
 mod layout;
 mod permute;
 
-mod halton;
-mod independent;
-pub mod pmj;
-pub mod sobol;
-mod stratified;
-mod zsobol;
-
 pub use grid::strata_shape;
 pub use halton::radical_inverse;
 pub use lanes::Lanes;
@@ -52,29 +46,26 @@ use hash::{hash, unit};
 // The registry: one line per layout
 // ------------------------------------------------------------------------------------------------
 
-/// Every sampler, in the order the CLI lists them. A name or alias is spelled only here.
-pub const SAMPLERS: &[SamplerInfo] = &[
-    SamplerInfo::new("independent", &["random"], "independent uniform points", &independent::Independent)
-        .note("random"),
-    SamplerInfo::new(
-        "stratified",
-        &["jittered"],
-        "one jittered point per strata cell",
-        &stratified::Stratified { jitter: true },
-    ),
-    SamplerInfo::new(
-        "grid-center",
-        &["grid", "center"],
-        "strata cell centres",
-        &stratified::Stratified { jitter: false },
-    )
-    .biased(),
-    SamplerInfo::new("halton", &[], "Owen-scrambled Halton (bases 2, 3)", &halton::Halton).period(1 << 24),
-    SamplerInfo::new("sobol", &[], "Owen-scrambled Sobol'", &sobol::Sobol).period(1 << 32),
-    SamplerInfo::new("pmj02", &["pmj"], "progressive multi-jittered (0,2)", &pmj::Pmj02)
-        .period(pmj::TABLE_POINTS as u64),
-    SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &zsobol::ZSobol),
-];
+/// Declares the layout modules and lists their registry entries ([`SAMPLERS`]), in this order:
+/// `MODULE: [ENTRY, ...]` names the module's `SamplerInfo` consts.
+macro_rules! registry {
+    ($($vis:vis $module:ident: [$($entry:ident),+]),+ $(,)?) => {
+        $($vis mod $module;)+
+
+        /// Every sampler, in the order the CLI lists them. A name or alias is spelled only in its
+        /// layout's file (its `SamplerInfo` const).
+        pub const SAMPLERS: &[SamplerInfo] = &[$($($module::$entry),+),+];
+    };
+}
+
+registry! {
+    independent: [INFO],
+    stratified: [JITTERED, CENTRES],
+    halton: [INFO],
+    pub sobol: [INFO],
+    pub pmj: [INFO],
+    zsobol: [INFO],
+}
 
 /// One registered sampler: its names, what it declares about itself, and its layout.
 pub struct SamplerInfo {

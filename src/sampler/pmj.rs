@@ -58,6 +58,10 @@ const TAG_TABLE: u32 = 0x50b0_1004;
 #[derive(Clone, Copy, Debug)]
 pub struct Pmj02;
 
+/// Its entry in the registry [`super::SAMPLERS`].
+pub(super) const INFO: super::SamplerInfo =
+    super::SamplerInfo::new("pmj02", &["pmj"], "progressive multi-jittered (0,2)", &Pmj02).period(TABLE_POINTS as u64);
+
 impl Layout for Pmj02 {
     #[inline]
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {

@@ -64,6 +64,10 @@ const TAG_SOBOL: u32 = 0x50b0_1002;
 #[derive(Clone, Copy, Debug)]
 pub struct Sobol;
 
+/// Its entry in the registry [`super::SAMPLERS`].
+pub(super) const INFO: super::SamplerInfo =
+    super::SamplerInfo::new("sobol", &[], "Owen-scrambled Sobol'", &Sobol).period(1 << 32);
+
 impl Layout for Sobol {
     #[inline]
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {

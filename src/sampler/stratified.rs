@@ -20,6 +20,19 @@ pub struct Stratified {
     pub jitter: bool,
 }
 
+/// Its registry entry as jittered strata (see [`super::SAMPLERS`]).
+pub(super) const JITTERED: super::SamplerInfo = super::SamplerInfo::new(
+    "stratified",
+    &["jittered"],
+    "one jittered point per strata cell",
+    &Stratified { jitter: true },
+);
+
+/// Its registry entry as strata cell centres (see [`super::SAMPLERS`]).
+pub(super) const CENTRES: super::SamplerInfo =
+    super::SamplerInfo::new("grid-center", &["grid", "center"], "strata cell centres", &Stratified { jitter: false })
+        .biased();
+
 /// Point in the 24-bit fixed-point span `[x lo, x hi, y lo, y hi]` picked by the stratified jitter
 /// hash of (pixel, sample, dim, k, seed); a zero-width span gives its lower edge.
 #[inline]

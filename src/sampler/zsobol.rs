@@ -29,6 +29,10 @@ const TAG_ZSOBOL: u32 = 0x50b0_1005;
 #[derive(Clone, Copy, Debug)]
 pub struct ZSobol;
 
+/// Its entry in the registry [`super::SAMPLERS`].
+pub(super) const INFO: super::SamplerInfo =
+    super::SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &ZSobol);
+
 /// The 24 permutations of the four quadrants, lexicographic: entry `4 p + d` is digit d under
 /// permutation p.
 const PERMS: [u32; 96] = {

@@ -155,17 +155,16 @@ pub enum BuildError {
     /// Embree refused something.
     #[error("{0}")]
     Accel(#[from] accel::AccelError),
-    /// The scene lacks something the renderer needs.
-    #[error("{0}")]
-    Invalid(String),
+    /// The scene has no `camera` command (the scene file).
+    #[error("{}: no camera command", .0.display())]
+    NoCamera(std::path::PathBuf),
 }
 
 impl Scene {
     /// Builds the scene. Quad lights become two triangles each, after the scene's triangles, then
     /// come the emissive triangles (zero-area ones are dropped: they can be neither hit nor sampled).
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
-        let cam_desc =
-            desc.camera.ok_or_else(|| BuildError::Invalid(format!("{}: no camera command", desc.source.display())))?;
+        let cam_desc = desc.camera.ok_or_else(|| BuildError::NoCamera(desc.source.clone()))?;
         let camera = Camera::new(&cam_desc, desc.width, desc.height);
         let mut materials = desc.materials.clone();
         let mut vertices = Vec::with_capacity(desc.triangles.len() * 3 + desc.quad_lights.len() * 4);

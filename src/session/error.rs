@@ -2,14 +2,19 @@
 //! it after `strata: `). Errors of the layers below are wrapped with their messages unchanged.
 
 use crate::checkpoint::CheckpointError;
+use crate::scene::build::BuildError;
+use crate::scene::error::SceneError;
 use std::path::PathBuf;
 
 /// Why a render session could not run or write its outputs.
 #[derive(Debug, thiserror::Error)]
 pub enum SessionError {
-    /// The scene could not be parsed or built (the scene layer's message).
-    #[error("{0}")]
-    Scene(String),
+    /// The scene file could not be parsed (the scene layer's `FILE:LINE: message`).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// The parsed scene could not be built (the build's message).
+    #[error(transparent)]
+    Build(#[from] BuildError),
     /// The scene file could not be read for its hash.
     #[error("{}: cannot read scene file: {source}", path.display())]
     SceneRead {
@@ -18,9 +23,13 @@ pub enum SessionError {
         /// the I/O error
         source: std::io::Error,
     },
-    /// `--camera` does not parse.
-    #[error("{0}")]
-    Camera(String),
+    /// `--camera` does not parse: the message of the `.test` parser's error for the `camera`
+    /// command it makes of the value.
+    #[error("{}", .0.message)]
+    Camera(#[source] SceneError),
+    /// `--camera` parsed without giving a camera.
+    #[error("--camera expects 10 numbers")]
+    CameraMissing,
     /// `--size` with a zero side.
     #[error("--size {w}x{h}: width and height must be positive")]
     SizeNotPositive {

@@ -18,11 +18,10 @@ fn over(flag: &'static str, value: String, max: u64, unit: &'static str, field: 
 /// Parses the scene named in `opts` (or the built-in one) and applies the size override.
 pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     let limits = opts.limits;
-    let scene_err = |e: &dyn std::fmt::Display| SessionError::Scene(e.to_string());
     let mut desc = match &opts.scene {
-        Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits).map_err(|e| scene_err(&e))?,
-        Some(p) => parse::parse_file(p, &limits).map_err(|e| scene_err(&e))?,
-        None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits).map_err(|e| scene_err(&e))?,
+        Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits)?,
+        Some(p) => parse::parse_file(p, &limits)?,
+        None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits)?,
     };
     if let Some((w, h)) = opts.size {
         if w == 0 || h == 0 {
@@ -80,9 +79,9 @@ pub fn is_obj(p: &Path) -> bool {
 pub fn parse_camera(s: &str) -> Result<CameraDesc, SessionError> {
     let text = format!("camera {}", s.replace(',', " "));
     parse::parse_str(&text, Path::new("--camera"), &Limits::default())
-        .map_err(|e| SessionError::Camera(e.message))?
+        .map_err(SessionError::Camera)?
         .camera
-        .ok_or_else(|| SessionError::Camera("--camera expects 10 numbers".to_string()))
+        .ok_or(SessionError::CameraMissing)
 }
 
 /// Parses, checks and builds the scene and the integrator of `opts`.
@@ -103,7 +102,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         ));
     }
     super::checks::check_sampler_periods(opts, &desc, spp)?;
-    let scene = Scene::build(desc).map_err(|e| SessionError::Scene(e.to_string()))?;
+    let scene = Scene::build(desc)?;
     let mut integrator =
         Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
     if opts.general_kernel {
