@@ -25,6 +25,8 @@ enum Cmd {
     Reference(RenderArgs),
     /// Compare sampling techniques against a reference: K independent runs per variant at equal spp
     /// (--spp-ladder) or equal time (--budget); writes rows.csv, rows.json, table.md, error.svg.
+    /// Seconds are the worker threads' CPU seconds; the sampler's ns/sample and share of the render
+    /// come from the phase profiler, which every run has on.
     Compare {
         /// Scene file (.test); omitted: the built-in Cornell box.
         scene: Option<PathBuf>,
@@ -38,7 +40,7 @@ enum Cmd {
         /// Independent runs per variant (seeds differ), at least 2.
         #[arg(long, default_value_t = 4)]
         runs: usize,
-        /// Equal time: seconds per run (passes of one sample until spent).
+        /// Equal time: CPU seconds of the worker threads per run (passes of one sample until spent).
         #[arg(long, conflicts_with = "spp_ladder")]
         budget: Option<f64>,
         /// Equal spp: comma-separated spp values, e.g. 1,2,4,8.

@@ -51,6 +51,13 @@ fn tiny_experiments_write_tables_sheets_and_plots() {
             }
         }
     }
+    // Every row was profiled: the sampler's cost per camera sample and its share of the render.
+    for r in rows {
+        let (ns, share) = (r["stats"]["sampler_ns_per_sample"].as_f64(), r["stats"]["sampler_share"].as_f64());
+        assert!(ns.is_some_and(|v| v > 0.0), "{r}");
+        assert!(share.is_some_and(|v| v > 0.0 && v < 1.0), "{r}");
+    }
+    assert!(md.contains("| sampler ns/sample | % in sampler |") && md.contains("CPU time of the worker threads"));
     for r in rows.iter().filter(|r| r["table"] != "direct") {
         let z = r["stats"]["z"].as_f64().unwrap();
         assert!(z.abs() < 4.0, "{} {} {}: z = {z}", r["table"], r["variant"], r["setting"]);

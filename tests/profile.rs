@@ -279,5 +279,17 @@ fn compare_profile_has_one_entry_and_bar_per_variant() {
     assert_eq!(text.matches("<g class=\"bar\">").count(), 2);
     assert!(text.contains(">strat<") && text.contains(">indep<"));
     assert_eq!(text.matches("<g class=\"legend-entry\">").count(), strata::profile::N_PHASES);
-    assert!(d.join("cmp/table.md").exists());
+    // The comparison's tables carry the sampler's cost of each row (2 variants x 2 ladder steps).
+    let md = std::fs::read_to_string(d.join("cmp/table.md")).unwrap();
+    assert!(md.lines().next().unwrap().contains("| sampler ns/sample | % of render in sampler |"), "{md}");
+    let rows: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("cmp/rows.json")).unwrap()).unwrap();
+    assert_eq!(rows.as_array().unwrap().len(), 4);
+    for r in rows.as_array().unwrap() {
+        assert!(r["sampler_ns_per_sample"].as_f64().unwrap() > 0.0, "{r}");
+        assert!((0.0..1.0).contains(&r["sampler_share"].as_f64().unwrap()), "{r}");
+        assert!(r["seconds"].as_f64().unwrap() > 0.0);
+    }
+    let csv = std::fs::read_to_string(d.join("cmp/rows.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",sampler_ns_per_sample,sampler_share"));
 }

@@ -1,6 +1,7 @@
 //! `strata compare`: sampling techniques against a reference, K independent runs per variant, at
 //! equal spp (a ladder) or equal time (a budget); writes CSV, JSON, a Markdown table and a
-//! log-log plot of RMSE against seconds.
+//! log-log plot of RMSE against seconds. Seconds are the worker threads' CPU seconds, and every
+//! row carries the sampler's cost from the phase profiler.
 
 use super::{io_err, LabError};
 use crate::film::{self, Film};
@@ -25,7 +26,7 @@ pub struct Variant {
 pub enum Mode {
     /// render each run at each of these spp
     Ladder(Vec<u32>),
-    /// render each run in passes until this many seconds are spent
+    /// render each run in passes until this many CPU seconds of the worker threads are spent
     Budget(f64),
 }
 
@@ -40,7 +41,9 @@ pub struct VariantProfile {
 }
 
 /// Runs every variant `runs` times (seeds 1..=runs, independent streams) under `mode`, compares
-/// with the reference image and returns one row per (variant, ladder step).
+/// with the reference image and returns one row per (variant, ladder step). Times are the worker
+/// threads' CPU seconds (a budget too); every render is profiled, so each row carries the
+/// sampler's ns per sample and share of the render.
 pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, LabError> {
     compare_profiled(variants, reference, runs, mode).map(|(rows, _)| rows)
 }
@@ -79,6 +82,7 @@ pub fn compare_profiled(
         };
         for step in steps {
             let (mut images, mut secs, mut spps) = (Vec::new(), 0.0, 0.0);
+            let mut step_stats = RenderStats { threads: all.threads, ..Default::default() };
             for run in 0..runs {
                 let mut it = integ.clone();
                 it.seed = v.opts.seed.wrapping_add(1 + run as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -87,18 +91,19 @@ pub fn compare_profiled(
                     (Some(spp), _) => {
                         it = it.resampled(Some(spp));
                         let st = render::render(&scene, &it, &mut film, 0..spp, &pool);
-                        all.merge(&st);
-                        (st.seconds, spp)
+                        step_stats.merge(&st);
+                        (st.cpu_seconds, spp)
                     }
                     (None, Mode::Budget(b)) => {
-                        // Equal time: whole passes of one sample until the budget is spent. The
-                        // pixel layout assumes an spp it cannot know in advance: independent.
+                        // Equal time: whole passes of one sample until the budget (the workers' CPU
+                        // seconds) is spent. The pixel layout assumes an spp it cannot know in
+                        // advance: independent.
                         it = it.resampled(None);
                         let (mut t, mut s) = (0.0, 0u32);
                         while t < *b {
                             let st = render::render(&scene, &it, &mut film, s..s + 1, &pool);
-                            all.merge(&st);
-                            t += st.seconds;
+                            step_stats.merge(&st);
+                            t += st.cpu_seconds;
                             s += 1;
                         }
                         (t, s)
@@ -111,7 +116,12 @@ pub fn compare_profiled(
             }
             let stats = RunStats::from_runs(&images, &img.rgb)
                 .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
-            rows.push(Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?);
+            let step_profile = Profile::from_stats("", &step_stats);
+            all.merge(&step_stats);
+            rows.push(
+                Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?
+                    .with_sampler(step_profile.sampler_ns_per_sample(), step_profile.sampler_share()),
+            );
         }
         let profile = Profile::from_stats(&scene.desc.source.display().to_string(), &all);
         profiles.push(VariantProfile { variant: v.name.clone(), profile });
@@ -133,7 +143,7 @@ pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, La
             None => series.push(Series { name: r.variant.clone(), points: vec![p] }),
         }
     }
-    let svg = report::loglog_svg(&series, title, "seconds", "RMSE", report::plot::RMSE_SLOPE);
+    let svg = report::loglog_svg(&series, title, "CPU seconds (worker threads)", "RMSE", report::plot::RMSE_SLOPE);
     for (name, text) in
         [("rows.csv", report::to_csv(rows)), ("rows.json", json), ("table.md", md.clone()), ("error.svg", svg)]
     {

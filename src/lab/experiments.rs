@@ -10,8 +10,9 @@
 //!   cosine against uniform hemisphere, Phong-lobe BRDF sampling against cosine, at equal spp and at
 //!   equal time, each against a high-spp reference whose variance layer enters the bias test.
 //!
-//! Every number except seconds (and the equal-time spp derived from them) is a pure function of the
-//! configuration: seeds are fixed and renders are bit-identical whatever the thread count.
+//! Seconds are the worker threads' CPU seconds, and every variant's runs are profiled for the
+//! sampler's cost (`sampler ns/sample`, `% in sampler`). Every number except these timings (and
+//! the equal-time spp derived from them) is a pure function of the configuration: seeds are fixed and renders are bit-identical whatever the thread count.
 
 use super::{io_err, LabError};
 use crate::film::{self, Film};
@@ -67,20 +68,46 @@ impl Config {
 /// Linear RGB images, one per run.
 pub type Images = Vec<Vec<[f32; 3]>>;
 
-/// K renders of `opts` (seeds derived from 1..=K as `strata compare` does) at `spp`: the mean images and the mean seconds.
+/// K renders of `opts` (seeds derived from 1..=K as `strata compare` does) at `spp`: the images
+/// and the mean CPU seconds of the worker threads per run.
 pub fn runs(opts: &RenderOptions, spp: u32, k: usize) -> Result<(Images, f64), LabError> {
+    runs_profiled(opts, spp, k).map(|r| (r.images, r.seconds))
+}
+
+/// What [`runs_profiled`] measured.
+pub struct Runs {
+    /// one image per run
+    pub images: Images,
+    /// mean CPU seconds of the worker threads per run
+    pub seconds: f64,
+    /// sample generation's nanoseconds per camera sample over the runs (phase profiler)
+    pub sampler_ns_per_sample: f64,
+    /// sample generation's fraction of the profiled render time
+    pub sampler_share: f64,
+}
+
+/// [`runs`] with the phase profiler on (it never changes an image): also the sampler's cost.
+pub fn runs_profiled(opts: &RenderOptions, spp: u32, k: usize) -> Result<Runs, LabError> {
     let (scene, integ) = session::prepare(opts)?;
     let pool = render::thread_pool(opts.threads)?;
     let integ = integ.resampled(Some(spp));
-    let (mut images, mut secs) = (Vec::with_capacity(k), 0.0);
+    let mut images = Vec::with_capacity(k);
+    let mut all = render::RenderStats { threads: pool.current_num_threads(), ..Default::default() };
+    let _profiling = crate::profile::enable();
     for run in 0..k {
         let mut it = integ.clone();
         it.seed = opts.seed.wrapping_add(1 + run as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
         let mut f = Film::new(scene.desc.width, scene.desc.height);
-        secs += render::render(&scene, &it, &mut f, 0..spp, &pool).seconds;
+        all.merge(&render::render(&scene, &it, &mut f, 0..spp, &pool));
         images.push(f.mean());
     }
-    Ok((images, secs / k as f64))
+    let p = session::profile::Profile::from_stats("", &all);
+    Ok(Runs {
+        images,
+        seconds: all.cpu_seconds / k as f64,
+        sampler_ns_per_sample: p.sampler_ns_per_sample(),
+        sampler_share: p.sampler_share(),
+    })
 }
 
 /// A reference image, its per-value variance (of the image itself) and the scene's gamma.
@@ -93,7 +120,7 @@ pub struct Reference {
     pub gamma: f32,
     /// (width, height)
     pub size: (u32, u32),
-    /// seconds spent
+    /// CPU seconds of the worker threads spent
     pub seconds: f64,
 }
 
@@ -106,7 +133,7 @@ fn film_of(opts: &RenderOptions, seed: u64) -> Result<(Film, f32, f64), LabError
             count: out.stats.counters.nonfinite,
         });
     }
-    Ok((out.film, out.scene.desc.gamma, out.stats.seconds))
+    Ok((out.film, out.scene.desc.gamma, out.stats.cpu_seconds))
 }
 
 /// Direct-lighting reference: two halves with independent seeds, averaged; the per-pixel variance
@@ -133,11 +160,12 @@ pub fn run_stats(images: &[Vec<[f32; 3]>], reference: &Reference) -> Result<RunS
     RunStats::against(images, &reference.rgb, info)
 }
 
-/// The row of `variant`: K runs at `spp`, `seconds` per run, against `reference`.
-fn measure(variant: &str, images: &Images, reference: &Reference, seconds: f64, spp: u32) -> Result<Row, LabError> {
+/// The row of `variant`: K runs at `spp` against `reference`, with their CPU seconds per run and
+/// the sampler's cost.
+fn measure(variant: &str, r: &Runs, reference: &Reference, spp: u32) -> Result<Row, LabError> {
     let stats =
-        run_stats(images, reference).map_err(|source| LabError::VariantStats { variant: variant.into(), source })?;
-    Ok(Row::new(variant, seconds, f64::from(spp), &stats)?)
+        run_stats(&r.images, reference).map_err(|source| LabError::VariantStats { variant: variant.into(), source })?;
+    Ok(Row::new(variant, r.seconds, f64::from(spp), &stats)?.with_sampler(r.sampler_ns_per_sample, r.sampler_share))
 }
 
 /// The variance of the 8-bit values of a row (computed for every row of the experiments).
@@ -203,8 +231,9 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
             for (label, kind) in kinds {
                 log(cfg, &format!("direct {name}: {label} x{n}, {} runs", cfg.runs));
                 let o = RenderOptions { light_sampler: Some(kind), light_samples: Some(n), ..base.clone() };
-                let (imgs, secs) = runs(&o, 1, cfg.runs)?;
-                let st = measure(label, &imgs, &reference, secs, 1)?.grouped("direct", name, format!("{n}"));
+                let r = runs_profiled(&o, 1, cfg.runs)?;
+                let st = measure(label, &r, &reference, 1)?.grouped("direct", name, format!("{n}"));
+                let imgs = r.images;
                 tiles.push(contact::tile_from_linear(
                     w,
                     h,
@@ -344,9 +373,10 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             let mut points = Vec::new();
             for s in ladder {
                 log(cfg, &format!("path {}: {label} {s} spp, {} runs", case.key, cfg.runs));
-                let (imgs, secs) = runs(o, s, cfg.runs)?;
-                let st = measure(label, &imgs, reference, secs, s)?;
-                points.push((secs, st.stats.mse.sqrt()));
+                let r = runs_profiled(o, s, cfg.runs)?;
+                let st = measure(label, &r, reference, s)?;
+                points.push((r.seconds, st.stats.mse.sqrt()));
+                let imgs = r.images;
                 if s == spp {
                     tiles.push(contact::tile_from_linear(
                         w,
@@ -376,12 +406,12 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
         let eq_spp = ((budget / per_spp).round() as u32).max(1);
         let (label, o) = &case.variants[fast];
         log(cfg, &format!("path {}: equal time, {label} at {eq_spp} spp", case.key));
-        let (imgs, secs) = if f64::from(eq_spp) == main[fast].spp {
-            (Vec::new(), main[fast].seconds)
-        } else {
-            runs(o, eq_spp, cfg.runs)?
+        let eq = if f64::from(eq_spp) == main[fast].spp { None } else { Some(runs_profiled(o, eq_spp, cfg.runs)?) };
+        let st = match &eq {
+            None => main[fast].clone(),
+            Some(r) => measure(label, r, reference, eq_spp)?,
         };
-        let st = if imgs.is_empty() { main[fast].clone() } else { measure(label, &imgs, reference, secs, eq_spp)? };
+        let imgs = eq.map(|r| r.images).unwrap_or_default();
         if !imgs.is_empty() {
             tiles.push(contact::tile_from_linear(
                 w,
@@ -401,7 +431,7 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
         let svg = report::loglog_svg(
             &series,
             &format!("{}: {}", case.scene, case.title),
-            "seconds",
+            "CPU seconds (worker threads)",
             "RMSE",
             report::plot::RMSE_SLOPE,
         );
@@ -444,8 +474,10 @@ pub fn markdown(rows: &[Row], runs: usize, width: u32, sheet_factor: u32) -> Str
          linear radiance, `var8` the same on the 8-bit gamma-encoded values 0..255; `MSE` against the reference (linear), `MSE8` the same in 8-bit units; `bias` \
          the mean signed error with its standard error `se` (runs' spread plus the reference's own noise) and `z = bias/se`; \
          `rms bias` the root mean squared per-pixel bias with the noise removed; `b-ratio = mean (m-r)^2 / mean (s^2/K + \
-         var_ref)`, about 1 when unbiased; `eff = 1/(MSE x s)`; ratios are to the first row of each block. Seconds are wall \
-         clock on a shared machine.\n",
+         var_ref)`, about 1 when unbiased; `eff = 1/(MSE x s)`; ratios are to the first row of each block. `s` is the CPU time of the \
+         worker threads per run (summed over them, so not inflated by other jobs' load as wall clock is); `sampler ns/sample` \
+         and `% in sampler` are the phase profiler's sample-generation time (phases named `sampler...`, see `strata profile`) \
+         per camera sample and as a share of the profiled render time.\n",
         runs, width
     );
     let (mut i, mut shown) = (0, Vec::<String>::new());

@@ -18,7 +18,8 @@ pub struct Row {
     pub variant: String,
     /// "equal spp", "equal time" or a light-sample count; empty in `strata compare`
     pub setting: String,
-    /// wall-clock seconds of one run (the mean over runs)
+    /// CPU seconds of the worker threads for one run, summed over the workers (the mean over
+    /// runs); wall clock before the profiling columns came (a loaded machine inflated it)
     pub seconds: f64,
     /// samples per pixel of one run (the mean over runs)
     pub spp: f64,
@@ -26,6 +27,11 @@ pub struct Row {
     pub stats: RunStats,
     /// `1 / (mse * seconds)`, infinite when that product is zero ([`efficiency`])
     pub efficiency: f64,
+    /// nanoseconds of sample generation (the profile phases named `sampler...`) per camera
+    /// sample; NaN when the runs were not profiled
+    pub sampler_ns_per_sample: f64,
+    /// fraction of the profiled render time spent in sample generation; NaN when not profiled
+    pub sampler_share: f64,
 }
 
 impl Row {
@@ -40,7 +46,15 @@ impl Row {
             spp,
             stats: *stats,
             efficiency: efficiency(stats.mse, seconds)?,
+            sampler_ns_per_sample: f64::NAN,
+            sampler_share: f64::NAN,
         })
+    }
+
+    /// This row with the sampler's cost from the runs' profile: nanoseconds per camera sample and
+    /// the fraction of render time in sample generation.
+    pub fn with_sampler(self, ns_per_sample: f64, share: f64) -> Self {
+        Row { sampler_ns_per_sample: ns_per_sample, sampler_share: share, ..self }
     }
 
     /// This row in table `table`, scene `scene`, under `setting` (the grouping of
@@ -160,6 +174,24 @@ pub fn g3(x: f64) -> String {
     }
 }
 
+/// Nanoseconds per sample in one decimal, `n/a` when not profiled.
+fn ns1(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.1}")
+    } else {
+        "n/a".into()
+    }
+}
+
+/// A fraction as a percentage in one decimal, `n/a` when not profiled.
+fn pct1(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:.1}%", 100.0 * x)
+    } else {
+        "n/a".into()
+    }
+}
+
 /// The 8-bit statistics of a row (NaN when they were not computed).
 fn eight_bit(r: &Row) -> (f64, f64) {
     r.stats.eight_bit.map_or((f64::NAN, f64::NAN), |e| (e.variance, e.mse))
@@ -177,16 +209,21 @@ pub const CSV_COLUMNS: &[Column] = &[
     Column { header: "bias_ci_hi", cell: |r, _| exact(r.stats.bias_ci.1) },
     Column { header: "variance", cell: |r, _| exact(r.stats.variance) },
     Column { header: "efficiency", cell: |r, _| exact(r.efficiency) },
+    Column { header: "sampler_ns_per_sample", cell: |r, _| exact(r.sampler_ns_per_sample) },
+    Column { header: "sampler_share", cell: |r, _| exact(r.sampler_share) },
 ];
 
-/// The CSV header written by [`to_csv`]; `bias_ci` is split into two columns.
-pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency";
+/// The CSV header written by [`to_csv`]; `bias_ci` is split into two columns. `seconds` is the
+/// workers' CPU seconds of one run; `sampler_share` a fraction (0..1), NaN when not profiled.
+pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share";
 
 /// The columns of `table.md` of `strata compare` ([`to_markdown`]).
 pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "variant", cell: |r, _| r.variant.replace('|', "\\|") },
     Column { header: "seconds", cell: |r, _| sci(r.seconds) },
     Column { header: "spp", cell: |r, _| sci(r.spp) },
+    Column { header: "sampler ns/sample", cell: |r, _| ns1(r.sampler_ns_per_sample) },
+    Column { header: "% of render in sampler", cell: |r, _| pct1(r.sampler_share) },
     Column { header: "MSE", cell: |r, _| sci(r.stats.mse) },
     Column { header: "relMSE", cell: |r, _| sci(r.stats.rel_mse) },
     Column { header: "bias", cell: |r, _| sci(r.stats.bias) },
@@ -212,6 +249,8 @@ pub const EXPERIMENT_COLUMNS: &[Column] = &[
     Column { header: "variant", cell: |r, _| r.variant.clone() },
     Column { header: "spp", cell: |r, _| format!("{}", r.spp as u32) },
     Column { header: "s", cell: |r, _| g3(r.seconds) },
+    Column { header: "sampler ns/sample", cell: |r, _| ns1(r.sampler_ns_per_sample) },
+    Column { header: "% in sampler", cell: |r, _| pct1(r.sampler_share) },
     Column { header: "var", cell: |r, _| g3(r.stats.variance) },
     Column { header: "var8", cell: |r, _| g3(eight_bit(r).0) },
     Column { header: "var ratio", cell: |r, first| g3(r.stats.variance / first.stats.variance) },
@@ -252,10 +291,13 @@ struct FlatRow<'a> {
     bias_ci: (f64, f64),
     variance: f64,
     efficiency: f64,
+    sampler_ns_per_sample: f64,
+    sampler_share: f64,
 }
 
-/// The JSON of `strata compare`: an array of objects with the keys `variant`, `seconds`, `spp`,
-/// `mse`, `rel_mse`, `bias`, `bias_ci` (`[lo, hi]`), `variance` and `efficiency`. JSON has no
+/// The JSON of `strata compare`: an array of objects with the keys `variant`, `seconds` (the
+/// workers' CPU seconds of one run), `spp`, `mse`, `rel_mse`, `bias`, `bias_ci` (`[lo, hi]`),
+/// `variance`, `efficiency`, `sampler_ns_per_sample` and `sampler_share` (a fraction). JSON has no
 /// infinity or NaN: such values (e.g. an infinite efficiency) become `null`.
 pub fn to_json(rows: &[Row]) -> serde_json::Value {
     let flat: Vec<FlatRow> = rows
@@ -270,6 +312,8 @@ pub fn to_json(rows: &[Row]) -> serde_json::Value {
             bias_ci: r.stats.bias_ci,
             variance: r.stats.variance,
             efficiency: r.efficiency,
+            sampler_ns_per_sample: r.sampler_ns_per_sample,
+            sampler_share: r.sampler_share,
         })
         .collect();
     serde_json::to_value(flat).expect("rows serialize to JSON")
@@ -301,12 +345,15 @@ struct GroupedStats {
     rms_bias: f64,
     bias_ratio: f64,
     efficiency: f64,
+    sampler_ns_per_sample: f64,
+    sampler_share: f64,
 }
 
 /// The rows as `strata experiments` writes them to JSON: objects with `table`, `scene`, `variant`,
-/// `setting` and `stats` (`runs`, `seconds`, `spp`, `variance`, `variance_8bit`, `mse`,
-/// `mse_8bit`, `bias`, `bias_se`, `z`, `rms_bias`, `bias_ratio`, `efficiency`; non-finite
-/// numbers are `null`). Serialize the result with `serde_json`.
+/// `setting` and `stats` (`runs`, `seconds` (the workers' CPU seconds of one run), `spp`,
+/// `variance`, `variance_8bit`, `mse`, `mse_8bit`, `bias`, `bias_se`, `z`, `rms_bias`,
+/// `bias_ratio`, `efficiency`, `sampler_ns_per_sample`, `sampler_share`; non-finite numbers are
+/// `null`). Serialize the result with `serde_json`.
 pub fn to_grouped_json(rows: &[Row]) -> Vec<GroupedRow<'_>> {
     rows.iter()
         .map(|r| {
@@ -331,6 +378,8 @@ pub fn to_grouped_json(rows: &[Row]) -> Vec<GroupedRow<'_>> {
                     rms_bias: s.rms_bias,
                     bias_ratio: s.bias_ratio,
                     efficiency: r.efficiency,
+                    sampler_ns_per_sample: r.sampler_ns_per_sample,
+                    sampler_share: r.sampler_share,
                 },
             }
         })
@@ -338,182 +387,5 @@ pub fn to_grouped_json(rows: &[Row]) -> Vec<GroupedRow<'_>> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::report::metrics::EightBit;
-
-    fn row(variant: &str, seconds: f64, mse: f64) -> Row {
-        let stats = RunStats {
-            runs: 4,
-            bias: -1.25e-4,
-            bias_se: 1.0e-4,
-            bias_ci: (-3.5e-4, 1.0e-4),
-            z: -1.25,
-            bias_sq: 0.1 * mse,
-            rms_bias: 0.01,
-            bias_ratio: 1.5,
-            variance: 0.9 * mse,
-            mse,
-            rel_mse: 3.0 * mse,
-            eight_bit: Some(EightBit { variance: 2.5, mse: 3.5 }),
-        };
-        Row::new(variant, seconds, 64.0, &stats).unwrap()
-    }
-
-    fn rows() -> Vec<Row> {
-        vec![
-            row("independent", 2.0, 0.004),
-            row("stratified, 8x8", 2.5, 0.001),
-            row("say \"halton\" | x", 1.0, 0.0123456),
-        ]
-    }
-
-    /// Splits one CSV line into fields, honouring RFC 4180 quotes.
-    fn parse_csv_line(line: &str) -> Vec<String> {
-        let (mut fields, mut field, mut quoted, mut chars) =
-            (Vec::new(), String::new(), false, line.chars().peekable());
-        while let Some(c) = chars.next() {
-            match (c, quoted) {
-                ('"', true) if chars.peek() == Some(&'"') => {
-                    field.push('"');
-                    chars.next();
-                }
-                ('"', _) => quoted = !quoted,
-                (',', false) => fields.push(std::mem::take(&mut field)),
-                _ => field.push(c),
-            }
-        }
-        fields.push(field);
-        fields
-    }
-
-    #[test]
-    fn csv_has_header_one_line_per_row_and_parses_back() {
-        let rows = rows();
-        let csv = to_csv(&rows);
-        let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines.len(), rows.len() + 1);
-        assert_eq!(lines[0], CSV_HEADER);
-        for (line, row) in lines[1..].iter().zip(&rows) {
-            let f = parse_csv_line(line);
-            assert_eq!(f.len(), 10, "{line}");
-            let x: Vec<f64> = f[1..].iter().map(|s| s.parse().unwrap()).collect();
-            assert_eq!(f[0], row.variant);
-            let s = &row.stats;
-            let want =
-                [row.seconds, row.spp, s.mse, s.rel_mse, s.bias, s.bias_ci.0, s.bias_ci.1, s.variance, row.efficiency];
-            assert_eq!(x, want, "{line}");
-        }
-        // Infinite efficiency survives the round trip too.
-        let mut inf = rows[0].clone();
-        inf.efficiency = f64::INFINITY;
-        let line = to_csv(&[inf]).lines().nth(1).unwrap().to_string();
-        assert_eq!(parse_csv_line(&line)[9].parse::<f64>().unwrap(), f64::INFINITY);
-    }
-
-    #[test]
-    fn json_has_the_compare_keys_and_round_trips_the_numbers() {
-        let rows = rows();
-        let value = to_json(&rows);
-        assert_eq!(value.as_array().unwrap().len(), 3);
-        assert_eq!(value[1]["variant"], "stratified, 8x8");
-        assert_eq!(value[0]["bias_ci"], serde_json::json!([-3.5e-4, 1.0e-4]));
-        let keys: Vec<&str> = value[0].as_object().unwrap().keys().map(String::as_str).collect();
-        let mut want = ["variant", "seconds", "spp", "mse", "rel_mse", "bias", "bias_ci", "variance", "efficiency"];
-        want.sort_unstable();
-        let mut keys = keys;
-        keys.sort_unstable();
-        assert_eq!(keys, want);
-        let text = serde_json::to_string(&value).unwrap();
-        let back: serde_json::Value = serde_json::from_str(&text).unwrap();
-        for (b, r) in back.as_array().unwrap().iter().zip(&rows) {
-            assert_eq!(b["mse"].as_f64(), Some(r.stats.mse));
-            assert_eq!(b["efficiency"].as_f64(), Some(r.efficiency));
-            assert_eq!(b["spp"].as_f64(), Some(r.spp));
-        }
-        let mut inf = rows[0].clone();
-        inf.efficiency = f64::INFINITY;
-        assert!(to_json(&[inf])[0]["efficiency"].is_null());
-    }
-
-    #[test]
-    fn grouped_json_has_the_experiment_keys_in_order() {
-        let rows: Vec<Row> = rows().into_iter().map(|r| r.grouped("direct", "sphere", "9")).collect();
-        let text = serde_json::to_string(&to_grouped_json(&rows)).unwrap();
-        let first = text.split("},{").next().unwrap();
-        let order = [
-            "\"table\":\"direct\"",
-            "\"scene\":\"sphere\"",
-            "\"variant\":\"independent\"",
-            "\"setting\":\"9\"",
-            "\"stats\":{\"runs\":4,\"seconds\":2.0,\"spp\":64,\"variance\":",
-            "\"variance_8bit\":2.5,\"mse\":0.004,\"mse_8bit\":3.5,\"bias\":-0.000125,\"bias_se\":0.0001,\"z\":-1.25,",
-            "\"rms_bias\":0.01,\"bias_ratio\":1.5,\"efficiency\":125.0}",
-        ];
-        let mut at = 0;
-        for o in order {
-            let i = first[at..].find(o).unwrap_or_else(|| panic!("{o} after {at} in {first}"));
-            at += i + o.len();
-        }
-    }
-
-    #[test]
-    fn markdown_is_aligned_with_efficiency_ratio() {
-        let rows = rows();
-        let md = to_markdown(&rows);
-        let lines: Vec<&str> = md.lines().collect();
-        assert_eq!(lines.len(), rows.len() + 2);
-        let width = lines[0].chars().count();
-        assert!(lines.iter().all(|l| l.chars().count() == width), "{md}");
-        assert!(lines[0].contains("eff. vs first") && lines[1].starts_with("|:-"));
-        // Ratios: 1, (1/0.0025)/(1/0.008) = 3.2, (1/0.0123456)/(1/0.008) = 0.648.
-        let last = |l: &str| l.trim_end_matches('|').rsplit('|').next().unwrap().trim().to_string();
-        assert_eq!(last(lines[2]), "1.00e0");
-        assert_eq!(last(lines[3]), "3.20e0");
-        assert_eq!(last(lines[4]), "6.48e-1");
-        assert!(lines[2].contains("4.00e-3") && lines[2].contains("[-3.50e-4, 1.00e-4]"));
-        assert!(lines[4].contains("say \"halton\" \\| x"));
-        assert_eq!(to_markdown(&[]).lines().count(), 2);
-    }
-
-    #[test]
-    fn plain_markdown_has_one_cell_per_column_and_ratios_to_the_first_row() {
-        let rows = rows();
-        let md = markdown_table(EXPERIMENT_COLUMNS, &rows, Style::Plain);
-        let lines: Vec<&str> = md.lines().collect();
-        assert_eq!(lines.len(), 2 + rows.len());
-        assert!(
-            lines[0].starts_with("| variant | spp | s | var | var8 |") && lines[0].ends_with("| eff | eff ratio |")
-        );
-        assert_eq!(lines[1], format!("|{}", "---|".repeat(EXPERIMENT_COLUMNS.len())));
-        assert_eq!(lines[2], "| independent | 64 | 2.000 | 3.60e-3 | 2.500 | 1.000 | 4.00e-3 | 3.500 | -1.25e-4 | 1.00e-4 | -1.25 | 0.010 | 1.500 | 125.000 | 1.000 |");
-        // Second row: efficiency 1/(0.001 x 2.5) = 400, ratio 400 / 125 = 3.2; variance ratio 0.25.
-        assert!(
-            lines[3].ends_with(
-                "| 0.250 | 1.00e-3 | 3.500 | -1.25e-4 | 1.00e-4 | -1.25 | 0.010 | 1.500 | 400.000 | 3.200 |"
-            ),
-            "{}",
-            lines[3]
-        );
-    }
-
-    #[test]
-    fn csv_columns_spell_the_header_and_g3_reads_well() {
-        let header: Vec<&str> = CSV_COLUMNS.iter().map(|c| c.header).collect();
-        assert_eq!(header.join(","), CSV_HEADER);
-        assert_eq!(
-            (g3(0.0), g3(1.5), g3(12345.0), g3(0.001)),
-            ("0".into(), "1.500".into(), "1.23e4".into(), "1.00e-3".into())
-        );
-    }
-
-    #[test]
-    fn row_from_stats() {
-        let reference = vec![[1.0f32; 3]; 2];
-        let runs = vec![vec![[1.5f32; 3]; 2], vec![[0.5f32; 3]; 2]];
-        let stats = RunStats::from_runs(&runs, &reference).unwrap();
-        let row = Row::new("v", 2.0, 16.0, &stats).unwrap();
-        assert_eq!((row.stats.mse, row.efficiency, row.stats.bias), (0.25, 2.0, 0.0));
-        assert!(Row::new("v", f64::NAN, 16.0, &stats).is_err());
-    }
-}
+#[path = "table_tests.rs"]
+mod tests;
