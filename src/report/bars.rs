@@ -19,14 +19,14 @@ pub struct Bar {
 }
 
 // Layout in SVG pixels: labels, the bars, then the legend to their right.
-const WIDTH: f64 = 940.0;
+const WIDTH: f64 = 960.0;
 const LABEL_X: f64 = 130.0;
 const LEFT: f64 = 140.0;
-const RIGHT: f64 = 500.0;
+const RIGHT: f64 = 420.0;
 const TOP: f64 = 50.0;
 const BAR_H: f64 = 28.0;
 const BAR_GAP: f64 = 16.0;
-const LEGEND_X: f64 = 600.0;
+const LEGEND_X: f64 = 640.0;
 const LEGEND_DY: f64 = 18.0;
 /// Segments at least this wide (pixels) carry their share as text.
 const LABEL_MIN_PX: f64 = 34.0;
