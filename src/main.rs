@@ -497,23 +497,27 @@ fn main() -> ExitCode {
             let quiet = args.quiet;
             // `--profile FILE` (a render flag) means the same here as `--json FILE`.
             let json_file = json_file.or_else(|| args.profile.clone());
-            session::run_profile(&args.options(), repeats).map_err(|e| e.to_string()).and_then(|p| {
-                if let Some(f) = &json_file {
-                    let text = serde_json::to_string_pretty(&p).map_err(|e| e.to_string())?;
-                    std::fs::write(f, text).map_err(|e| format!("{}: {e}", f.display()))?;
-                }
-                if let Some(f) = &svg_file {
-                    let svg = session::profile::profile_svg(
-                        &[(p.scene.as_str(), &p)],
-                        &format!("strata profile: {}", p.scene),
-                    );
-                    session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
-                }
-                if !quiet {
-                    println!("{}", session::profile_table(&p));
-                }
-                Ok(())
-            })
+            let early =
+                [&json_file, &svg_file].into_iter().flatten().try_for_each(|f| session::checks::check_output_file(f));
+            early.and_then(|()| session::run_profile(&args.options(), repeats)).map_err(|e| e.to_string()).and_then(
+                |p| {
+                    if let Some(f) = &json_file {
+                        let text = serde_json::to_string_pretty(&p).map_err(|e| e.to_string())?;
+                        std::fs::write(f, text).map_err(|e| format!("{}: {e}", f.display()))?;
+                    }
+                    if let Some(f) = &svg_file {
+                        let svg = session::profile::profile_svg(
+                            &[(p.scene.as_str(), &p)],
+                            &format!("strata profile: {}", p.scene),
+                        );
+                        session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
+                    }
+                    if !quiet {
+                        println!("{}", session::profile_table(&p));
+                    }
+                    Ok(())
+                },
+            )
         }
     };
     match result {
@@ -578,6 +582,9 @@ fn run_compare(
         (None, Some(_)) => return Err("--spp-ladder: expected positive spp values".into()),
         (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
     };
+    for f in [&profile_out.json, &profile_out.svg].into_iter().flatten() {
+        session::checks::check_output_file(f).map_err(|e| e.to_string())?;
+    }
     let (rows, profiles) =
         strata::lab::compare_profiled(&variants, reference, runs, &mode).map_err(|e| e.to_string())?;
     let title = format!(

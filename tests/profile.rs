@@ -293,3 +293,24 @@ fn compare_profile_has_one_entry_and_bar_per_variant() {
     let csv = std::fs::read_to_string(d.join("cmp/rows.csv")).unwrap();
     assert!(csv.lines().next().unwrap().ends_with(",sampler_ns_per_sample,sampler_share"));
 }
+
+/// An unwritable `--svg`/`--json` (profile), `--profile` (render) or `--profile-svg` (compare)
+/// directory is a clear error before anything renders.
+#[test]
+fn unwritable_profile_outputs_fail_before_rendering() {
+    let bad = std::path::Path::new("/nonexistent-strata-dir/p.svg");
+    for args in [vec!["profile", "--svg"], vec!["profile", "--json"], vec!["render", "--profile"]] {
+        let out = common::strata().args(&args).arg(bad).args(["--size", "8x8", "--spp", "1", "-q"]).output().unwrap();
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("/nonexistent-strata-dir: cannot write there"), "{args:?}: {err}");
+    }
+    let out = common::strata()
+        .args(["compare", "--reference", "/nonexistent-ref.exr", "--variant", "a=--spp 1", "--spp-ladder", "1"])
+        .arg("--profile-svg")
+        .arg(bad)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("cannot write there"), "{err}");
+}

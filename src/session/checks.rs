@@ -31,6 +31,13 @@ pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
     Ok(())
 }
 
+/// Checks that the directory `file` would be written in is writable (a probe file), for outputs
+/// the render options do not name (`strata profile --json/--svg`, `compare --profile`), so a bad
+/// path fails before the renders.
+pub fn check_output_file(file: &Path) -> Result<(), SessionError> {
+    check_writable(&dir_of(file))
+}
+
 /// The directory a file is written in ("." for a bare name).
 fn dir_of(f: &Path) -> PathBuf {
     match f.parent() {
