@@ -9,30 +9,10 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{Mat4, Vec3};
 use std::hint::black_box;
-use strata::accel::ellipsoid::bench::{Packet, Prim};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32) / (1u64 << 24) as f32
-    }
-    fn sym(&mut self) -> f32 {
-        2.0 * self.next() - 1.0
-    }
-}
+use strata::accel::ellipsoid::bench::{pack, Packet, Prim, Rng};
 
 fn packet(rays: &[(Vec3, Vec3)]) -> Packet {
-    let mut p = [[0f32; 8]; 9];
-    for (i, (o, d)) in rays.iter().enumerate() {
-        let v = [o.x, o.y, o.z, 0.0, d.x, d.y, d.z, 0.0, f32::INFINITY];
-        for f in 0..9 {
-            p[f][i] = v[f];
-        }
-    }
-    p
+    pack(&rays.iter().map(|&(o, d)| (o, d, 0.0, f32::INFINITY)).collect::<Vec<_>>())
 }
 
 /// 8x1 pixel rows of a 256x256 45-degree view from (0, 1, 3) at (0, 1, 0) whose rays pass within

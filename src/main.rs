@@ -416,6 +416,15 @@ fn main() -> ExitCode {
                     if !quiet {
                         println!("{}", session::summary(&o));
                     }
+                    // A signal after the last pass (while the outputs were written, atomically)
+                    // left them complete; the exit status still says a signal was received.
+                    if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
+                        eprintln!(
+                            "strata: interrupted after the last pass; outputs complete ({} spp)",
+                            o.film.samples().len()
+                        );
+                        return ExitCode::from(130);
+                    }
                     Ok(())
                 }
                 Err(e) => Err(e.to_string()),

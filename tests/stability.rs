@@ -262,8 +262,10 @@ fn cornell_with(extra: &str) -> String {
 }
 
 /// Zero-area triangles (coincident vertices, collinear vertices), also far outside the box, leave the
-/// image bit-identical to the scene without them: they are never hit and do not count towards the
-/// scene extent that scales the ray offsets.
+/// image bit-identical to the scene without them, with the course's pixel-centre sample 0 (whose
+/// centre ray runs exactly through the degenerate triangles at y = 1, x = 0) and with jittered
+/// ones: they are dropped when the scene is built (counted, and announced once on stderr), so they
+/// are never hit and do not count towards the scene extent that scales the ray offsets.
 #[test]
 fn zero_area_triangles_leave_the_image_unchanged() {
     let dir = tmpdir("degenerate");
@@ -272,13 +274,25 @@ fn zero_area_triangles_leave_the_image_unchanged() {
     let plain = write_scene(&dir, "plain.test", &cornell_with(""));
     let with = write_scene(&dir, "with.test", &cornell_with(degenerate));
     for integ in [IntegratorKind::Direct, IntegratorKind::PathTracer, IntegratorKind::RayTracer] {
-        // Jittered sample 0: with the course's pixel-centre sample 0 the Direct image changes (a
-        // centre ray exactly through the degenerate triangles at y = 1, x = 0; open, see report [4 of 5]).
-        let first_sample = Some(strata::integrator::FirstSample::Jittered);
-        let o = |p: &PathBuf| RenderOptions { spp: Some(8), first_sample, ..opts_for(p.clone(), integ, 4) };
-        let (a, b) = (render(&o(&plain)), render(&o(&with)));
-        assert!(a.mean == b.mean, "{integ:?}: degenerate triangles changed the image");
+        for first_sample in [None, Some(strata::integrator::FirstSample::Jittered)] {
+            let o = |p: &PathBuf| RenderOptions { spp: Some(8), first_sample, ..opts_for(p.clone(), integ, 4) };
+            let (a, b) = (render(&o(&plain)), render(&o(&with)));
+            assert!(a.mean == b.mean, "{integ:?} {first_sample:?}: degenerate triangles changed the image");
+        }
     }
+    let (scene, _) = app::prepare(&opts_for(with.clone(), IntegratorKind::Direct, 4)).unwrap();
+    assert_eq!(scene.degenerate_dropped, 5);
+    let warned = |p: &Path| {
+        let args = ["--spp", "1", "--size", "8x8", "-q", "-o"];
+        let r = strata().arg("render").arg(p).args(args).arg(dir.join("out")).output().unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let err = String::from_utf8_lossy(&r.stderr).into_owned();
+        err.lines().filter(|l| l.contains("degenerate")).map(str::to_string).collect::<Vec<_>>()
+    };
+    let lines = warned(&with);
+    assert_eq!(lines.len(), 1, "one warning line: {lines:?}");
+    assert_eq!(lines[0], format!("strata: warning: {}: dropped 5 degenerate (zero-area) triangles", with.display()));
+    assert!(warned(&plain).is_empty());
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -302,17 +302,58 @@ pub(super) fn packet_hits(
     }
 }
 
-/// Old (f64 per lane) and new (f32 packet) intersection of one ellipsoid, for `benches/ellipsoid.rs`.
+/// Old (f64 per lane) and new (f32 packet) intersection of one ellipsoid, and the deterministic
+/// ray generator and packet layout shared by `benches/ellipsoid.rs` and the tests.
 #[doc(hidden)]
 pub mod bench {
     use super::{packet_hits, Ellipsoid};
-    use glam::Mat4;
+    use glam::{Mat4, Vec3};
 
     /// One ellipsoid, the unit sphere under `object_to_world`.
     pub struct Prim(Ellipsoid);
 
     /// 8 rays in Embree field order (0-2 org, 3 tnear, 4-6 dir, 8 tfar).
     pub type Packet = [[f32; 8]; 9];
+
+    /// xorshift64*: deterministic, no dependency (the state must not be 0).
+    pub struct Rng(pub u64);
+
+    impl Rng {
+        /// Uniform in [0, 1), 24 bits.
+        pub fn unit(&mut self) -> f32 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32) / (1u64 << 24) as f32
+        }
+
+        /// Uniform in [-1, 1).
+        pub fn sym(&mut self) -> f32 {
+            2.0 * self.unit() - 1.0
+        }
+
+        /// A uniformly distributed unit direction (rejection from the cube).
+        pub fn dir(&mut self) -> Vec3 {
+            loop {
+                let v = Vec3::new(self.sym(), self.sym(), self.sym());
+                if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                    return v.normalize();
+                }
+            }
+        }
+    }
+
+    /// Up to 8 rays `(origin, direction, tnear, tfar)` as a [`Packet`]; missing lanes are zero.
+    pub fn pack(rays: &[(Vec3, Vec3, f32, f32)]) -> Packet {
+        let mut p = [[0f32; 8]; 9];
+        for (i, &(o, d, tn, tf)) in rays.iter().enumerate() {
+            let v = [o.x, o.y, o.z, tn, d.x, d.y, d.z, 0.0, tf];
+            for (f, x) in v.into_iter().enumerate() {
+                p[f][i] = x;
+            }
+        }
+        p
+    }
 
     impl Prim {
         /// None if the map is singular.

@@ -1,32 +1,11 @@
 //! Tests of the SIMD ellipsoid intersection against the f64 oracle (`Ellipsoid::hit`).
 
+use super::bench::{pack, Rng};
 use super::*;
 use glam::{Mat4, Quat, Vec3};
 
 /// Tolerance on hit distances against the f64 path: |t - t64| <= REL |t64|.
 const REL: f32 = 1e-5;
-
-/// xorshift64*: deterministic, no dependency.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32) / (1u64 << 24) as f32
-    }
-    fn sym(&mut self) -> f32 {
-        2.0 * self.next() - 1.0
-    }
-    fn dir(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(self.sym(), self.sym(), self.sym());
-            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
-                return v.normalize();
-            }
-        }
-    }
-}
 
 #[derive(Clone, Copy, Debug)]
 struct Ray {
@@ -36,15 +15,14 @@ struct Ray {
     tf: f32,
 }
 
+/// Up to 8 rays in Embree field order.
+fn fields(rays: &[Ray]) -> bench::Packet {
+    pack(&rays.iter().map(|r| (r.o, r.d, r.tn, r.tf)).collect::<Vec<_>>())
+}
+
 /// Packet answer of the first `rays.len() <= 8` lanes (lane subsets through `valid`).
 fn packet(e: &Ellipsoid, rays: &[Ray], valid: impl Fn(usize) -> bool) -> [Option<f32>; 8] {
-    let mut fields = [[0f32; 8]; 9];
-    for (i, r) in rays.iter().enumerate() {
-        let v = [r.o.x, r.o.y, r.o.z, r.tn, r.d.x, r.d.y, r.d.z, 0.0, r.tf];
-        for f in 0..9 {
-            fields[f][i] = v[f];
-        }
-    }
+    let fields = fields(rays);
     let mut out = [None; 8];
     packet_hits(
         e,
@@ -82,13 +60,7 @@ fn check(m: &Mat4, rays: &[Ray], normal_tol: Option<f32>) -> Stats {
     let mut st = Stats::default();
     for chunk in rays.chunks(8) {
         let got = packet(&e, chunk, |_| true);
-        let mut fields = [[0f32; 8]; 9];
-        for (i, r) in chunk.iter().enumerate() {
-            let v = [r.o.x, r.o.y, r.o.z, r.tn, r.d.x, r.d.y, r.d.z, 0.0, r.tf];
-            for f in 0..9 {
-                fields[f][i] = v[f];
-            }
-        }
+        let fields = fields(chunk);
         let v3 = |f: usize| Vec3x8::new(F8::new(fields[f]), F8::new(fields[f + 1]), F8::new(fields[f + 2]));
         let live = crate::simd::mask_first(chunk.len());
         let fr = fast8(&e.fast, v3(0), v3(4), F8::new(fields[3]), F8::new(fields[8]), live);
@@ -132,7 +104,7 @@ fn ellipsoid(c: Vec3, axes: Vec3) -> Mat4 {
 fn aimed(rng: &mut Rng, n: usize, eye: Vec3, c: Vec3, rad: f32) -> Vec<Ray> {
     (0..n)
         .map(|_| {
-            let target = c + rng.dir() * (rad * 1.3 * rng.next().cbrt());
+            let target = c + rng.dir() * (rad * 1.3 * rng.unit().cbrt());
             Ray { o: eye, d: (target - eye).normalize(), tn: 0.0, tf: f32::INFINITY }
         })
         .collect()
@@ -157,17 +129,17 @@ fn random_rays_agree_with_f64() {
     let mut rng = Rng(2);
     for k in 0..4 {
         let c = Vec3::new(rng.sym(), rng.sym(), rng.sym()) * 5.0;
-        let axes = Vec3::new(0.2 + rng.next(), 0.2 + rng.next(), 0.2 + rng.next());
+        let axes = Vec3::new(0.2 + rng.unit(), 0.2 + rng.unit(), 0.2 + rng.unit());
         let m = if k % 2 == 0 { sphere(c, axes.x) } else { ellipsoid(c, axes) };
         let rays: Vec<Ray> = (0..25_000)
             .map(|_| {
                 let o = c + Vec3::new(rng.sym(), rng.sym(), rng.sym()) * 4.0;
                 // Aim near the centre (many hits) or anywhere.
-                let d = if rng.next() < 0.5 { (c + rng.dir() * 1.5 - o).normalize() } else { rng.dir() };
-                let tn = if rng.next() < 0.2 { rng.next() * 3.0 } else { 0.0 };
-                let tf = if rng.next() < 0.2 { tn + rng.next() * 8.0 } else { f32::INFINITY };
+                let d = if rng.unit() < 0.5 { (c + rng.dir() * 1.5 - o).normalize() } else { rng.dir() };
+                let tn = if rng.unit() < 0.2 { rng.unit() * 3.0 } else { 0.0 };
+                let tf = if rng.unit() < 0.2 { tn + rng.unit() * 8.0 } else { f32::INFINITY };
                 // Unnormalized directions too: t is in units of |d|.
-                let s = if rng.next() < 0.3 { 0.1 + 10.0 * rng.next() } else { 1.0 };
+                let s = if rng.unit() < 0.3 { 0.1 + 10.0 * rng.unit() } else { 1.0 };
                 Ray { o, d: d * s, tn: tn / s, tf: tf / s }
             })
             .collect();
@@ -233,7 +205,7 @@ fn rays_from_inside_agree_with_f64() {
     for m in [sphere(c, 2.0), ellipsoid(c, Vec3::new(2.0, 0.5, 1.0))] {
         let rays: Vec<Ray> = (0..20_000)
             .map(|_| {
-                let o = m.transform_point3(rng.dir() * 0.99 * rng.next());
+                let o = m.transform_point3(rng.dir() * 0.99 * rng.unit());
                 Ray { o, d: rng.dir(), tn: 0.0, tf: f32::INFINITY }
             })
             .collect();

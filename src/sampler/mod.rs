@@ -8,10 +8,11 @@
 //!
 //! Layouts: each is one file implementing [`Layout`] and exporting its `SamplerInfo` const(s),
 //! plus one line of the `registry!` list here (which declares the module and adds its entries to
-//! [`SAMPLERS`]), the registry that the `.test` parser, the CLI (`--pixel-sampler`, `--light-sampler`, their help text) and the
-//! tests read; [`SamplerKind`] is a handle into it. Stratification is across `k` *within one set*:
-//! to stratify the camera jitter over a pixel's spp samples, call with `n = spp, k = s,
-//! sample = 0`. Sequence layouts (halton, sobol, pmj02) use the global index `sample * n + k`.
+//! [`SAMPLERS`]), the registry that the `.test` parser, the CLI (`--pixel-sampler`,
+//! `--light-sampler`, their help text) and the tests read; [`SamplerKind`] is a handle into it.
+//! Stratification is across `k` *within one set*: to stratify the camera jitter over a pixel's spp
+//! samples, call with `n = spp, k = s, sample = 0`. Sequence layouts (halton, sobol, pmj02) use
+//! the global index `sample * n + k`.
 //!
 //! Precision: every coordinate is a 24-bit fixed-point value `y * 2^-24` with `y < 2^24`, computed
 //! with exact integer arithmetic, so it lies in [0, 1) and is exactly representable as f32. Grid

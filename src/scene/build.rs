@@ -128,8 +128,15 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// per triangle: material index
     pub tri_material: Vec<u32>,
-    /// per triangle: unit geometric normal (zero for degenerate triangles)
+    /// per triangle: unit geometric normal
     pub tri_normal: Vec<Vec3>,
+    /// per scene triangle (Embree's first primitives): its corner shading normals, `[ZERO; 3]` for
+    /// none; empty when the scene has none (the desc's `triangle_normals` without the dropped
+    /// triangles)
+    pub tri_corner_normals: Vec<[Vec3; 3]>,
+    /// zero-area triangles (scene and emissive) dropped at build: they can be neither hit nor
+    /// sampled, and an exact ray through one would get no usable normal
+    pub degenerate_dropped: usize,
     /// per triangle: light index or u32::MAX
     pub tri_light: Vec<u32>,
     /// per sphere/ellipsoid of the desc: material index
@@ -160,9 +167,16 @@ pub enum BuildError {
     NoCamera(std::path::PathBuf),
 }
 
+/// A triangle without a unit normal: zero area (collinear or repeated corners) or non-finite.
+fn is_degenerate(v: &[Vec3; 3]) -> bool {
+    (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero() == Vec3::ZERO
+}
+
 impl Scene {
     /// Builds the scene. Quad lights become two triangles each, after the scene's triangles, then
-    /// come the emissive triangles (zero-area ones are dropped: they can be neither hit nor sampled).
+    /// come the emissive triangles. Zero-area triangles (no unit normal: the cross product of two
+    /// edges vanishes or is not finite) of either kind are dropped and counted in
+    /// [`Scene::degenerate_dropped`].
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
         let cam_desc = desc.camera.ok_or_else(|| BuildError::NoCamera(desc.source.clone()))?;
         let camera = Camera::new(&cam_desc, desc.width, desc.height);
@@ -171,7 +185,18 @@ impl Scene {
         let mut indices = Vec::with_capacity(desc.triangles.len() + desc.quad_lights.len() * 2);
         let mut tri_material = Vec::with_capacity(indices.capacity());
         let mut tri_light = Vec::with_capacity(indices.capacity());
-        for t in &desc.triangles {
+        let mut tri_corner_normals = Vec::new();
+        let mut degenerate_dropped = 0;
+        for (k, t) in desc.triangles.iter().enumerate() {
+            if is_degenerate(&t.v) {
+                degenerate_dropped += 1;
+                continue;
+            }
+            if !desc.triangle_normals.is_empty() {
+                let none = [Vec3::ZERO; 3];
+                tri_corner_normals.resize(indices.len(), none);
+                tri_corner_normals.push(desc.triangle_normals.get(k).copied().unwrap_or(none));
+            }
             let base = vertices.len() as u32;
             vertices.extend_from_slice(&t.v);
             indices.push([base, base + 1, base + 2]);
@@ -194,7 +219,8 @@ impl Scene {
         let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
         for t in &desc.emissive_triangles {
             let e = Emitter::triangle(t.v, t.radiance);
-            if !(e.area > 0.0 && e.area.is_finite()) {
+            if !(e.area > 0.0 && e.area.is_finite()) || is_degenerate(&t.v) {
+                degenerate_dropped += 1;
                 continue;
             }
             let base = vertices.len() as u32;
@@ -274,6 +300,8 @@ impl Scene {
             materials,
             tri_material,
             tri_normal,
+            tri_corner_normals,
+            degenerate_dropped,
             tri_light,
             ell_material,
             sphere_point_index,
@@ -323,7 +351,7 @@ impl Scene {
                             le[i] = q.radiance;
                         }
                     }
-                    if let Some(c) = self.desc.triangle_normals.get(prim).filter(|c| c[0] != Vec3::ZERO) {
+                    if let Some(c) = self.tri_corner_normals.get(prim).filter(|c| c[0] != Vec3::ZERO) {
                         let (u, v) = (bu[i], bv[i]);
                         vertex_normal = Some(c[0] * (1.0 - u - v) + c[1] * u + c[2] * v);
                     }

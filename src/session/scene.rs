@@ -103,6 +103,14 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     }
     super::checks::check_sampler_periods(opts, &desc, spp)?;
     let scene = Scene::build(desc)?;
+    if scene.degenerate_dropped > 0 {
+        let n = scene.degenerate_dropped;
+        eprintln!(
+            "strata: warning: {}: dropped {n} degenerate (zero-area) triangle{}",
+            scene.desc.source.display(),
+            if n == 1 { "" } else { "s" }
+        );
+    }
     let mut integrator =
         Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
     if opts.general_kernel {
