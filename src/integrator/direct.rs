@@ -63,6 +63,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
         {
             let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
             sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
+            crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, dim);
         }
         for k in 0..n_light {
             sc.shadow.clear();
@@ -75,6 +76,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 }
                 let (u, v) = {
                     let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(i as u32, k);
                     sc.streams[i].point(k)
                 };
                 let ls = group.sample(scene, u, v, shade);

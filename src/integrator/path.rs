@@ -22,7 +22,7 @@ use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
 use crate::light::emitters::LightSample8;
 use crate::light::select::LightSelection;
-use crate::sampler::permute_x8;
+use crate::sampler::shuffled_index_x8;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
 use crate::scene::desc::{ImportanceSampling, Nee};
@@ -114,9 +114,8 @@ impl Integrator {
     #[inline]
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
         let _p = crate::profile::scope(crate::profile::Phase::SamplerPath);
-        let n = self.spp;
-        let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-        let k = permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)));
+        crate::sampler::replay::path_point(pixel, s, dim);
+        let k = shuffled_index_x8(s, self.spp, pixel, dim, self.seed);
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
     }
 }

@@ -2,6 +2,7 @@
 //! profiler's overhead measured in the same run (the same job rendered with profiling off,
 //! interleaved) and the profiled image checked bit-identical to the unprofiled one.
 
+use super::replay::{record, replay_sets, replay_table, time_replay, SamplerReplay, REPLAY_REPEATS};
 use super::{prepare, RenderOptions, SessionError};
 use crate::film::Film;
 use crate::profile::{self, PHASES};
@@ -53,6 +54,8 @@ pub struct Profile {
     pub threads: usize,
     /// renders per mode, interleaved
     pub repeats: usize,
+    /// the sampler alone on the render's exact call sequence, and with every other kind
+    pub sampler_replay: SamplerReplay,
 }
 
 fn render_once(
@@ -69,8 +72,14 @@ fn render_once(
 }
 
 /// `strata profile`: renders the job `repeats` times with profiling off and on, interleaved, and
-/// returns the phase split of the fastest profiled render.
+/// returns the phase split of the fastest profiled render, then renders it once more recording
+/// the sampler calls and times their replay ([`super::replay`]).
 pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, SessionError> {
+    run_profile_capped(opts, repeats, crate::sampler::replay::DEFAULT_CAP_WORDS)
+}
+
+/// [`run_profile`] keeping at most `cap_words` words of the sampler call log.
+pub fn run_profile_capped(opts: &RenderOptions, repeats: usize, cap_words: usize) -> Result<Profile, SessionError> {
     let (scene, integrator) = prepare(opts)?;
     let pool = render::thread_pool(opts.threads)?;
     let repeats = repeats.max(1);
@@ -108,6 +117,12 @@ pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, Sess
         })
         .collect();
     let sum: f64 = phases.iter().map(|p| p.seconds).sum();
+    let (rec, img) = record(&scene, &integrator, &pool, cap_words);
+    bit_identical &= first_image.as_ref().is_none_or(|f| bits(f) == bits(&img));
+    let mut sampler_replay = time_replay(&rec, &replay_sets(&integrator), samples, REPLAY_REPEATS);
+    drop(rec);
+    sampler_replay.instrumented_ns_per_sample =
+        phases.iter().filter(|r| r.name.starts_with("sampler")).map(|r| r.ns_per_sample).sum();
     Ok(Profile {
         scene: scene.desc.source.display().to_string(),
         total_seconds: total,
@@ -121,6 +136,7 @@ pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, Sess
         rays,
         threads: on.threads,
         repeats,
+        sampler_replay,
     })
 }
 
@@ -156,5 +172,7 @@ pub fn profile_table(p: &Profile) -> String {
         p.repeats,
         if p.bit_identical { "bit-identical with profiling off" } else { "DIFFERS with profiling off" }
     );
+    s += "\n";
+    s += &replay_table(&p.sampler_replay);
     s
 }
