@@ -44,6 +44,7 @@ impl<'a> Tracer<'a> {
     /// lanes traced.
     #[inline]
     pub fn intersect_all(&mut self, packets: &mut [(RayHit8, Mask8)], kind: RayKind) {
+        let _p = crate::profile::scope(crate::profile::Phase::EmbreeIntersect);
         for (rh, active) in packets.iter_mut() {
             *active = self.intersect(rh, kind, *active);
         }

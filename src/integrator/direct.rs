@@ -29,7 +29,7 @@ impl Group<'_> {
     /// A point on the group's light(s) for the unit-square sample (u, v).
     #[inline]
     fn sample(self, scene: &Scene, u: F8, v: F8, active: Mask8) -> LightSample8 {
-        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
         match self {
             Group::Quad(e) => e.sample_x8(u, v),
             Group::Triangles => scene.emitters.sample_triangles_x8(u, v, active),
@@ -75,7 +75,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                     continue;
                 }
                 let (u, v) = {
-                    let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
                     crate::sampler::replay::light_point(i as u32, k);
                     sc.streams[i].point(k)
                 };
@@ -135,6 +135,7 @@ fn trace_shadow_batch(
     owner: &[u32],
     acc: &mut [Vec3x8],
 ) {
+    let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
     for (j, (ray, lit)) in shadow.iter_mut().enumerate() {
         let occluded = tracer.occluded(ray, *lit);
         acc[owner[j] as usize] += masked(contrib[j], *lit & !occluded);

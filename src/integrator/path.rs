@@ -113,7 +113,7 @@ impl Integrator {
     /// Stratified 2D point of dimension `dim` for pixel sample `s`, strata shuffled per (pixel, dim).
     #[inline]
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
-        let _p = crate::profile::scope(crate::profile::Phase::SamplerPath);
+        let _p = crate::profile::leaf(crate::profile::Phase::SamplerPath);
         crate::sampler::replay::path_point(pixel, s, dim);
         let k = shuffled_index_x8(s, self.spp, pixel, dim, self.seed);
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
@@ -299,7 +299,7 @@ impl Integrator {
                         // historical path, kept bit-identical.
                         LightSelection::Uniform => {
                             let ls = {
-                                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                 scene.emitters.sample_x8(u_choice, u, w, shade)
                             };
                             push(ls, None, None, shade)
@@ -316,7 +316,7 @@ impl Integrator {
                                 for j in 0..n_all {
                                     let (uj, wj) = lattice_point(u, w, j, n_all);
                                     let ls = {
-                                        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                         e.sample_x8(uj, wj)
                                     };
                                     push(ls, scale, mis_n, shade);
@@ -325,7 +325,7 @@ impl Integrator {
                         }
                         LightSelection::Power | LightSelection::Spatial => {
                             let (ls, ok) = {
-                                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                 let (idx, pmf) = self.light_sampler.sample_x8(u_choice, sh.p, sh.n, shade);
                                 let ok = shade & pmf.simd_gt(F8::ZERO);
                                 let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
@@ -390,11 +390,13 @@ impl Integrator {
                 sc.shadow_contrib.push(Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].contrib)));
                 sc.shadow_slots.push(std::array::from_fn(|i| chunk[i].slot));
             }
+            let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
             for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
                 let occluded = tracer.occluded(ray, *lit);
                 let visible = *lit & !occluded;
                 add_lanes(&mut sc.radiance, &sc.shadow_slots[j], masked(sc.shadow_contrib[j], visible));
             }
+            drop(occluded_batch);
             pad8(&mut sc.next, PathLane::DEAD);
             std::mem::swap(&mut sc.lanes, &mut sc.next);
             v += 1;

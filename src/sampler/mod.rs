@@ -41,6 +41,9 @@ pub mod sobol;
 mod stratified;
 mod zsobol;
 
+#[cfg(test)]
+mod slow_test;
+
 pub use grid::strata_shape;
 pub use halton::radical_inverse;
 pub use lanes::Lanes;
@@ -145,6 +148,10 @@ impl SamplerKind {
     /// Progressive multi-jittered (0,2) sequence (table-based, XOR-scrambled) at `sample * n + k`.
     pub const PMJ02: Self = Self::named("pmj02");
 
+    /// Test builds only: a stratified layout spinning in every call (not in the registry).
+    #[cfg(test)]
+    pub(crate) const SLOW_TEST: Self = SamplerKind(u8::MAX);
+
     /// Every registered kind, in registry order.
     pub const ALL: [SamplerKind; SAMPLERS.len()] = {
         let mut all = [SamplerKind(0); SAMPLERS.len()];
@@ -188,6 +195,10 @@ impl SamplerKind {
 
     /// Its registry entry.
     pub fn info(self) -> &'static SamplerInfo {
+        #[cfg(test)]
+        if self.0 == u8::MAX {
+            return &slow_test::INFO;
+        }
         &SAMPLERS[self.0 as usize]
     }
 

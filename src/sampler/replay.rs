@@ -60,7 +60,7 @@ struct Shared {
 }
 
 /// The log of one tile.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 struct TileLog {
     tile: u32,
     level: u32,
@@ -69,6 +69,10 @@ struct TileLog {
 }
 
 struct ThreadLog {
+    /// this thread records (the threads of the recording render's pool, see [`arm`])
+    armed: bool,
+    /// this tile's calls are counted (a recording runs and the thread is armed)
+    counting: bool,
     /// this tile's calls are logged (its level is not below the threshold)
     active: bool,
     tile: u32,
@@ -84,6 +88,8 @@ struct ThreadLog {
 thread_local! {
     static LOG: RefCell<ThreadLog> = const {
         RefCell::new(ThreadLog {
+            armed: false,
+            counting: false,
             active: false,
             tile: 0,
             level: 0,
@@ -109,6 +115,13 @@ pub fn start(cap_words: usize) {
     *sh = Shared { cap_words: cap_words.max(1), words: 0, calls: 0, tiles: Vec::new() };
     THRESHOLD.store(0, Ordering::SeqCst);
     RECORDING.store(true, Ordering::SeqCst);
+}
+
+/// Arms (or disarms) this thread: only armed threads record, so that renders on other threads
+/// (other pools, tests running at the same time) stay out of the log. Call it on every worker of
+/// the recording render's pool (`rayon::ThreadPool::broadcast`).
+pub fn arm(on: bool) {
+    LOG.with_borrow_mut(|l| l.armed = on);
 }
 
 /// Stops recording and returns what the tiles logged, in tile order.
@@ -138,6 +151,10 @@ pub fn tile_begin(tile: u32) {
         return;
     }
     LOG.with_borrow_mut(|l| {
+        l.counting = l.armed;
+        if !l.armed {
+            return;
+        }
         l.tile = tile;
         l.level = level(tile);
         l.active = l.level >= THRESHOLD.load(Ordering::Relaxed);
@@ -155,8 +172,12 @@ pub fn tile_end() {
     }
     let (tile, level, calls, active, words) = LOG.with_borrow_mut(|l| {
         let words = if l.active { std::mem::take(&mut l.words) } else { Vec::new() };
-        (l.tile, l.level, l.calls, std::mem::replace(&mut l.active, false), words)
+        let counting = std::mem::replace(&mut l.counting, false);
+        (l.tile, l.level, if counting { l.calls } else { 0 }, std::mem::replace(&mut l.active, false), words)
     });
+    if calls == 0 && !active {
+        return;
+    }
     let mut sh = SHARED.lock().unwrap_or_else(|e| e.into_inner());
     sh.calls += calls;
     if !active {
@@ -180,6 +201,9 @@ pub fn tile_end() {
 impl ThreadLog {
     /// Logs one call: op word, then the lanes that changed and k.
     fn push(&mut self, op: u32, pixel: U8, sample: U8, dim: u32, k: Option<U8>) {
+        if !self.counting {
+            return;
+        }
         self.calls += 1;
         if !self.active {
             return;
@@ -274,6 +298,9 @@ pub fn light_streams(pixels: impl IntoIterator<Item = U8>, sample: U8, dim: u32)
 pub fn light_point(stream: u32, k: u32) {
     if recording() {
         LOG.with_borrow_mut(|l| {
+            if !l.counting {
+                return;
+            }
             l.calls += 1;
             if l.active {
                 l.words.extend([OP_STREAM_POINT, stream, k]);
@@ -323,7 +350,7 @@ pub enum ReplayMode {
 }
 
 /// What a recording render logged: the kept tiles' calls, and the count of every call.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Recording {
     tiles: Vec<TileLog>,
     calls: u64,
@@ -339,6 +366,11 @@ impl Recording {
     /// Calls in the log (all of them unless the cap kept a subset of the tiles).
     pub fn recorded_calls(&self) -> u64 {
         self.tiles.iter().map(|t| t.calls).sum()
+    }
+
+    /// The log holds a subset of the render's calls (the cap was reached).
+    pub fn is_subset(&self) -> bool {
+        self.recorded_calls() < self.calls
     }
 
     /// Tiles in the log.

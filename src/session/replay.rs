@@ -70,8 +70,10 @@ pub fn record(
     cap_words: usize,
 ) -> (Recording, Vec<[f32; 3]>) {
     replay::start(cap_words);
+    pool.broadcast(|_| replay::arm(true));
     let mut film = Film::new(scene.desc.width, scene.desc.height);
     render::render(scene, it, &mut film, 0..it.spp, pool);
+    pool.broadcast(|_| replay::arm(false));
     (replay::finish(), film.mean())
 }
 
@@ -166,3 +168,7 @@ pub fn replay_table(r: &SamplerReplay) -> String {
     s.pop();
     s
 }
+
+#[cfg(test)]
+#[path = "replay_tests.rs"]
+mod tests;
