@@ -48,6 +48,7 @@ pub enum Phase {
 
 /// Number of phases.
 pub const N_PHASES: usize = 9;
+const _: () = assert!(N_PHASES <= 32, "leaf phases are bits of a u32");
 
 /// Every phase in table order.
 pub const PHASES: [Phase; N_PHASES] = [
@@ -88,8 +89,8 @@ static EMPTY_TICKS: AtomicU64 = AtomicU64::new(0);
 /// ticks from which a [`leaf`] span is long enough to time every time (2 us)
 static EXACT_TICKS: AtomicU64 = AtomicU64::new(u64::MAX);
 
-/// A short [`leaf`] span is timed with probability 1 / `LEAF_RATE` (and then counts `LEAF_RATE`
-/// times).
+/// A short [`leaf`] span is timed once in `LEAF_RATE` on average (gaps drawn uniformly from
+/// 1..2 `LEAF_RATE`, independently of the spans) and then counts `LEAF_RATE` times.
 pub const LEAF_RATE: u64 = 16;
 
 /// Leaf spans of a phase whose last timed span took at least this long are all timed (the clock's
@@ -122,8 +123,10 @@ struct State {
     since: Cell<u64>,
     switches: Cell<u32>,
     rng: Cell<u32>,
-    /// ticks of the last timed leaf span per phase
-    last: [Cell<u64>; N_PHASES],
+    /// leaf spans until the next timed one
+    countdown: Cell<u32>,
+    /// bit p: the last timed leaf span of phase p was long, so each of its spans is timed
+    exact: Cell<u32>,
     acc: [Cell<u64>; N_PHASES],
     est: [Cell<u64>; N_PHASES * N_PHASES],
 }
@@ -135,7 +138,8 @@ thread_local! {
             since: Cell::new(0),
             switches: Cell::new(0),
             rng: Cell::new(0x9e37_79b9),
-            last: [const { Cell::new(0) }; N_PHASES],
+            countdown: Cell::new(1),
+            exact: Cell::new(0),
             acc: [const { Cell::new(0) }; N_PHASES],
             est: [const { Cell::new(0) }; N_PHASES * N_PHASES],
         }
@@ -249,7 +253,9 @@ fn leaf_end(l: &Leaf) {
             return;
         }
         let d = now.wrapping_sub(l.t0).saturating_sub(EMPTY_TICKS.load(Ordering::Relaxed));
-        st.last[l.phase].set(d);
+        let bit = 1u32 << l.phase;
+        let long = d >= EXACT_TICKS.load(Ordering::Relaxed);
+        st.exact.set(if long { st.exact.get() | bit } else { st.exact.get() & !bit });
         let e = &st.est[st.current.get() * N_PHASES + l.phase];
         e.set(e.get() + d * l.weight);
     })
@@ -257,9 +263,10 @@ fn leaf_end(l: &Leaf) {
 
 /// Enters leaf phase `phase` until the returned guard drops: for short, frequent spans (one
 /// sampler or emitter call, one hit gather) that contain no [`scope`]. One span in
-/// [`LEAF_RATE`] (chosen by a per-thread random stream) is timed and counts `LEAF_RATE` times,
-/// or every span when the phase's last timed span took [`LEAF_EXACT_NS`] or more (an unbiased
-/// estimate either way: the probability is fixed before the span starts). At [`tile_end`] the
+/// [`LEAF_RATE`] (random gaps of a per-thread stream, one counter decrement per span untimed) is
+/// timed and counts `LEAF_RATE` times, or every span when the phase's last timed span took
+/// [`LEAF_EXACT_NS`] or more (unbiased either way: whether a span is timed is settled before it
+/// starts, independently of its length). At [`tile_end`] the
 /// estimate moves from the phase the span ran in to `phase`, so the phases still sum to the
 /// tile. Nothing when profiling is off.
 #[inline]
@@ -270,17 +277,20 @@ pub fn leaf(phase: Phase) -> Leaf {
         return UNTIMED;
     }
     STATE.with(|st| {
-        let weight = if st.last[phase as usize].get() >= EXACT_TICKS.load(Ordering::Relaxed) {
+        let weight = if st.exact.get() & (1 << phase as u32) != 0 {
             1
         } else {
+            let c = st.countdown.get();
+            if c > 1 {
+                st.countdown.set(c - 1);
+                return UNTIMED;
+            }
             let mut x = st.rng.get();
             x ^= x << 13;
             x ^= x >> 17;
             x ^= x << 5;
             st.rng.set(x);
-            if u64::from(x) % LEAF_RATE != 0 {
-                return UNTIMED;
-            }
+            st.countdown.set(1 + x % (2 * LEAF_RATE as u32 - 1));
             LEAF_RATE
         };
         Leaf { t0: now().max(1), phase: phase as usize, switches: st.switches.get(), weight }
@@ -309,7 +319,7 @@ pub fn tile_end() -> [u64; N_PHASES] {
     STATE.with(|st| {
         switch(st, 0);
         let mut acc: [u64; N_PHASES] = std::array::from_fn(|i| st.acc[i].replace(0));
-        let est: Vec<u64> = st.est.iter().map(|c| c.replace(0)).collect();
+        let est: [u64; N_PHASES * N_PHASES] = std::array::from_fn(|i| st.est[i].replace(0));
         // Leaf estimates move out of the phase they ran in (at most all of its time).
         for (i, row) in est.chunks_exact(N_PHASES).enumerate() {
             let want: u64 = row.iter().sum();

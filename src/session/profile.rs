@@ -121,8 +121,10 @@ pub fn run_profile_capped(opts: &RenderOptions, repeats: usize, cap_words: usize
     bit_identical &= first_image.as_ref().is_none_or(|f| bits(f) == bits(&img));
     let mut sampler_replay = time_replay(&rec, &replay_sets(&integrator), samples, REPLAY_REPEATS);
     drop(rec);
-    sampler_replay.instrumented_ns_per_sample =
-        phases.iter().filter(|r| r.name.starts_with("sampler")).map(|r| r.ns_per_sample).sum();
+    // The phases are thread wall time; their share of the profiled render's CPU time compares
+    // with the replay's thread CPU time on a loaded machine too.
+    let sampler_share: f64 = phases.iter().filter(|r| r.name.starts_with("sampler")).map(|r| r.share).sum();
+    sampler_replay.instrumented_ns_per_sample = sampler_share * on.cpu_seconds * 1e9 / samples.max(1) as f64;
     Ok(Profile {
         scene: scene.desc.source.display().to_string(),
         total_seconds: total,

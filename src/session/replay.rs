@@ -30,7 +30,8 @@ pub struct KindReplay {
 pub struct SamplerReplay {
     /// nanoseconds of sampler work per camera sample with the render's own layouts, replayed
     pub ns_per_sample: f64,
-    /// the sampler phases of the profiled render, in nanoseconds per camera sample (for comparison)
+    /// the sampler phases of the profiled render, in nanoseconds per camera sample: their share of
+    /// the render times its worker CPU seconds (comparable with the replay's CPU time)
     pub instrumented_ns_per_sample: f64,
     /// the render's layouts per call site ("pixel stratified, light stratified, path stratified")
     pub layouts: String,
