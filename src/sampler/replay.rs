@@ -309,9 +309,9 @@ pub fn light_point(stream: u32, k: u32) {
     }
 }
 
-/// The layouts a replay draws from, one per call site: what the render had
-/// ([`Integrator`](../../strata/integrator/struct.Integrator.html)'s `pixel_set`, `light_set`,
-/// `path_set`, with its spp and seed), or one kind everywhere ([`ReplaySets::with_kind`]).
+/// The layouts a replay draws from, one per call site: what the render had (the integrator's
+/// `pixel_set`, `light_set` and `path_set`, with its spp and seed), or one kind everywhere
+/// ([`ReplaySets::with_kind`]).
 #[derive(Clone, Debug)]
 pub struct ReplaySets {
     /// the camera's pixel jitter layout
