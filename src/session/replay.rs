@@ -96,8 +96,11 @@ pub fn time_replay(rec: &Recording, sets: &ReplaySets, samples: u64, repeats: us
     let decode = best_ns(repeats, || rec.replay(sets, ReplayMode::DecodeOnly).1);
     // ns of the whole render per camera sample from the replayed subset's ns.
     let per_sample = |ns: f64| {
+        if rec.calls() == 0 {
+            return 0.0; // no sampler call: the sampler costs nothing
+        }
         if recorded == 0 {
-            return f64::NAN;
+            return f64::NAN; // every tile's log was over the cap: not measured (JSON null)
         }
         (ns - decode).max(0.0) / recorded as f64 * rec.calls() as f64 / samples.max(1) as f64
     };
