@@ -129,7 +129,8 @@ impl Camera<'_> {
         } else {
             // Stratified: the sample whose stratum holds the centre takes sample 0's stratum.
             let k = if centre && kind == SamplerKind::STRATIFIED { centre_swap(s, self.pixel_set.n()) } else { s };
-            let _p = crate::profile::scope(crate::profile::Phase::SamplerPixel);
+            let _p = crate::profile::leaf(crate::profile::Phase::SamplerPixel);
+            crate::sampler::replay::pixel_point(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(k));
             self.pixel_set.point_x8(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(k), self.seed)
         };
         let dir = self.lens.dirs8(pk.x + jx, pk.y + jy);

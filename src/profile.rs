@@ -9,15 +9,23 @@
 //! callbacks from inside `rtcIntersect8`/`rtcOccluded8`, where no scope can be entered (`accel`
 //! sits below this module), so `accel::user_geometry` counts the callbacks' ticks itself
 //! ([`crate::accel::take_callback_ticks`]) and the switch out of an Embree phase moves them from
-//! that phase to [`Phase::UserGeometry`]. The clock is the CPU's time-stamp counter ([`crate::accel::timestamp`],
-//! a few ns a read), converted to nanoseconds with a rate calibrated against `Instant` when
-//! profiling is turned on, and the sum is checked against the tiles' `Instant` time measured
-//! independently. Work outside the tiles that a profile covers is timed with `Instant` and added
-//! to both the phase and the total: the film merge after the tiles ([`Phase::Film`], in
-//! `render`) and the image encoding of the commands that write one ([`Phase::Output`], in
-//! `session`). Scopes sit at batch granularity (one 8-lane packet call or one tile loop),
-//! never per lane. Profiling off (the default) costs one
-//! relaxed atomic load per scope; it never changes what is computed, so images are bit-identical.
+//! that phase to [`Phase::UserGeometry`]. The clock is the CPU's time-stamp counter
+//! ([`crate::accel::timestamp`], a few ns a read), converted to nanoseconds with a rate
+//! calibrated against `Instant` when profiling is turned on, and the sum is checked against the
+//! tiles' `Instant` time measured independently. Work outside the tiles that a profile covers is
+//! timed with `Instant` and added to both the phase and the total: the film merge after the tiles
+//! ([`Phase::Film`], in `render`) and the image encoding of the commands that write one
+//! ([`Phase::Output`], in `session`).
+//!
+//! Scopes sit at batch granularity (a batch of packets traced back to back, one tile loop), never
+//! per lane; a scope of the phase already running costs no clock read, so a batch scope makes the
+//! per-packet scopes inside it free. Short, frequent spans (one sampler or emitter call, one hit
+//! gather) are [`leaf`] spans: one in [`LEAF_RATE`], picked at random, is timed and stands for
+//! `LEAF_RATE` spans, and the estimate moves from the phase the span ran in to the leaf's phase
+//! when the tile ends (an unbiased estimate, so the phases still sum to the tile; a clock read
+//! costs about 20 ns on a VM, which timing every span would pay twice per call). Profiling off
+//! (the default) costs one relaxed atomic load per scope; it never changes what is computed, so
+//! images are bit-identical.
 
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -109,20 +117,66 @@ impl Phase {
 static ENABLED: AtomicBool = AtomicBool::new(false);
 /// nanoseconds per tick, as f64 bits (0: not calibrated yet)
 static NS_PER_TICK: AtomicU64 = AtomicU64::new(0);
+/// ticks two back-to-back clock reads are apart at least (the clock's own cost, taken off leaf spans)
+static EMPTY_TICKS: AtomicU64 = AtomicU64::new(0);
 
-/// A thread's profiler state, in one thread-local (one lookup per switch, no array copies).
+/// ticks from which a [`leaf`] span is long enough to time every time (2 us)
+static EXACT_TICKS: AtomicU64 = AtomicU64::new(u64::MAX);
+
+/// A short [`leaf`] span is timed once in `LEAF_RATE` on average (gaps drawn uniformly from
+/// 1..2 `LEAF_RATE`, independently of the spans) and then counts `LEAF_RATE` times.
+pub const LEAF_RATE: u64 = 16;
+
+/// Leaf spans of a phase whose last timed span took at least this long are all timed (the clock's
+/// cost is then under 2% of the span, and preemption is charged as exactly as in a [`scope`]).
+pub const LEAF_EXACT_NS: f64 = 2000.0;
+
+#[cfg(test)]
+thread_local! {
+    /// Test builds: a clock the test drives (0: the real one), on this thread only.
+    static FAKE_CLOCK: Cell<u64> = const { Cell::new(0) };
+}
+
+/// The profiler's clock: the time-stamp counter (a test's fake clock in test builds).
+#[inline]
+fn now() -> u64 {
+    #[cfg(test)]
+    {
+        let f = FAKE_CLOCK.with(|c| c.get());
+        if f != 0 {
+            return f;
+        }
+    }
+    crate::accel::timestamp()
+}
+
+/// A thread's profiler state: the running phase, the last switch, exclusive ticks per phase, and
+/// the leaf estimates (ticks of leaf phase `j` measured inside phase `i`: `est[i * N + j]`).
 struct State {
-    /// the running phase
     current: Cell<usize>,
-    /// tick of the last switch
     since: Cell<u64>,
-    /// ticks per phase
+    switches: Cell<u32>,
+    rng: Cell<u32>,
+    /// leaf spans until the next timed one
+    countdown: Cell<u32>,
+    /// bit p: the last timed leaf span of phase p was long, so each of its spans is timed
+    exact: Cell<u32>,
     acc: [Cell<u64>; N_PHASES],
+    est: [Cell<u64>; N_PHASES * N_PHASES],
 }
 
 thread_local! {
     static STATE: State = const {
-        State { current: Cell::new(0), since: Cell::new(0), acc: [const { Cell::new(0) }; N_PHASES] }
+        State {
+            current: Cell::new(0),
+            since: Cell::new(0),
+            switches: Cell::new(0),
+            rng: Cell::new(0x9e37_79b9),
+            countdown: Cell::new(1),
+            exact: Cell::new(0),
+            acc: [const { Cell::new(0) }; N_PHASES],
+            est: [const { Cell::new(0) }; N_PHASES * N_PHASES],
+        }
     };
 }
 
@@ -130,12 +184,21 @@ thread_local! {
 /// time it is turned on, the tick clock is calibrated against `Instant` (about 20 ms).
 pub fn set_enabled(on: bool) {
     if on && NS_PER_TICK.load(Ordering::SeqCst) == 0 {
-        let (t, c) = (Instant::now(), crate::accel::timestamp());
+        let (t, c) = (Instant::now(), now());
         while t.elapsed().as_millis() < 20 {
             std::hint::spin_loop();
         }
-        let (ns, ticks) = (t.elapsed().as_nanos() as f64, crate::accel::timestamp().wrapping_sub(c));
+        let (ns, ticks) = (t.elapsed().as_nanos() as f64, now().wrapping_sub(c));
         NS_PER_TICK.store((ns / ticks.max(1) as f64).to_bits(), Ordering::SeqCst);
+        let empty = (0..1000)
+            .map(|_| {
+                let a = now();
+                now().wrapping_sub(a)
+            })
+            .min()
+            .unwrap_or(0);
+        EMPTY_TICKS.store(empty, Ordering::SeqCst);
+        EXACT_TICKS.store((LEAF_EXACT_NS / ns_per_tick()) as u64, Ordering::SeqCst);
     }
     ENABLED.store(on, Ordering::SeqCst);
     crate::accel::set_callback_timing(on);
@@ -176,21 +239,20 @@ pub fn enabled() -> bool {
 /// user-geometry callbacks' ticks counted meanwhile (inside the Embree call that just ended) go to
 /// [`Phase::UserGeometry`] instead.
 #[inline]
-fn switch(next: usize) -> usize {
-    let now = crate::accel::timestamp();
-    STATE.with(|st| {
-        let prev = st.current.replace(next);
-        let spent = now.saturating_sub(st.since.replace(now));
-        // Callbacks only run inside Embree calls: only a switch out of an Embree phase has any.
-        let embree = prev == Phase::EmbreeIntersect as usize || prev == Phase::EmbreeOccluded as usize;
-        let nested = if embree { crate::accel::take_callback_ticks().min(spent) } else { 0 };
-        let add = |i: usize, t: u64| st.acc[i].set(st.acc[i].get() + t);
-        add(prev, spent - nested);
-        if nested > 0 {
-            add(Phase::UserGeometry as usize, nested);
-        }
-        prev
-    })
+fn switch(st: &State, next: usize) -> usize {
+    let now = now();
+    let prev = st.current.replace(next);
+    let spent = now.saturating_sub(st.since.replace(now));
+    // Callbacks only run inside Embree calls: only a switch out of an Embree phase has any.
+    let embree = prev == Phase::EmbreeIntersect as usize || prev == Phase::EmbreeOccluded as usize;
+    let nested = if embree { crate::accel::take_callback_ticks().min(spent) } else { 0 };
+    let add = |i: usize, t: u64| st.acc[i].set(st.acc[i].get() + t);
+    add(prev, spent - nested);
+    if nested > 0 {
+        add(Phase::UserGeometry as usize, nested);
+    }
+    st.switches.set(st.switches.get().wrapping_add(1));
+    prev
 }
 
 /// A running phase; dropping it restores the outer phase.
@@ -202,19 +264,97 @@ impl Drop for Scope {
     #[inline]
     fn drop(&mut self) {
         if let Some(o) = self.outer {
-            switch(o);
+            STATE.with(|st| switch(st, o));
         }
     }
 }
 
-/// Enters `phase` until the returned guard drops (nothing when profiling is off).
+/// Enters `phase` until the returned guard drops (nothing when profiling is off, or when `phase`
+/// is already running: a scope around a batch makes the per-packet scopes inside it free).
 #[inline]
 #[must_use = "the phase ends when the guard drops"]
 pub fn scope(phase: Phase) -> Scope {
     if !enabled() {
         return Scope { outer: None };
     }
-    Scope { outer: Some(switch(phase as usize)) }
+    STATE.with(|st| {
+        if st.current.get() == phase as usize {
+            return Scope { outer: None };
+        }
+        Scope { outer: Some(switch(st, phase as usize)) }
+    })
+}
+
+/// A sampled span of a leaf phase; see [`leaf`].
+pub struct Leaf {
+    /// start tick (0: this span is not timed)
+    t0: u64,
+    phase: usize,
+    switches: u32,
+    /// spans this one stands for (1 / its probability of being timed)
+    weight: u64,
+}
+
+impl Drop for Leaf {
+    #[inline]
+    fn drop(&mut self) {
+        if self.t0 != 0 {
+            leaf_end(self);
+        }
+    }
+}
+
+#[inline(never)]
+fn leaf_end(l: &Leaf) {
+    let now = now();
+    STATE.with(|st| {
+        // A scope inside the span already charged its time: the estimate would count it twice.
+        if st.switches.get() != l.switches {
+            return;
+        }
+        let d = now.wrapping_sub(l.t0).saturating_sub(EMPTY_TICKS.load(Ordering::Relaxed));
+        let bit = 1u32 << l.phase;
+        let long = d >= EXACT_TICKS.load(Ordering::Relaxed);
+        st.exact.set(if long { st.exact.get() | bit } else { st.exact.get() & !bit });
+        let e = &st.est[st.current.get() * N_PHASES + l.phase];
+        e.set(e.get() + d * l.weight);
+    })
+}
+
+/// Enters leaf phase `phase` until the returned guard drops: for short, frequent spans (one
+/// sampler or emitter call, one hit gather) that contain no [`scope`]. One span in
+/// [`LEAF_RATE`] (random gaps of a per-thread stream, one counter decrement per span untimed) is
+/// timed and counts `LEAF_RATE` times, or every span when the phase's last timed span took
+/// [`LEAF_EXACT_NS`] or more (unbiased either way: whether a span is timed is settled before it
+/// starts, independently of its length). At [`tile_end`] the
+/// estimate moves from the phase the span ran in to `phase`, so the phases still sum to the
+/// tile. Nothing when profiling is off.
+#[inline]
+#[must_use = "the phase ends when the guard drops"]
+pub fn leaf(phase: Phase) -> Leaf {
+    const UNTIMED: Leaf = Leaf { t0: 0, phase: 0, switches: 0, weight: 0 };
+    if !enabled() {
+        return UNTIMED;
+    }
+    STATE.with(|st| {
+        let weight = if st.exact.get() & (1 << phase as u32) != 0 {
+            1
+        } else {
+            let c = st.countdown.get();
+            if c > 1 {
+                st.countdown.set(c - 1);
+                return UNTIMED;
+            }
+            let mut x = st.rng.get();
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            st.rng.set(x);
+            st.countdown.set(1 + x % (2 * LEAF_RATE as u32 - 1));
+            LEAF_RATE
+        };
+        Leaf { t0: now().max(1), phase: phase as usize, switches: st.switches.get(), weight }
+    })
 }
 
 /// Starts timing a tile on this thread, in phase [`Phase::Other`].
@@ -224,8 +364,8 @@ pub fn tile_begin() {
         crate::accel::take_callback_ticks();
         STATE.with(|st| {
             st.current.set(0);
-            st.acc.iter().for_each(|a| a.set(0));
-            st.since.set(crate::accel::timestamp());
+            st.since.set(now());
+            st.acc.iter().chain(&st.est).for_each(|c| c.set(0));
         });
     }
 }
@@ -236,10 +376,34 @@ pub fn tile_end() -> [u64; N_PHASES] {
     if !enabled() {
         return [0; N_PHASES];
     }
-    switch(0);
     let k = ns_per_tick();
-    STATE.with(|st| std::array::from_fn(|i| (st.acc[i].replace(0) as f64 * k) as u64))
+    STATE.with(|st| {
+        switch(st, 0);
+        let mut acc: [u64; N_PHASES] = std::array::from_fn(|i| st.acc[i].replace(0));
+        let est: [u64; N_PHASES * N_PHASES] = std::array::from_fn(|i| st.est[i].replace(0));
+        // Leaf estimates move out of the phase they ran in (at most all of its time).
+        for (i, row) in est.chunks_exact(N_PHASES).enumerate() {
+            let want: u64 = row.iter().sum();
+            if want == 0 {
+                continue;
+            }
+            let take = want.min(acc[i]);
+            let mut moved = 0;
+            for (j, &e) in row.iter().enumerate() {
+                let m = (e as u128 * take as u128 / want as u128) as u64;
+                acc[j] += m;
+                moved += m;
+            }
+            acc[i] -= moved;
+        }
+        acc.map(|t| (t as f64 * k) as u64)
+    })
 }
+
+/// Test builds: profiling (and sampler recording) are process-wide switches; the library's tests
+/// that turn them on take turns with this lock.
+#[cfg(test)]
+pub(crate) static TEST_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 #[cfg(test)]
 mod tests {
@@ -256,6 +420,7 @@ mod tests {
     /// and the phases add up to the tile's duration.
     #[test]
     fn nested_scopes_are_exclusive_and_sum_to_the_tile() {
+        let _g = TEST_LOCK.lock().unwrap_or_else(|e| e.into_inner());
         set_enabled(true);
         let t = Instant::now();
         tile_begin();
@@ -279,5 +444,38 @@ mod tests {
         let ei = acc[Phase::EmbreeIntersect as usize];
         assert!((1_900_000..2_900_000).contains(&ei), "inner time not charged to the outer scope: {ei}");
         assert!(acc[Phase::Other as usize] >= 950_000);
+    }
+
+    /// Leaf spans on a clock the test drives (deterministic: the random stream is the thread's
+    /// own): short spans, one in `LEAF_RATE` timed, and long ones, all timed, each give the leaf
+    /// phase about the time spent in them, taken out of the phase they ran in; the phases sum to
+    /// the tile exactly.
+    #[test]
+    fn leaf_spans_are_estimated_from_a_sample_and_sum_to_the_tile() {
+        let _g = TEST_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+        set_enabled(true); // calibrates on the real clock
+        let (exact, empty) = (EXACT_TICKS.load(Ordering::SeqCst), EMPTY_TICKS.load(Ordering::SeqCst));
+        let tick = |dt: u64| FAKE_CLOCK.with(|c| c.set(c.get() + dt));
+        for (span, n, tol) in [(exact / 2, 6400u64, 0.15), (exact * 4, 400, 0.05)] {
+            FAKE_CLOCK.with(|c| c.set(1_000_000));
+            tile_begin();
+            for _ in 0..n {
+                let l = leaf(Phase::SamplerPixel);
+                tick(span);
+                drop(l);
+                tick(span / 3);
+            }
+            let acc = tile_end();
+            let k = ns_per_tick();
+            let total = (n * (span + span / 3)) as f64 * k;
+            let sum: u64 = acc.iter().sum();
+            assert!((sum as f64 / total - 1.0).abs() < 1e-5, "sum {sum} of {total}");
+            let want = (n * (span - empty)) as f64 * k;
+            let got = acc[Phase::SamplerPixel as usize] as f64;
+            assert!((got / want - 1.0).abs() < tol, "span {span}: leaf {got} of {want}");
+            assert!(acc[Phase::Other as usize] > 0);
+        }
+        FAKE_CLOCK.with(|c| c.set(0));
+        set_enabled(false);
     }
 }

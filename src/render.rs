@@ -117,12 +117,14 @@ pub fn render_counted(
                 let profiling = crate::profile::enabled();
                 let w0 = profiling.then(Instant::now);
                 crate::profile::tile_begin();
+                crate::sampler::replay::tile_begin(ty * tiles_x + tx);
                 let mut counters = Counters::default();
                 let mut r = {
                     let _f = crate::profile::scope(crate::profile::Phase::Film);
                     TileResult::from_film(film_in, tx * TILE, ty * TILE)
                 };
                 render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
+                crate::sampler::replay::tile_end();
                 let phases = crate::profile::tile_end();
                 let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
                 tiles_done.fetch_add(1, Ordering::Relaxed);

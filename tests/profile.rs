@@ -314,3 +314,55 @@ fn unwritable_profile_outputs_fail_before_rendering() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("cannot write there"), "{err}");
 }
+
+/// `strata profile --json`: `sampler_replay` has this render's replayed ns per sample and one
+/// `by_kind` entry per registered sampler, in registry order, each replaying the same calls; the
+/// table prints them.
+#[test]
+fn cli_json_has_the_sampler_replay_with_one_entry_per_registered_kind() {
+    let dir = std::env::temp_dir().join(format!("strata-profile-replay-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let json = dir.join("p.json");
+    let r = std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
+        .args(["profile", "--size", "32x24", "--spp", "2", "--threads", "2", "--repeats", "1"])
+        .args(["--pixel-sampler", "sobol", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let out = String::from_utf8_lossy(&r.stdout);
+    assert!(out.contains("sampler replay (pixel sobol, "), "{out}");
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rep = &j["sampler_replay"];
+    assert!(rep["ns_per_sample"].as_f64().is_some_and(|v| v > 0.0), "{rep}");
+    let calls = rep["calls"].as_u64().unwrap();
+    assert!(calls > 0);
+    assert_eq!(rep["samples"], 32 * 24 * 2);
+    assert_eq!(rep["recorded_calls"].as_u64(), Some(calls), "a small render is replayed whole");
+    assert_eq!(rep["subset"], false);
+    let by_kind = rep["by_kind"].as_array().unwrap();
+    let names: Vec<&str> = by_kind.iter().map(|k| k["kind"].as_str().unwrap()).collect();
+    let registry: Vec<&str> = strata::sampler::SAMPLERS.iter().map(|s| s.name).collect();
+    assert_eq!(names, registry);
+    for k in by_kind {
+        assert!(k["ns_per_sample"].as_f64().is_some_and(|v| v > 0.0), "{k}");
+        assert_eq!(k["calls"].as_u64(), Some(calls));
+        assert!(out.contains(k["kind"].as_str().unwrap()));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A log capped below the render's size replays a subset of the tiles, says so, and still
+/// counts every call of the render.
+#[test]
+fn a_capped_replay_says_it_is_a_scaled_subset() {
+    let _g = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let o = RenderOptions { size: Some((96, 64)), ..opts(IntegratorKind::PathTracer) };
+    let full = strata::session::run_profile(&o, 1).unwrap().sampler_replay.unwrap();
+    let capped = strata::session::run_profile_capped(&o, 1, 2000).unwrap().sampler_replay.unwrap();
+    assert!(!full.subset && capped.subset);
+    assert_eq!(capped.calls, full.calls);
+    assert!(capped.recorded_calls < full.calls && capped.log_bytes <= 8000);
+    assert!(capped.ns_per_sample.is_finite() && capped.ns_per_sample > 0.0);
+    assert!(strata::session::replay::replay_table(&capped).contains("log capped"));
+}

@@ -7,6 +7,7 @@ use super::path::PathScratch;
 use super::stats::{Counters, RayKind, RayLog};
 use crate::accel::{Ray8, RayHit8};
 use crate::camera::{Camera, PixelPacket};
+use crate::light::emitters::LightSample8;
 use crate::sampler::Stream;
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
@@ -44,6 +45,7 @@ impl<'a> Tracer<'a> {
     /// lanes traced.
     #[inline]
     pub fn intersect_all(&mut self, packets: &mut [(RayHit8, Mask8)], kind: RayKind) {
+        let _p = crate::profile::scope(crate::profile::Phase::EmbreeIntersect);
         for (rh, active) in packets.iter_mut() {
             *active = self.intersect(rh, kind, *active);
         }
@@ -81,6 +83,9 @@ pub struct Scratch {
     pub(super) contrib: Vec<Vec3x8>,
     pub(super) owner: Vec<u32>,
     pub(super) streams: Vec<Stream<U8>>,
+    /// `direct`: per shading packet, its unit-square light sample and its point on the light
+    pub(super) light_uv: Vec<(F8, F8)>,
+    pub(super) light_points: Vec<LightSample8>,
     pub(super) path: PathScratch,
     pub(super) one: Vec<Vec3x8>,
 }

@@ -29,7 +29,6 @@ impl Group<'_> {
     /// A point on the group's light(s) for the unit-square sample (u, v).
     #[inline]
     fn sample(self, scene: &Scene, u: F8, v: F8, active: Mask8) -> LightSample8 {
-        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
         match self {
             Group::Quad(e) => e.sample_x8(u, v),
             Group::Triangles => scene.emitters.sample_triangles_x8(u, v, active),
@@ -63,21 +62,39 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
         {
             let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
             sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
+            crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, dim);
         }
         for k in 0..n_light {
             sc.shadow.clear();
             sc.contrib.clear();
             sc.owner.clear();
+            // Point k of every shading packet, then the light points: one batch each (profiled
+            // as two spans, not two per packet).
+            sc.light_uv.clear();
+            sc.light_points.clear();
+            {
+                let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
+                for (i, stream) in sc.streams.iter().enumerate() {
+                    if sc.shade[i].any() {
+                        crate::sampler::replay::light_point(i as u32, k);
+                        sc.light_uv.push(stream.point(k));
+                    }
+                }
+            }
+            {
+                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                let shading = sc.shade.iter().filter(|s| s.any());
+                for (&(u, v), &shade) in sc.light_uv.iter().zip(shading) {
+                    sc.light_points.push(group.sample(scene, u, v, shade));
+                }
+            }
+            let mut next_point = sc.light_points.iter();
             for i in 0..pks.len() {
                 let (sh, shade) = (&sc.hits[i], sc.shade[i]);
                 if shade.none() {
                     continue;
                 }
-                let (u, v) = {
-                    let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-                    sc.streams[i].point(k)
-                };
-                let ls = group.sample(scene, u, v, shade);
+                let Some(&ls) = next_point.next() else { break };
                 let to = ls.y - sh.p;
                 let d2 = to.length_squared();
                 let inv_d = F8::ONE / d2.sqrt();
@@ -92,7 +109,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 }
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
                 let f = {
-                    let _p = crate::profile::scope(crate::profile::Phase::BsdfEval);
+                    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
                     material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
                 };
                 let g = cos_i * cos_l * inv_d * inv_d;
@@ -136,6 +153,7 @@ fn trace_shadow_batch(
     owner: &[u32],
     acc: &mut [Vec3x8],
 ) {
+    let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
     for (j, (ray, lit)) in shadow.iter_mut().enumerate() {
         let occluded = tracer.occluded(ray, *lit);
         acc[owner[j] as usize] += masked(contrib[j], *lit & !occluded);

@@ -22,7 +22,7 @@ use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
 use crate::light::emitters::LightSample8;
 use crate::light::select::LightSelection;
-use crate::sampler::permute_x8;
+use crate::sampler::shuffled_index_x8;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
 use crate::scene::desc::{ImportanceSampling, Nee};
@@ -113,10 +113,9 @@ impl Integrator {
     /// Stratified 2D point of dimension `dim` for pixel sample `s`, strata shuffled per (pixel, dim).
     #[inline]
     fn path_point(&self, pixel: U8, s: U8, dim: u32) -> (F8, F8) {
-        let _p = crate::profile::scope(crate::profile::Phase::SamplerPath);
-        let n = self.spp;
-        let key_base = (self.seed as u32) ^ ((self.seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-        let k = permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)));
+        let _p = crate::profile::leaf(crate::profile::Phase::SamplerPath);
+        crate::sampler::replay::path_point(pixel, s, dim);
+        let k = shuffled_index_x8(s, self.spp, pixel, dim, self.seed);
         self.path_set.point_x8(pixel, U8::splat(0), dim, k, self.seed)
     }
 }
@@ -205,7 +204,7 @@ impl Integrator {
                     Nee::On => F8::splat(if v == 1 { 1.0 } else { 0.0 }),
                     Nee::Mis if v == 1 => F8::ONE,
                     Nee::Mis => {
-                        let _p = crate::profile::scope(crate::profile::Phase::Mis);
+                        let _p = crate::profile::leaf(crate::profile::Phase::Mis);
                         let p_light = if sel == LightSelection::Uniform {
                             light_pdf_at_hit(scene, &sh, rh, is_light)
                         } else {
@@ -266,7 +265,7 @@ impl Integrator {
                             return;
                         }
                         let (f, pdf_b) = {
-                            let _p = crate::profile::scope(crate::profile::Phase::BsdfEval);
+                            let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
                             mat.eval_pdf_k::<L>(self.strategy, wo, frame.to_local(wi), lit)
                         };
                         // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
@@ -306,7 +305,7 @@ impl Integrator {
                         // historical path, kept bit-identical.
                         LightSelection::Uniform => {
                             let ls = {
-                                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                 scene.emitters.sample_x8(u_choice, u, w, shade)
                             };
                             push(ls, None, None, shade)
@@ -323,7 +322,7 @@ impl Integrator {
                                 for j in 0..n_all {
                                     let (uj, wj) = lattice_point(u, w, j, n_all);
                                     let ls = {
-                                        let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                         e.sample_x8(uj, wj)
                                     };
                                     push(ls, scale, mis_n, shade);
@@ -332,7 +331,7 @@ impl Integrator {
                         }
                         LightSelection::Power | LightSelection::Spatial => {
                             let (ls, ok) = {
-                                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
+                                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                 let (idx, pmf) = self.light_sampler.sample_x8(u_choice, sh.p, sh.n, shade);
                                 let ok = shade & pmf.simd_gt(F8::ZERO);
                                 let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
@@ -347,7 +346,7 @@ impl Integrator {
                 if bounce_here {
                     let u2 = self.path_point(pixel, s, dims + 2);
                     let (wi_l, pdf, f) = {
-                        let _p = crate::profile::scope(crate::profile::Phase::BsdfSample);
+                        let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
                         mat.sample_k::<L>(self.strategy, wo, [u2.0, u2.1], u_lobe, shade)
                     };
                     let cos = wi_l.z;
@@ -400,11 +399,13 @@ impl Integrator {
                 sc.shadow_contrib.push(Vec3x8::from_lanes(std::array::from_fn(|i| chunk[i].contrib)));
                 sc.shadow_slots.push(std::array::from_fn(|i| chunk[i].slot));
             }
+            let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
             for (j, (ray, lit)) in sc.shadow.iter_mut().enumerate() {
                 let occluded = tracer.occluded(ray, *lit);
                 let visible = *lit & !occluded;
                 add_lanes(&mut sc.radiance, &sc.shadow_slots[j], masked(sc.shadow_contrib[j], visible));
             }
+            drop(occluded_batch);
             pad8(&mut sc.next, PathLane::DEAD);
             std::mem::swap(&mut sc.lanes, &mut sc.next);
             v += 1;

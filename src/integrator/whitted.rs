@@ -98,7 +98,7 @@ fn local_shading(scene: &Scene, sh: &SurfaceHit8, alive: Mask8, tracer: &mut Tra
 /// kd max(n.l, 0) + ks max(n.h, 0)^s with h = normalize(l + wo); zero on inactive lanes.
 #[inline]
 fn blinn_phong(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
-    let _p = crate::profile::scope(crate::profile::Phase::BsdfEval);
+    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
     let cos_l = sh.n.dot(wi).max(F8::ZERO);
     let h = (wi + sh.wo).normalize_or_zero();
     let nh = sh.n.dot(h);

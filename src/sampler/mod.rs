@@ -23,7 +23,8 @@
 //! [`Lanes`]), so they agree bit for bit; the tests check it anyway for every registered layout.
 //!
 //! Files: `layout.rs` (the trait), `lanes.rs`, `hash.rs`, `divisor.rs`, `grid.rs` (helpers),
-//! `permute.rs`, one file per layout, `tests.rs` (generic tests over the registry).
+//! `permute.rs`, one file per layout, `tests.rs` (generic tests over the registry), `replay.rs`
+//! (the call log of a render and its replay, for `strata profile`).
 
 use crate::simd::{F8, U8};
 
@@ -33,12 +34,16 @@ mod hash;
 mod lanes;
 mod layout;
 mod permute;
+pub mod replay;
+
+#[cfg(test)]
+mod slow_test;
 
 pub use grid::strata_shape;
 pub use halton::radical_inverse;
 pub use lanes::Lanes;
 pub use layout::{DynLayout, Layout, SetShape, StreamKey};
-pub use permute::{permute, permute_x8};
+pub use permute::{permute, permute_x8, shuffled_index_x8};
 pub use stratified::GridTable;
 
 use hash::{hash, unit};
@@ -135,6 +140,10 @@ impl SamplerKind {
     /// Progressive multi-jittered (0,2) sequence (table-based, XOR-scrambled) at `sample * n + k`.
     pub const PMJ02: Self = Self::named("pmj02");
 
+    /// Test builds only: a stratified layout spinning in every call (not in the registry).
+    #[cfg(test)]
+    pub(crate) const SLOW_TEST: Self = SamplerKind(u8::MAX);
+
     /// Every registered kind, in registry order.
     pub const ALL: [SamplerKind; SAMPLERS.len()] = {
         let mut all = [SamplerKind(0); SAMPLERS.len()];
@@ -178,6 +187,10 @@ impl SamplerKind {
 
     /// Its registry entry.
     pub fn info(self) -> &'static SamplerInfo {
+        #[cfg(test)]
+        if self.0 == u8::MAX {
+            return &slow_test::INFO;
+        }
         &SAMPLERS[self.0 as usize]
     }
 
@@ -295,6 +308,8 @@ impl PointSet {
     /// Point k of the set for (pixel, sample, dim) under seed, as [`point_2d`]; coordinates in [0, 1).
     #[inline]
     pub fn point(&self, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> [f32; 2] {
+        #[cfg(test)]
+        replay::count_api_call();
         let (x, y) = self.kind.layout().point_1(&self.shape, pixel, sample, dim, k, seed);
         [x, y]
     }
@@ -302,6 +317,8 @@ impl PointSet {
     /// Eight lanes of [`PointSet::point`], bit-identical per lane; coordinates in [0, 1).
     #[inline]
     pub fn point_x8(&self, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
+        #[cfg(test)]
+        replay::count_api_call();
         self.kind.layout().point_8(&self.shape, pixel, sample, dim, k, seed)
     }
 
@@ -310,6 +327,8 @@ impl PointSet {
     /// bit and is much cheaper (the cell of a lane-uniform k is found in scalar code).
     #[inline]
     pub fn stream_x8(&self, pixel: U8, sample: U8, dim: u32, seed: u64) -> Stream<U8> {
+        #[cfg(test)]
+        replay::count_api_call();
         let layout = self.kind.layout();
         Stream { layout, shape: self.shape, key: layout.stream_8(&self.shape, pixel, sample, dim, seed) }
     }
@@ -317,6 +336,8 @@ impl PointSet {
     /// Scalar twin of [`PointSet::stream_x8`].
     #[inline]
     pub fn stream_1(&self, pixel: u32, sample: u32, dim: u32, seed: u64) -> Stream<u32> {
+        #[cfg(test)]
+        replay::count_api_call();
         let layout = self.kind.layout();
         Stream { layout, shape: self.shape, key: layout.stream_1(&self.shape, pixel, sample, dim, seed) }
     }
@@ -340,6 +361,8 @@ impl Stream<U8> {
     /// Point k of the set, coordinates in [0, 1); equal to `PointSet::point_x8` for the same k.
     #[inline]
     pub fn point(&self, k: u32) -> (F8, F8) {
+        #[cfg(test)]
+        replay::count_api_call();
         self.layout.stream_point_8(&self.shape, &self.key, k)
     }
 }
@@ -348,6 +371,8 @@ impl Stream<u32> {
     /// Point k of the set, coordinates in [0, 1); equal to `PointSet::point` for the same k.
     #[inline]
     pub fn point(&self, k: u32) -> (f32, f32) {
+        #[cfg(test)]
+        replay::count_api_call();
         self.layout.stream_point_1(&self.shape, &self.key, k)
     }
 }

@@ -85,3 +85,12 @@ fn permute_round<L: Lanes>(x: L, key: L, mask: u32, half: u32) -> L {
     let x = x.xor(x.shr(half));
     x.xor(key.shr(16).and(m))
 }
+
+/// The path tracer's stratum for pixel samples `s` of dimension `dim`: [`permute_x8`] of `s` over
+/// `n` (the spp) keyed by (seed, dim, pixel), so strata are shuffled per (pixel, dimension) and
+/// dimensions are stratified independently of one another.
+#[inline]
+pub fn shuffled_index_x8(s: U8, n: u32, pixel: U8, dim: u32, seed: u64) -> U8 {
+    let key_base = (seed as u32) ^ ((seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
+    permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)))
+}

@@ -131,6 +131,8 @@ impl GridTable {
         if self.spans.is_empty() {
             return self.set.point(pixel, sample, dim, k, seed);
         }
+        #[cfg(test)]
+        super::replay::count_api_call();
         let k = k % self.set.n();
         let (x, y) = jitter_in(self.spans[k as usize], pixel, sample, dim, k, seed);
         [x, y]
@@ -142,6 +144,8 @@ impl GridTable {
         if self.spans.is_empty() {
             return self.set.point_x8(pixel, sample, dim, k, seed);
         }
+        #[cfg(test)]
+        super::replay::count_api_call();
         let k = self.set.shape().grid().n.rem(k);
         let ks = k.to_array();
         let cells: [[u32; 4]; 8] = std::array::from_fn(|i| self.spans[ks[i] as usize]);

@@ -316,7 +316,7 @@ impl Scene {
 
     /// Gathers the shading records of a packet's hits (rays `org + t dir`, `dir` unit).
     pub fn gather(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8) -> SurfaceHit8 {
-        let _p = crate::profile::scope(crate::profile::Phase::Gather);
+        let _p = crate::profile::leaf(crate::profile::Phase::Gather);
         let p = dir.mul_add(hits.t, org);
         let (geom, prim) = (hits.geom.to_array(), hits.prim.to_array());
         let valid = crate::simd::mask_to_bools(hits.hit);

@@ -11,6 +11,7 @@
 //! - [`rays`] — `strata rays`;
 //! - [`checks`] — command-line checks before rendering, the default light;
 //! - [`profile`] — `strata profile`;
+//! - [`replay`] — the sampler replay of `strata profile`;
 //! - [`error`] — [`SessionError`].
 
 pub mod checks;
@@ -21,6 +22,7 @@ pub mod pass;
 pub mod profile;
 pub mod progress;
 pub mod rays;
+pub mod replay;
 pub mod scene;
 pub mod stats;
 
@@ -28,7 +30,8 @@ pub use error::SessionError;
 pub use options::{default_first_sample, default_quantize, RenderOptions, DEFAULT_CHECKPOINT_EVERY, DEFAULT_SCENE};
 pub use output::{metadata, output_stem, run_render};
 pub use pass::{render_to_film, stop_on_signals, RenderOutput};
-pub use profile::{profile_table, run_profile, Profile};
+pub use profile::{profile_table, run_profile, run_profile_capped, Profile};
 pub use rays::{rates_table, run_rays};
+pub use replay::{KindReplay, SamplerReplay};
 pub use scene::{is_obj, load_scene, parse_camera, prepare, scene_hash};
 pub use stats::{stats_json, summary};

@@ -4,6 +4,7 @@
 //! [`Profile`] (JSON) comes out of `render`/`reference --profile` and, per variant, `compare
 //! --profile` ([`Profile::from_stats`]), and [`profile_svg`] draws profiles as stacked bars.
 
+use super::replay::{record, replay_sets, replay_table, time_replay, SamplerReplay, REPLAY_REPEATS};
 use super::{prepare, RenderOptions, SessionError};
 use crate::film;
 use crate::film::Film;
@@ -59,6 +60,9 @@ pub struct Profile {
     pub threads: usize,
     /// renders per mode, interleaved (1 for a profile of one command's renders)
     pub repeats: usize,
+    /// the sampler alone on the render's exact call sequence, and with every other kind
+    /// (`strata profile` only, else null)
+    pub sampler_replay: Option<SamplerReplay>,
 }
 
 impl Profile {
@@ -95,6 +99,7 @@ impl Profile {
             rays,
             threads: st.threads,
             repeats: 1,
+            sampler_replay: None,
         }
     }
 
@@ -153,8 +158,14 @@ fn render_once(
 }
 
 /// `strata profile`: renders the job `repeats` times with profiling off and on, interleaved, and
-/// returns the phase split of the fastest profiled render.
+/// returns the phase split of the fastest profiled render, then renders it once more recording
+/// the sampler calls and times their replay ([`super::replay`]).
 pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, SessionError> {
+    run_profile_capped(opts, repeats, crate::sampler::replay::DEFAULT_CAP_WORDS)
+}
+
+/// [`run_profile`] keeping at most `cap_words` words of the sampler call log.
+pub fn run_profile_capped(opts: &RenderOptions, repeats: usize, cap_words: usize) -> Result<Profile, SessionError> {
     let (scene, integrator) = prepare(opts)?;
     let pool = render::thread_pool(opts.threads)?;
     let repeats = repeats.max(1);
@@ -176,10 +187,18 @@ pub fn run_profile(opts: &RenderOptions, repeats: usize) -> Result<Profile, Sess
     }
     let (off, on) = (off.unwrap_or_default(), on.unwrap_or_default());
     let mut p = Profile::from_stats(&scene.desc.source.display().to_string(), &on);
+    let (rec, img) = record(&scene, &integrator, &pool, cap_words);
+    bit_identical &= first_image.as_ref().is_none_or(|f| bits(f) == bits(&img));
+    let mut sampler_replay = time_replay(&rec, &replay_sets(&integrator), p.samples, REPLAY_REPEATS);
+    drop(rec);
+    // The phases are thread wall time; their share of the profiled render's CPU time compares
+    // with the replay's thread CPU time on a loaded machine too.
+    sampler_replay.instrumented_ns_per_sample = p.sampler_share() * on.cpu_seconds * 1e9 / p.samples.max(1) as f64;
     p.cpu_seconds_unprofiled = Some(off.cpu_seconds);
     p.overhead = Some(on.cpu_seconds / off.cpu_seconds.max(1e-12) - 1.0);
     p.bit_identical = Some(bit_identical);
     p.repeats = repeats;
+    p.sampler_replay = Some(sampler_replay);
     Ok(p)
 }
 
@@ -221,6 +240,10 @@ pub fn profile_table(p: &Profile) -> String {
     }
     if let Some(same) = p.bit_identical {
         s += if same { "; image bit-identical with profiling off" } else { "; image DIFFERS with profiling off" };
+    }
+    if let Some(r) = &p.sampler_replay {
+        s += "\n";
+        s += &replay_table(r);
     }
     s
 }
