@@ -42,6 +42,24 @@ fn estimate(scene: &Path, (w, h): (u32, u32), spp: u32, seed: u64, sel: LightSel
     Est { name, w, mean: means(&out.film), var: var_of_mean(&out.film) }
 }
 
+/// [`estimate`] with the `direct` integrator and `n` light samples.
+fn estimate_direct(scene: &Path, (w, h): (u32, u32), spp: u32, n: u32, seed: u64, sel: LightSelection) -> (Est, u64) {
+    let o = RenderOptions {
+        seed,
+        light_selection: Some(sel),
+        integrator: Some(strata::scene::desc::IntegratorKind::Direct),
+        light_samples: Some(n),
+        first_sample: Some(strata::camera::FirstSample::Jittered),
+        ..opts(scene.to_path_buf(), w, h, spp)
+    };
+    let out = strata::session::render_to_film(&o).unwrap_or_else(|e| panic!("{}: {e}", scene.display()));
+    assert_eq!(out.stats.counters.nonfinite, 0, "direct {sel}: non-finite samples");
+    assert_eq!(strata::session::stats_json(&out)["light_selection"], sel.name());
+    assert!(strata::session::summary(&out).contains(&format!("lights {sel}")));
+    let est = Est { name: format!("direct {sel}"), w, mean: means(&out.film), var: var_of_mean(&out.film) };
+    (est, out.stats.counters.shadow)
+}
+
 /// Agreement of two independent estimates of the same image.
 #[derive(Debug)]
 struct Agreement {
@@ -227,10 +245,8 @@ fn strategies_agree_on_many_lights() {
     assert!(g.z_mean.abs() > 4.5 || g.frac_3 > 0.05, "a biased estimate should be detected: {g:?}");
 }
 
-/// A scene with emissive OBJ triangles (the OBJ Cornell box's ceiling patch) and two quad lights
-/// of very different power: quads and triangles share one index space in every strategy.
-#[test]
-fn strategies_agree_with_emissive_triangles() {
+/// The OBJ Cornell box (two emissive triangles) with two quad lights added, path traced to depth 3.
+fn triangles_and_quads() -> PathBuf {
     let text = std::fs::read_to_string(scene_dir().join("cornell_obj.test")).unwrap();
     let text: String = text
         .lines()
@@ -242,6 +258,14 @@ fn strategies_agree_with_emissive_triangles() {
     let d = tmpdir("lightsel-tri");
     let scene = d.join("tri.test");
     std::fs::write(&scene, text).unwrap();
+    scene
+}
+
+/// A scene with emissive OBJ triangles (the OBJ Cornell box's ceiling patch) and two quad lights
+/// of very different power: quads and triangles share one index space in every strategy.
+#[test]
+fn strategies_agree_with_emissive_triangles() {
+    let scene = triangles_and_quads();
     let mut mis = Vec::new();
     for (k, sel) in ALL.into_iter().enumerate() {
         mis.push(estimate(&scene, (32, 32), 256, 60 + k as u64, sel, None));
@@ -296,4 +320,42 @@ fn compare_runs_light_selections_as_variants() {
     assert!(!bad.status.success());
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("nearest") && err.contains("spatial"), "{err}");
+}
+
+/// The `.test` keyword `lightselection` picks the strategy (stats and summary say so), and
+/// `--light-selection` overrides it; a bad value is refused with file and line.
+#[test]
+fn scene_keyword_and_flag_override() {
+    let pt = "integrator pathtracer\nnexteventestimation on\nlightselection power\n";
+    let scene = scene_variant(&scene_dir().join("cornell.test"), "kw", &["integrator"], pt);
+    let o = opts(scene.clone(), 8, 8, 1);
+    let out = strata::session::render_to_film(&o).unwrap();
+    assert_eq!(strata::session::stats_json(&out)["light_selection"], "power");
+    assert!(strata::session::summary(&out).contains("lights power"), "{}", strata::session::summary(&out));
+    let o = RenderOptions { light_selection: Some(LightSelection::Uniform), ..opts(scene, 8, 8, 1) };
+    let out = strata::session::render_to_film(&o).unwrap();
+    assert_eq!(strata::session::stats_json(&out)["light_selection"], "uniform");
+    let bad = scene_variant(&scene_dir().join("cornell.test"), "kw-bad", &[], "lightselection nearest\n");
+    let lines = std::fs::read_to_string(&bad).unwrap().lines().count();
+    let e = strata::session::render_to_film(&opts(bad, 8, 8, 1)).err().expect("refused").to_string();
+    assert!(e.contains(&format!("kw-bad.test:{lines}")) && e.contains("all|uniform|power|spatial"), "{e}");
+}
+
+/// `direct` with `uniform`, `power` or `spatial` picks one light per light sample (one shadow ray
+/// per sample, however many lights) and agrees with its loop over every light (`all`), on quads
+/// and emissive triangles together; stats and summary name the strategy.
+#[test]
+fn direct_picks_one_light_per_sample() {
+    let scene = triangles_and_quads();
+    let (size, n) = ((32, 32), 2);
+    let (all, all_rays) = estimate_direct(&scene, size, 64, n, 80, LightSelection::All);
+    let mut ests = vec![all];
+    for (k, sel) in ALL.into_iter().enumerate().skip(1) {
+        let (e, rays) = estimate_direct(&scene, size, 256, n, 81 + k as u64, sel);
+        // One shadow ray per light sample at most (4 lights: `all` traces up to 4 per sample).
+        assert!(rays <= u64::from(size.0 * size.1 * 256 * n), "direct {sel}: {rays} shadow rays");
+        assert!(rays * 64 < all_rays * 256, "direct {sel}: {rays} shadow rays vs all's {all_rays} at 1/4 the spp");
+        ests.push(e);
+    }
+    assert_all_agree("direct", &ests, 1, 0.02);
 }

@@ -81,6 +81,8 @@ pub struct Scratch {
     pub(super) contrib: Vec<Vec3x8>,
     pub(super) owner: Vec<u32>,
     pub(super) streams: Vec<Stream<U8>>,
+    /// `direct` with one light per sample: the light-choice streams
+    pub(super) choice_streams: Vec<Stream<U8>>,
     pub(super) path: PathScratch,
     pub(super) one: Vec<Vec3x8>,
 }
