@@ -373,9 +373,9 @@ fn wide_importance_equals_the_binary_bound() {
     fn walk(bin: &[tree::Node], wide: &WideTree, w: usize, k: usize, p: Vec3, n: Vec3, leaves: &mut usize) {
         let kids = WideTree::frontier(bin, k);
         let imp = WideTree::importance8(&wide.nodes[w], p, n);
-        for c in 0..8 {
+        for (c, &got) in imp.iter().enumerate() {
             let want = kids.get(c).map_or(0.0, |&j| LightTree::importance(&bin[j], p, n));
-            assert_eq!(imp[c].to_bits(), want.to_bits(), "node {w} child {c} at {p}, {n}");
+            assert_eq!(got.to_bits(), want.to_bits(), "node {w} child {c} at {p}, {n}");
             if let Some(&j) = kids.get(c) {
                 if wide.nodes[w].leaf & (1 << c) != 0 {
                     assert_eq!(wide.nodes[w].child[c], bin[j].link);
