@@ -86,6 +86,8 @@ pub struct Scratch {
     /// `direct`: per shading packet, its unit-square light sample and its point on the light
     pub(super) light_uv: Vec<(F8, F8)>,
     pub(super) light_points: Vec<LightSample8>,
+    /// `direct` with one light per sample: the light-choice streams
+    pub(super) choice_streams: Vec<Stream<U8>>,
     pub(super) path: PathScratch,
     pub(super) one: Vec<Vec3x8>,
 }

@@ -7,12 +7,21 @@
 //! over the `lightsamples` samples of L f cos(th_i) cos(th_l) / (d^2 pdf_area) where the shadow ray
 //! is clear. A quad group's radiance and area are constant, so they scale its sum once at the end.
 //! f is `bsdf::Material8::eval_world`, the world-space form of the path tracer's material code.
+//!
+//! That loop is `--light-selection all` (the default for `.test` scenes). With `uniform`, `power`
+//! or `spatial` each of the `lightsamples` samples instead picks one light from the integrator's
+//! [`crate::light::select::LightSampler`] (dimension `DIM_LIGHT_BASE + 1` for the choice) and a
+//! point on it (dimension `DIM_LIGHT_BASE`), and adds L f cos(th_i) cos(th_l) / (d^2 pmf pdf_area)
+//! / `lightsamples`: one shadow ray per sample whatever the number of lights, as Mitsuba's
+//! `direct` does with one emitter sample. `uniform` is then truly 1/#lights (quads and triangles
+//! alike).
 
 use super::context::{masked, Scratch, TileCtx, Tracer};
 use super::{Integrator, DIM_LIGHT_BASE};
 use crate::accel::Ray8;
 use crate::bsdf::{LobeSet, Material8};
 use crate::light::emitters::{Emitter, LightSample8};
+use crate::light::select::LightSelection;
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 
@@ -45,6 +54,9 @@ fn groups(scene: &Scene) -> impl Iterator<Item = Group<'_>> {
 /// Adds direct lighting at the camera hits of the tile (`ctx.scratch.hits`) for pixel sample `s`
 /// to `out`.
 pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
+    if it.light_selection != LightSelection::All {
+        return shade_one::<L>(it, ctx, s, out);
+    }
     let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
@@ -135,6 +147,76 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 *o += acc.mul_elem(scale);
             }
         }
+    }
+}
+
+/// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
+fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
+    let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
+    let n_light = it.light_set.n();
+    let inv_n = F8::splat(1.0 / n_light as f32);
+    let sample_idx = U8::splat(s);
+    sc.shade.clear();
+    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
+    sc.streams.clear();
+    sc.choice_streams.clear();
+    {
+        let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
+        sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE, it.seed)));
+        sc.choice_streams
+            .extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE + 1, it.seed)));
+        crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, DIM_LIGHT_BASE);
+        let choice = pks.iter().map(|pk| pk.pixel);
+        crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
+    }
+    let n_pks = pks.len() as u32;
+    for k in 0..n_light {
+        sc.shadow.clear();
+        sc.contrib.clear();
+        sc.owner.clear();
+        for i in 0..pks.len() {
+            let (sh, shade) = (&sc.hits[i], sc.shade[i]);
+            if shade.none() {
+                continue;
+            }
+            let ((u, v), (uc, _)) = {
+                let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                crate::sampler::replay::light_point(i as u32, k);
+                crate::sampler::replay::light_point(n_pks + i as u32, k);
+                (sc.streams[i].point(k), sc.choice_streams[i].point(k))
+            };
+            let (ls, ok) = {
+                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                let (idx, pmf) = it.light_sampler.sample_x8(uc, sh.p, sh.n, shade);
+                let ok = shade & pmf.simd_gt(F8::ZERO);
+                let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
+                (scene.emitters.place_x8(idx, inv_pmf, u, v), ok)
+            };
+            let to = ls.y - sh.p;
+            let d2 = to.length_squared();
+            let inv_d = F8::ONE / d2.sqrt();
+            let wi = to.scale(inv_d);
+            let cos_i = sh.n.dot(wi);
+            let cos_l = -ls.normal.dot(wi);
+            let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+            let lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves;
+            if lit.none() {
+                continue;
+            }
+            let f = {
+                let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
+                material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
+            };
+            let g = cos_i * cos_l * inv_d * inv_d * ls.area * ls.inv_pmf * inv_n;
+            sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));
+            let o = sh.ng.mul_add(scene.offset_eps(sh.p), sh.p);
+            let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
+            let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
+            sc.shadow.push((ray, lit));
+            sc.owner.push(i as u32);
+        }
+        let Scratch { shadow, contrib, owner, .. } = &mut **sc;
+        trace_shadow_batch(tracer, shadow, contrib, owner, out);
     }
 }
 

@@ -19,6 +19,8 @@
 
 #[path = "tree.rs"]
 mod tree;
+#[path = "wide.rs"]
+mod wide;
 
 #[cfg(test)]
 #[path = "select_tests.rs"]

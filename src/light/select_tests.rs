@@ -158,26 +158,7 @@ fn pmf_equals_the_probability_sample_returns_bit_for_bit() {
 
 /// Probability that the tree's descent ends in a node whose children both have importance 0.
 fn lost_mass(t: &LightTree, p: Vec3, n: Vec3) -> f64 {
-    if t.nodes.is_empty() || !(LightTree::importance(&t.nodes[0], p, n) > 0.0) {
-        return 1.0;
-    }
-    fn rec(t: &LightTree, k: usize, mass: f64, p: Vec3, n: Vec3) -> f64 {
-        let node = &t.nodes[k];
-        if node.leaf {
-            return 0.0;
-        }
-        let il = LightTree::importance(&t.nodes[k + 1], p, n);
-        let ir = LightTree::importance(&t.nodes[node.link as usize], p, n);
-        let sum = il + ir;
-        if !(sum > 0.0) {
-            return mass;
-        }
-        let (pl, pr) = (il / sum, ir / sum);
-        let l = if pl > 0.0 { rec(t, k + 1, mass * pl as f64, p, n) } else { 0.0 };
-        let r = if pr > 0.0 { rec(t, node.link as usize, mass * pr as f64, p, n) } else { 0.0 };
-        l + r
-    }
-    rec(t, 0, 1.0, p, n)
+    t.wide.lost_mass(p, n)
 }
 
 #[test]
@@ -376,4 +357,39 @@ fn tree_structure_and_spatial_preference() {
     }
     eprintln!("spatial pmf of the light just above p / uniform: {gain:?}");
     assert!(gain.iter().all(|&g| g > 20.0), "{gain:?}");
+}
+
+/// The collapsed tree's 8-lane importance is the scalar bound of the binary nodes it holds, bit
+/// for bit (the conservativeness argument of `LightTree::importance` carries over), and every
+/// light is a leaf of exactly one slot.
+#[test]
+fn wide_importance_equals_the_binary_bound() {
+    use super::wide::WideTree;
+    let mut rng = Rng::new(66);
+    let lights = random_lights(&mut rng, 300, 4.0);
+    let s = LightSampler::new(&lights, LightSelection::Spatial);
+    let (bin, wide) = (&s.tree.nodes, &s.tree.wide);
+    let mut leaves = 0;
+    fn walk(bin: &[tree::Node], wide: &WideTree, w: usize, k: usize, p: Vec3, n: Vec3, leaves: &mut usize) {
+        let kids = WideTree::frontier(bin, k);
+        let imp = WideTree::importance8(&wide.nodes[w], p, n);
+        for (c, &got) in imp.iter().enumerate() {
+            let want = kids.get(c).map_or(0.0, |&j| LightTree::importance(&bin[j], p, n));
+            assert_eq!(got.to_bits(), want.to_bits(), "node {w} child {c} at {p}, {n}");
+            if let Some(&j) = kids.get(c) {
+                if wide.nodes[w].leaf & (1 << c) != 0 {
+                    assert_eq!(wide.nodes[w].child[c], bin[j].link);
+                    *leaves += 1;
+                } else {
+                    walk(bin, wide, wide.nodes[w].child[c] as usize, j, p, n, leaves);
+                }
+            }
+        }
+    }
+    for round in 0..50 {
+        let p = (Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - Vec3::ONE) * 6.0;
+        let n = if round % 5 == 0 { Vec3::ZERO } else { unit(&mut rng) };
+        walk(bin, wide, 0, 0, p, n, &mut leaves);
+    }
+    assert_eq!(leaves, 50 * lights.iter().filter(|e| e.power() > 0.0).count());
 }

@@ -6,9 +6,11 @@
 //! that they are conservative in f32, see [`LightTree::importance`]).
 //!
 //! Every emitter is one leaf. Emitters of power 0 are left out (their pmf is 0, they never
-//! contribute). For light `i`, `path[i]` holds the left/right turns from the root to its leaf, so
-//! [`LightTree::pmf`] recomputes the very same products as [`LightTree::sample`].
+//! contribute). For light `i`, `path[i]` holds the left/right turns from the root to its leaf.
+//! Sampling runs in the tree collapsed to 8 children per node (`wide.rs`), where one 8-lane
+//! importance evaluation serves a whole node and the pmf recomputes the descent's products.
 
+use super::wide::WideTree;
 use crate::light::emitters::Emitter;
 use glam::Vec3;
 use std::f32::consts::{FRAC_PI_2, PI};
@@ -16,17 +18,15 @@ use std::f32::consts::{FRAC_PI_2, PI};
 /// Margin on the cosine bounds (about 0.06 degrees): a node is given importance 0 only when the
 /// best cosine is below `-COS_SLACK`, which absorbs the f32 rounding of the bound itself (the
 /// worst term is `sqrt(1 - cos^2)` near `cos = +-1`, off by up to ~3e-4).
-const COS_SLACK: f32 = 1e-3;
+pub(super) const COS_SLACK: f32 = 1e-3;
 /// Floor of a cosine factor that passed the slack test, so that the importance stays positive.
-const COS_FLOOR: f32 = 1e-6;
+pub(super) const COS_FLOOR: f32 = 1e-6;
 /// Extra angle added to every orientation cone at build time (radians).
 const CONE_SLACK: f32 = 1e-5;
 /// Buckets per axis of the binned SAOH split.
 const BUCKETS: usize = 12;
 /// Depth from which splits are by median count, so that paths fit in 64 bits.
 const MEDIAN_DEPTH: u32 = 40;
-/// Largest f32 below 1.
-const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// A node of the light tree (depth-first order: the left child of node `k` is `k + 1`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,6 +57,8 @@ pub(crate) struct LightTree {
     /// per light: turns from the root (bit k set = right at depth k) and depth; depth `u8::MAX` for
     /// a light outside the tree (power 0)
     pub path: Vec<(u64, u8)>,
+    /// the tree as sampled: collapsed to nodes of 8 children ([`super::wide`])
+    pub wide: WideTree,
 }
 
 /// Build-time record of one emitter.
@@ -183,13 +185,17 @@ impl LightTree {
             let hi = cs.iter().fold(Vec3::NEG_INFINITY, |m, &c| m.max(c));
             items.push(Item { lo, hi, centroid: 0.5 * (lo + hi), power, normal: e.normal, light: i as u32 });
         }
-        let mut tree =
-            LightTree { nodes: Vec::with_capacity(2 * items.len()), path: vec![(0, u8::MAX); emitters.len()] };
+        let mut tree = LightTree {
+            nodes: Vec::with_capacity(2 * items.len()),
+            path: vec![(0, u8::MAX); emitters.len()],
+            wide: WideTree::default(),
+        };
         if items.is_empty() {
             return tree;
         }
         let total: f64 = items.iter().map(|it| it.power as f64).sum();
         tree.build_rec(&mut items, total, 0, 0);
+        tree.wide = WideTree::build(&tree.nodes, emitters.len());
         tree
     }
 
@@ -324,7 +330,10 @@ impl LightTree {
     /// whenever any light of the node can contribute both cosine bounds are positive. Cosines of
     /// differences are computed from cosines and sines (no acos), and a bound is declared 0 only
     /// below `-COS_SLACK`. Inside the bounding sphere both bounds are 1.
-    #[inline]
+    ///
+    /// This scalar form is the reference; the sampler evaluates the same bound for the 8 children
+    /// of a collapsed node at once (`wide.rs`, `importance8`).
+    #[cfg(test)]
     pub(crate) fn importance(node: &Node, p: Vec3, n: Vec3) -> f32 {
         let d = p - node.center;
         let d2 = d.length_squared();
@@ -372,64 +381,16 @@ impl LightTree {
         node.phi * cos_e.max(COS_FLOOR) * cos_r.max(COS_FLOOR) / d2
     }
 
-    /// Probabilities of the two children of interior node `k`: `(p_left, p_right)`, or `None`
-    /// when both have importance 0.
-    #[inline]
-    fn split(&self, k: usize, p: Vec3, n: Vec3) -> Option<(f32, f32)> {
-        let node = &self.nodes[k];
-        let il = Self::importance(&self.nodes[k + 1], p, n);
-        let ir = Self::importance(&self.nodes[node.link as usize], p, n);
-        let sum = il + ir;
-        if !(sum > 0.0) {
-            return None;
-        }
-        Some((il / sum, ir / sum))
-    }
-
     /// Light chosen by `u` in [0, 1) at `(p, n)` and its probability; `None` when no light of the
-    /// tree can contribute (importance 0).
-    pub(crate) fn sample(&self, mut u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32)> {
-        let root = self.nodes.first()?;
-        if !(Self::importance(root, p, n) > 0.0) {
-            return None;
-        }
-        let (mut k, mut pmf) = (0usize, 1.0f32);
-        loop {
-            let node = &self.nodes[k];
-            if node.leaf {
-                return if pmf > 0.0 { Some((node.link, pmf)) } else { None };
-            }
-            let (pl, pr) = self.split(k, p, n)?;
-            if u < pl {
-                u = (u / pl).min(ONE_MINUS);
-                pmf *= pl;
-                k += 1;
-            } else {
-                u = ((u - pl) / pr).clamp(0.0, ONE_MINUS);
-                pmf *= pr;
-                k = node.link as usize;
-            }
-        }
+    /// tree can contribute (importance 0). Sampled in the collapsed tree ([`super::wide`]).
+    #[inline]
+    pub(crate) fn sample(&self, u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32)> {
+        self.wide.sample(u, p, n)
     }
 
     /// Probability that [`LightTree::sample`] picks `light` at `(p, n)` (the same products).
+    #[inline]
     pub(crate) fn pmf(&self, p: Vec3, n: Vec3, light: u32) -> f32 {
-        let Some(&(bits, depth)) = self.path.get(light as usize) else { return 0.0 };
-        if depth == u8::MAX || !(Self::importance(&self.nodes[0], p, n) > 0.0) {
-            return 0.0;
-        }
-        let (mut k, mut pmf) = (0usize, 1.0f32);
-        for level in 0..depth as u32 {
-            let Some((pl, pr)) = self.split(k, p, n) else { return 0.0 };
-            if bits & (1u64 << level) == 0 {
-                pmf *= pl;
-                k += 1;
-            } else {
-                pmf *= pr;
-                k = self.nodes[k].link as usize;
-            }
-        }
-        debug_assert!(self.nodes[k].leaf && self.nodes[k].link == light);
-        pmf
+        self.wide.pmf(p, n, light)
     }
 }

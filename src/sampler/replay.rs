@@ -293,6 +293,20 @@ pub fn light_streams(pixels: impl IntoIterator<Item = U8>, sample: U8, dim: u32)
     }
 }
 
+/// Reports more light streams appended to the table of the last [`light_streams`] (stream
+/// `len + i` of the table is the i-th of `pixels`): a second stream per packet, such as the light
+/// choice of `direct` with one light per sample.
+#[inline]
+pub fn light_streams_append(pixels: impl IntoIterator<Item = U8>, sample: U8, dim: u32) {
+    if recording() {
+        LOG.with_borrow_mut(|l| {
+            for p in pixels {
+                l.push(OP_STREAM, p, sample, dim, None);
+            }
+        });
+    }
+}
+
 /// Reports `streams[stream].point(k)` of the last table of [`light_streams`].
 #[inline]
 pub fn light_point(stream: u32, k: u32) {

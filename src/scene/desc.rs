@@ -169,6 +169,9 @@ pub struct SceneDesc {
     pub light_samples: u32,
     /// `lightstratify on`
     pub light_stratify: bool,
+    /// `lightselection all|uniform|power|spatial` (a strata extension; None: the session's default,
+    /// `--light-selection` overrides it)
+    pub light_selection: Option<crate::light::select::LightSelection>,
     /// next event estimation
     pub nee: Nee,
     /// Russian roulette
@@ -269,6 +272,7 @@ impl Default for SceneDesc {
             max_depth: 5,
             light_samples: 1,
             light_stratify: false,
+            light_selection: None,
             nee: Nee::Off,
             russian_roulette: false,
             importance_sampling: ImportanceSampling::Hemisphere,

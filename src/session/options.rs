@@ -102,6 +102,8 @@ pub fn default_first_sample(opts: &RenderOptions) -> crate::camera::FirstSample 
 
 /// NEE's light selection for `opts`: `--light-selection`, else `all` (every light, the CSE168
 /// course's convention) for `.test` scenes and the built-in one, `uniform` for `.obj` scenes.
+/// (The session puts a scene's `lightselection` keyword between the flag and this default, and
+/// gives `direct` `all` by default whatever the scene kind.)
 pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::LightSelection {
     use crate::light::select::LightSelection;
     opts.light_selection.unwrap_or(course_or_obj(opts, LightSelection::All, LightSelection::Uniform))

@@ -25,16 +25,20 @@ fn pool_calls(pool: &rayon::ThreadPool) -> u64 {
     pool.broadcast(|_| take_api_calls()).iter().sum()
 }
 
-/// On every integrator and with a sequence and a grid sampler: the log holds every sampler call
+/// On every integrator (`direct` also with one light per sample) and with a sequence and a grid
+/// sampler: the log holds every sampler call
 /// the render made (the render's count comes from a counter inside the sampler API, not from the
 /// log), the replay makes exactly that many calls, and recording leaves the image bit-identical.
 #[test]
 fn replay_calls_the_sampler_exactly_as_often_as_the_render() {
     let _g = crate::profile::TEST_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    use crate::light::select::LightSelection;
     use IntegratorKind::*;
-    for kind in [RayTracer, AnalyticDirect, Direct, PathTracer] {
+    let cases = [(RayTracer, None), (AnalyticDirect, None), (Direct, None), (Direct, Some(LightSelection::Power))];
+    for (kind, selection) in cases.into_iter().chain([(PathTracer, None)]) {
         for sampler in [None, Some(SamplerKind::SOBOL)] {
-            let (scene, it) = prepare(&opts(kind, sampler)).unwrap();
+            let o = RenderOptions { light_selection: selection, ..opts(kind, sampler) };
+            let (scene, it) = prepare(&o).unwrap();
             let pool = render::thread_pool(2).unwrap();
             let mut film = Film::new(scene.desc.width, scene.desc.height);
             pool_calls(&pool);

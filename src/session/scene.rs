@@ -118,7 +118,16 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     }
     integrator.clamp = opts.clamp;
     integrator.first_sample = super::options::default_first_sample(opts);
-    integrator.set_light_selection(&scene, super::options::default_light_selection(opts));
+    // `--light-selection`, else the scene's `lightselection`, else `all` for `direct` (its loop over
+    // every light) and the default of the scene's kind for the path tracer.
+    let selection = opts.light_selection.or(scene.desc.light_selection).unwrap_or_else(|| {
+        if scene.desc.integrator == crate::scene::desc::IntegratorKind::Direct {
+            crate::light::select::LightSelection::All
+        } else {
+            super::options::default_light_selection(opts)
+        }
+    });
+    integrator.set_light_selection(&scene, selection);
     Ok((scene, integrator))
 }
 

@@ -57,7 +57,12 @@ pub fn summary(out: &RenderOutput) -> String {
     let it = &out.integrator;
     // The settings that matter for this integrator only.
     let technique = match d.integrator {
-        IntegratorKind::Direct => format!(" (light {} x{})", it.light_set.kind().name(), it.light_set.n()),
+        IntegratorKind::Direct => format!(
+            " (light {} x{}, lights {})",
+            it.light_set.kind().name(),
+            it.light_set.n(),
+            it.light_selection.name()
+        ),
         IntegratorKind::PathTracer => {
             format!(
                 " (nee {}, lights {}, {} sampling, rr {}, maxdepth {})",

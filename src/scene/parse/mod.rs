@@ -51,12 +51,12 @@ pub fn parse_str(text: &str, source: &Path, limits: &Limits) -> Result<SceneDesc
 
 /// Every command the format knows (used only to suggest the right spelling).
 #[rustfmt::skip]
-const COMMANDS: [&str; 33] = [
+const COMMANDS: [&str; 34] = [
     "size", "output", "camera", "spp", "gamma", "maxdepth", "maxverts", "vertex", "tri", "sphere",
     "pushTransform", "popTransform", "translate", "rotate", "scale", "diffuse", "specular",
     "shininess", "emission", "ambient", "brdf", "roughness", "quadLight", "point", "directional",
     "attenuation", "integrator", "lightsamples", "lightstratify", "nexteventestimation",
-    "russianroulette", "importancesampling", "obj",
+    "russianroulette", "importancesampling", "obj", "lightselection",
 ];
 
 /// Parser state: the scene so far plus the transform stack, material state and vertex list.
@@ -202,6 +202,10 @@ impl<'l> Parser<'l> {
                 self.desc.light_samples = a.int_in(1, max, "max_light_samples")? as u32;
             }
             "lightstratify" => self.desc.light_stratify = a.keyword(&on_off)?,
+            "lightselection" => {
+                let names = crate::light::select::LIGHT_SELECTIONS.map(|i| (i.name, i.selection));
+                self.desc.light_selection = Some(a.keyword(&names)?);
+            }
             "nexteventestimation" => self.desc.nee = a.keyword(Nee::NAMES)?,
             "russianroulette" => self.desc.russian_roulette = a.keyword(&on_off)?,
             "importancesampling" => self.desc.importance_sampling = a.keyword(ImportanceSampling::NAMES)?,

@@ -218,6 +218,13 @@ fn settings() {
     assert_eq!(d.output.as_deref(), Some("out.png"));
     let c = d.camera.expect("camera");
     assert_eq!((c.eye, c.center, c.up, c.fovy_deg), (Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 30.0));
+    assert_eq!(d.light_selection, None);
+    use crate::light::select::LightSelection;
+    for (text, sel) in
+        [("all", LightSelection::All), ("Power", LightSelection::Power), ("spatial", LightSelection::Spatial)]
+    {
+        assert_eq!(parse_ok(&format!("lightselection {text}")).light_selection, Some(sel));
+    }
 }
 
 #[test]
@@ -249,6 +256,8 @@ fn errors_name_line_and_cause() {
     expect_err("quadLight 0 0 0 1 0 0 2 0 0 1 1 1", 1, &["quadLight", "area"]);
     expect_err("integrator foo", 1, &["integrator", "raytracer|analyticdirect|direct|pathtracer", "'foo'"]);
     expect_err("lightstratify", 1, &["lightstratify", "on|off", "0 arguments"]);
+    expect_err("spp 4\nlightselection nearest", 2, &["lightselection", "all|uniform|power|spatial", "'nearest'"]);
+    expect_err("lightselection", 1, &["lightselection", "all|uniform|power|spatial", "0 arguments"]);
     expect_err("attenuation 0 0 0", 1, &["attenuation"]);
     expect_err("shininess -1", 1, &["shininess", ">= 0"]);
     expect_err("camera 0 0 0 0 0 0 0 1 0 45", 1, &["camera", "coincide"]);
