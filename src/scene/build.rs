@@ -114,6 +114,30 @@ pub struct SurfaceHit8 {
     pub light: U8,
 }
 
+impl SurfaceHit8 {
+    /// The record of eight misses (what [`Scene::gather`] gives lanes that hit nothing).
+    pub const MISS: Self = Self {
+        valid: F8::ZERO,
+        p: Vec3x8::ZERO,
+        n: Z8,
+        ng: Z8,
+        smooth: F8::ZERO,
+        wo: Vec3x8::ZERO,
+        kd: Vec3x8::ZERO,
+        ks: Vec3x8::ZERO,
+        shininess: F8::ZERO,
+        roughness: F8::ONE,
+        ggx: F8::ZERO,
+        emitted: Vec3x8::ZERO,
+        ambient: Vec3x8::ZERO,
+        le: Vec3x8::ZERO,
+        light: U8::MAX,
+    };
+}
+
+/// +z in every lane.
+const Z8: Vec3x8 = Vec3x8 { x: F8::ZERO, y: F8::ZERO, z: F8::ONE };
+
 /// A renderable scene.
 pub struct Scene {
     /// settings and geometry as parsed
@@ -294,6 +318,14 @@ impl Scene {
     /// lane has the same material (the common case of a coherent packet). Lanes that missed get
     /// the miss record (normals +z, zero reflectances, roughness 1, no light).
     pub fn gather(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8) -> SurfaceHit8 {
+        let mut sh = SurfaceHit8::MISS;
+        self.gather_into(org, dir, hits, &mut sh);
+        sh
+    }
+
+    /// [`Scene::gather`] written into `out` (a record in a buffer: no copy of the record).
+    #[inline]
+    pub fn gather_into(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8, out: &mut SurfaceHit8) {
         let _p = crate::profile::scope(crate::profile::Phase::Gather);
         let p = dir.mul_add(hits.t, org);
         let valid = hits.hit;
@@ -341,23 +373,21 @@ impl Scene {
             (ng, crate::simd::mask_from_bools([false; 8]))
         };
         let m = self.gather_materials(bits, valid, &mat);
-        SurfaceHit8 {
-            valid,
-            p,
-            n: ns,
-            ng,
-            smooth,
-            wo: -dir,
-            kd: m.kd,
-            ks: m.ks,
-            shininess: m.shininess,
-            roughness: m.roughness,
-            ggx: m.ggx,
-            emitted: m.emitted,
-            ambient: m.ambient,
-            le: le.get(),
-            light: U8::new(light),
-        }
+        out.valid = valid;
+        out.p = p;
+        out.n = ns;
+        out.ng = ng;
+        out.smooth = smooth;
+        out.wo = -dir;
+        out.kd = m.kd;
+        out.ks = m.ks;
+        out.shininess = m.shininess;
+        out.roughness = m.roughness;
+        out.ggx = m.ggx;
+        out.emitted = m.emitted;
+        out.ambient = m.ambient;
+        out.le = le.get();
+        out.light = U8::new(light);
     }
 
     /// Shading normals from the triangles' vertex normals (see the module docs) on the triangle
