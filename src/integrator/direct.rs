@@ -65,6 +65,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
             sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
         }
         for k in 0..n_light {
+            let point_k = it.light_set.point_k(k);
             sc.shadow.clear();
             sc.contrib.clear();
             sc.owner.clear();
@@ -75,7 +76,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 }
                 let (u, v) = {
                     let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-                    sc.streams[i].point(k)
+                    sc.streams[i].point_k(&point_k)
                 };
                 let ls = group.sample(scene, u, v, shade);
                 let to = ls.y - sh.p;

@@ -317,6 +317,7 @@ impl Scene {
     /// rest is 8-wide: the two-sided flip, and the material fields, splatted once when every hit
     /// lane has the same material (the common case of a coherent packet). Lanes that missed get
     /// the miss record (normals +z, zero reflectances, roughness 1, no light).
+    #[inline]
     pub fn gather(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8) -> SurfaceHit8 {
         let mut sh = SurfaceHit8::MISS;
         self.gather_into(org, dir, hits, &mut sh);
