@@ -330,7 +330,7 @@ impl Scene {
         let _p = crate::profile::scope(crate::profile::Phase::Gather);
         let p = dir.mul_add(hits.t, org);
         let valid = hits.hit;
-        let bits = valid.to_bitmask() as u32;
+        let bits = valid.to_bitmask();
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());
         let mut n = Lanes3::splat(Vec3::Z);
         let mut mat = [0u32; 8];
