@@ -7,7 +7,7 @@
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
 pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
-use crate::film::{combine, leaf_moments, push_block, Block, Film, Moments};
+use crate::film::{leaf_moments, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::Vec3x8;
@@ -215,13 +215,16 @@ fn render_tile(
     }
 }
 
-/// Adds a batch of samples of packet `pk` (`radiance`: its values for the batch's samples in
-/// increasing order) to the dyadic stacks of its pixels in the tile `(x0, y0, tw)`: `depth` live
-/// levels of `tn` pixels each before the batch; sample k of the batch is a leaf combined with the
-/// top `carries[k]` blocks; `radiance.0[k * radiance.1]` is sample k, as [`push_block`] did to the block list. Each pixel's stack is run
-/// through the batch in `stack` and written back once (the same additions, in the same order,
-/// as one sample at a time). A non-finite lane value is counted and replaced by zero so no NaN
-/// or Inf ever reaches the image.
+/// The moments of one dyadic level for the 8 lanes of a packet: `[moment][lane]`.
+type Moments8 = [[f64; 8]; 6];
+
+/// Adds a batch of samples of packet `pk` to the dyadic stacks of its pixels in the tile
+/// `(x0, y0, tw)`: `radiance.0[k * radiance.1]` is the packet's value at sample k of the batch;
+/// `depth` live levels of `tn` pixels each before the batch; sample k is a leaf combined with the
+/// top `carries[k]` blocks, as [`push_block`] did to the block list. The 8 pixels' stacks are run
+/// through the batch together in `stack` (lane-wise, the same f64 additions in the same order as
+/// one sample at a time: the values are bit-identical) and written back once. A non-finite lane
+/// value is counted and replaced by zero so no NaN or Inf ever reaches the image.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn accumulate(
@@ -232,39 +235,61 @@ fn accumulate(
     pk: &PixelPacket,
     (x0, y0, tw): (u32, u32, u32),
     (radiance, stride): (&[Vec3x8], usize),
-    stack: &mut Vec<Moments>,
+    stack: &mut Vec<Moments8>,
     counters: &mut Counters,
 ) {
     let active = pk.active.to_bitmask();
+    if active == 0 {
+        return;
+    }
     let (xs, ys) = (pk.x.to_array(), pk.y.to_array());
-    for i in 0..8 {
+    let j: [usize; 8] = std::array::from_fn(|i| {
         if active & (1 << i) == 0 {
-            continue;
+            0
+        } else {
+            ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize
         }
-        let j = ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize;
-        stack.clear();
-        stack.extend((0..depth).map(|l| data[l * tn + j]));
-        stack.resize(depth + carries.len(), [0.0; 6]);
-        let mut top = depth;
-        for (k, &c) in carries.iter().enumerate() {
-            let l = &radiance[k * stride];
-            let v = [l.x.as_array()[i], l.y.as_array()[i], l.z.as_array()[i]];
-            let v = if v[0].is_finite() && v[1].is_finite() && v[2].is_finite() {
-                v
-            } else {
-                counters.nonfinite += 1;
-                [0.0; 3]
-            };
-            let mut acc = leaf_moments(v);
-            for _ in 0..c {
-                top -= 1;
-                combine(&stack[top], &mut acc);
+    });
+    stack.clear();
+    stack.resize(depth + carries.len(), [[0.0; 8]; 6]);
+    for (l, level) in stack[..depth].iter_mut().enumerate() {
+        for i in (0..8).filter(|i| active & (1 << i) != 0) {
+            let m = &data[l * tn + j[i]];
+            for q in 0..6 {
+                level[q][i] = m[q];
             }
-            stack[top] = acc;
-            top += 1;
         }
-        for (l, m) in stack[..top].iter().enumerate() {
-            data[l * tn + j] = *m;
+    }
+    let mut top = depth;
+    for (k, &c) in carries.iter().enumerate() {
+        let l = &radiance[k * stride];
+        let finite = l.is_finite().to_bitmask();
+        counters.nonfinite += u64::from((active & !finite).count_ones());
+        let (r, g, b) = (l.x.to_array(), l.y.to_array(), l.z.to_array());
+        let mut acc: Moments8 = [[0.0; 8]; 6];
+        for i in 0..8 {
+            let ok = finite & (1 << i) != 0;
+            let v = if ok { [r[i], g[i], b[i]] } else { [0.0; 3] };
+            let m = leaf_moments(v);
+            for q in 0..6 {
+                acc[q][i] = m[q];
+            }
+        }
+        for _ in 0..c {
+            top -= 1;
+            let left = &stack[top];
+            for q in 0..6 {
+                for i in 0..8 {
+                    acc[q][i] += left[q][i];
+                }
+            }
+        }
+        stack[top] = acc;
+        top += 1;
+    }
+    for (l, level) in stack[..top].iter().enumerate() {
+        for i in (0..8).filter(|i| active & (1 << i) != 0) {
+            data[l * tn + j[i]] = std::array::from_fn(|q| level[q][i]);
         }
     }
 }
