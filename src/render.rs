@@ -7,7 +7,7 @@
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
 pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
-use crate::film::{combine, leaf_moments, push_block, Block, Film, Moments};
+use crate::film::{leaf_moments, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::Vec3x8;
@@ -181,7 +181,7 @@ impl TileResult {
         let (tw, th) = (TILE.min(film.width - x0), TILE.min(film.height - y0));
         let n = film.pixels();
         let src = film.block_data();
-        let mut data = Vec::with_capacity((film.blocks().len() + 8) * (tw * th) as usize);
+        let mut data = Vec::with_capacity(film.blocks().len() * (tw * th) as usize);
         for b in 0..film.blocks().len() {
             for ty in 0..th {
                 let row = b * n + ((y0 + ty) * film.width + x0) as usize;
@@ -218,6 +218,8 @@ fn render_tile(
     let packets = tile_packets(x0, y0, tw, th, w, h);
     let tn = (tw * th) as usize;
     let mut radiance = Vec::with_capacity(packets.len() * SAMPLE_BATCH as usize);
+    let mut carries = Vec::with_capacity(SAMPLE_BATCH as usize);
+    let mut stack = Vec::new();
     let mut start = samples.start;
     while start < samples.end {
         // A batch of samples is one wavefront (full packets for the path tracer); samples are
@@ -225,59 +227,99 @@ fn render_tile(
         let batch = start..samples.end.min(start + SAMPLE_BATCH);
         integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None);
         let _acc = crate::profile::scope(crate::profile::Phase::Accumulate);
-        for (s, per_sample) in batch.clone().zip(radiance.chunks_exact(packets.len())) {
-            // The block structure is the same for every pixel: one binary-counter step.
-            let depth = tile.blocks.len();
-            let carries = push_block(&mut tile.blocks, Block::leaf(s));
-            if tile.data.len() < (depth + 1) * tn {
-                tile.data.resize((depth + 1) * tn, [0.0; 6]);
-            }
-            for (pk, l) in packets.iter().zip(per_sample) {
-                accumulate(&mut tile.data, tn, depth, carries, pk, x0, y0, tw, l, counters);
-            }
+        // The block structure is the same for every pixel: one binary-counter step per sample.
+        let depth = tile.blocks.len();
+        carries.clear();
+        carries.extend(batch.clone().map(|s| push_block(&mut tile.blocks, Block::leaf(s))));
+        let levels = depth.max(tile.blocks.len());
+        if tile.data.len() < levels * tn {
+            tile.data.resize(levels * tn, [0.0; 6]);
         }
+        for (p, pk) in packets.iter().enumerate() {
+            let per_pixel = (&radiance[p..], packets.len());
+            accumulate(&mut tile.data, tn, depth, &carries, pk, (x0, y0, tw), per_pixel, &mut stack, counters);
+        }
+        tile.data.truncate(tile.blocks.len() * tn);
         start = batch.end;
     }
-    tile.data.truncate(tile.blocks.len() * tn);
 }
 
-/// Adds one sample per active lane as a leaf of the dyadic stack (`depth` live levels of `tn`
-/// pixels each before the sample; the leaf combines with the top `carries` levels). A non-finite
-/// lane value is counted and replaced by zero so no NaN or Inf ever reaches the image.
+/// The moments of one dyadic level for the 8 lanes of a packet: `[moment][lane]`.
+type Moments8 = [[f64; 8]; 6];
+
+/// Adds a batch of samples of packet `pk` to the dyadic stacks of its pixels in the tile
+/// `(x0, y0, tw)`: `radiance.0[k * radiance.1]` is the packet's value at sample k of the batch;
+/// `depth` live levels of `tn` pixels each before the batch; sample k is a leaf combined with the
+/// top `carries[k]` blocks, as [`push_block`] did to the block list. The 8 pixels' stacks are run
+/// through the batch together in `stack` (lane-wise, the same f64 additions in the same order as
+/// one sample at a time: the values are bit-identical) and written back once. A non-finite lane
+/// value is counted and replaced by zero so no NaN or Inf ever reaches the image.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn accumulate(
     data: &mut [Moments],
     tn: usize,
     depth: usize,
-    carries: usize,
+    carries: &[usize],
     pk: &PixelPacket,
-    x0: u32,
-    y0: u32,
-    tw: u32,
-    l: &Vec3x8,
+    (x0, y0, tw): (u32, u32, u32),
+    (radiance, stride): (&[Vec3x8], usize),
+    stack: &mut Vec<Moments8>,
     counters: &mut Counters,
 ) {
-    let active = crate::simd::mask_to_bools(pk.active);
-    let finite = crate::simd::mask_to_bools(l.is_finite());
+    let active = pk.active.to_bitmask();
+    if active == 0 {
+        return;
+    }
     let (xs, ys) = (pk.x.to_array(), pk.y.to_array());
-    let lanes = l.to_lanes();
-    for i in 0..8 {
-        if !active[i] {
-            continue;
-        }
-        let v = if finite[i] {
-            lanes[i]
+    let j: [usize; 8] = std::array::from_fn(|i| {
+        if active & (1 << i) == 0 {
+            0
         } else {
-            counters.nonfinite += 1;
-            glam::Vec3::ZERO
-        };
-        let j = ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize;
-        let mut acc = leaf_moments([v.x, v.y, v.z]);
-        for t in 0..carries {
-            combine(&data[(depth - 1 - t) * tn + j], &mut acc);
+            ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize
         }
-        data[(depth - carries) * tn + j] = acc;
+    });
+    stack.clear();
+    stack.resize(depth + carries.len(), [[0.0; 8]; 6]);
+    for (l, level) in stack[..depth].iter_mut().enumerate() {
+        for i in (0..8).filter(|i| active & (1 << i) != 0) {
+            let m = &data[l * tn + j[i]];
+            for q in 0..6 {
+                level[q][i] = m[q];
+            }
+        }
+    }
+    let mut top = depth;
+    for (k, &c) in carries.iter().enumerate() {
+        let l = &radiance[k * stride];
+        let finite = l.is_finite().to_bitmask();
+        counters.nonfinite += u64::from((active & !finite).count_ones());
+        let (r, g, b) = (l.x.to_array(), l.y.to_array(), l.z.to_array());
+        let mut acc: Moments8 = [[0.0; 8]; 6];
+        for i in 0..8 {
+            let ok = finite & (1 << i) != 0;
+            let v = if ok { [r[i], g[i], b[i]] } else { [0.0; 3] };
+            let m = leaf_moments(v);
+            for q in 0..6 {
+                acc[q][i] = m[q];
+            }
+        }
+        for _ in 0..c {
+            top -= 1;
+            let left = &stack[top];
+            for q in 0..6 {
+                for i in 0..8 {
+                    acc[q][i] += left[q][i];
+                }
+            }
+        }
+        stack[top] = acc;
+        top += 1;
+    }
+    for (l, level) in stack[..top].iter().enumerate() {
+        for i in (0..8).filter(|i| active & (1 << i) != 0) {
+            data[l * tn + j[i]] = std::array::from_fn(|q| level[q][i]);
+        }
     }
 }
 
@@ -296,7 +338,7 @@ mod tests {
         // One leaf per pixel of the 3x2 tile, at stack depth 0 (no carries).
         let mut data = vec![[0.0f64; 6]; 6];
         let mut c = Counters::default();
-        accumulate(&mut data, 6, 0, 0, &pk, 0, 0, 3, &l, &mut c);
+        accumulate(&mut data, 6, 0, &[0], &pk, (0, 0, 3), (std::slice::from_ref(&l), 1), &mut Vec::new(), &mut c);
         assert_eq!(c.nonfinite, 4, "lanes 0, 1, 2 and 5 (lane 3 and 7 are outside the image)");
         assert!(data.iter().flatten().all(|v: &f64| v.is_finite()));
         let sum: Vec<[f64; 3]> = data.iter().map(|m| [m[0], m[1], m[2]]).collect();

@@ -77,6 +77,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
             crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, dim);
         }
         for k in 0..n_light {
+            let point_k = it.light_set.point_k(k);
             sc.shadow.clear();
             sc.contrib.clear();
             sc.owner.clear();
@@ -89,7 +90,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 for (i, stream) in sc.streams.iter().enumerate() {
                     if sc.shade[i].any() {
                         crate::sampler::replay::light_point(i as u32, k);
-                        sc.light_uv.push(stream.point(k));
+                        sc.light_uv.push(stream.point_k(&point_k));
                     }
                 }
             }
@@ -171,6 +172,7 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
     }
     let n_pks = pks.len() as u32;
     for k in 0..n_light {
+        let point_k = it.light_set.point_k(k);
         sc.shadow.clear();
         sc.contrib.clear();
         sc.owner.clear();
@@ -183,7 +185,7 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
                 let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
                 crate::sampler::replay::light_point(i as u32, k);
                 crate::sampler::replay::light_point(n_pks + i as u32, k);
-                (sc.streams[i].point(k), sc.choice_streams[i].point(k))
+                (sc.streams[i].point_k(&point_k), sc.choice_streams[i].point_k(&point_k))
             };
             let (ls, ok) = {
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);

@@ -16,7 +16,7 @@ pub use crate::camera::FirstSample;
 use crate::camera::{Camera, PixelPacket};
 pub use crate::light::select::{LightSampler, LightSelection};
 use crate::sampler::{GridTable, PointSet, SamplerKind};
-use crate::scene::build::Scene;
+use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use crate::simd::{Vec3x8, F8};
 use context::masked;
@@ -181,21 +181,22 @@ impl Integrator {
         let n = ctx.pks.len();
         out.clear();
         let sc = &mut *ctx.scratch;
-        sc.rh.clear();
-        sc.hits.clear();
+        // Packets and records are written in place (the buffers keep their length across samples;
+        // Embree resets a packet's hit ids itself).
+        sc.rh.truncate(n);
+        sc.rh.resize(n, (RayHit8::default(), ctx.pks[0].active));
+        sc.hits.truncate(n);
+        sc.hits.resize(n, SurfaceHit8::MISS);
         // Camera packets: coherent primary rays from 4x2 pixel blocks.
-        for pk in ctx.pks {
+        for (pk, (rh, active)) in ctx.pks.iter().zip(sc.rh.iter_mut()) {
             let (org, dir) = ctx.camera.rays(pk, s);
-            let mut rh = RayHit8::default();
-            let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
-            sc.rh.push((rh, active));
+            *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
         }
         ctx.tracer.intersect_all(&mut sc.rh, RayKind::Camera);
         // Gather: hit records to SoA shading records; emission.
-        for (rh, traced) in &sc.rh {
-            let sh = ctx.scene.gather(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced));
+        for ((rh, traced), sh) in sc.rh.iter().zip(sc.hits.iter_mut()) {
+            ctx.scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced), sh);
             out.push(masked(sh.emitted + sh.le, sh.valid));
-            sc.hits.push(sh);
         }
         match self.kind {
             IntegratorKind::AnalyticDirect => {

@@ -172,12 +172,13 @@ impl Integrator {
         while !sc.lanes.is_empty() && v <= max_v {
             let dims = DIM_PATH_BASE + 4 * (v - 1);
             // Trace: full packets of 8 live paths (the first bounce keeps the camera packets).
-            sc.rh.clear();
-            for chunk in sc.lanes.chunks_exact(8) {
-                let (org, dir, active) = soa_rays(chunk);
-                let mut rh = RayHit8::default();
-                let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), active);
-                sc.rh.push((rh, active));
+            // (Written in place: Embree resets a packet's hit ids itself.)
+            let n_packets = sc.lanes.len() / 8;
+            sc.rh.truncate(n_packets);
+            sc.rh.resize(n_packets, (RayHit8::default(), F8::ZERO));
+            for (chunk, (rh, active)) in sc.lanes.chunks_exact(8).zip(sc.rh.iter_mut()) {
+                let (org, dir, lanes) = soa_rays(chunk);
+                *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), lanes);
             }
             tracer.intersect_all(&mut sc.rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
             sc.next.clear();

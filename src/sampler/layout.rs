@@ -92,6 +92,22 @@ pub trait Layout: Send + Sync + 'static {
         self.point(set, s.prefix, s.sample, s.dim, L::splat(k), s.seed)
     }
 
+    /// [`Layout::stream_point`] with the per-k work done in advance: `span` is
+    /// [`Layout::cell_span`] of k (the same for every stream of the set, so a caller drawing
+    /// point k of many streams finds its cell once). Must equal `stream_point`, bit for bit; the
+    /// default ignores `span`.
+    #[inline]
+    fn stream_point_span<L: Lanes>(
+        &self,
+        set: &SetShape,
+        s: &StreamKey<L>,
+        k: u32,
+        span: Option<[u32; 4]>,
+    ) -> (L::F, L::F) {
+        let _ = span;
+        self.stream_point(set, s, k)
+    }
+
     /// For [`GridTable`](super::GridTable): `Some([x lo, x hi, y lo, y hi])` (24-bit fixed point)
     /// if point k is always `grid::jitter_in` of that span for every pixel, sample, dim and seed;
     /// `None` (the default) otherwise.
@@ -116,6 +132,8 @@ pub trait DynLayout: Send + Sync {
     fn stream_point_1(&self, set: &SetShape, s: &StreamKey<u32>, k: u32) -> (f32, f32);
     /// `Layout::stream_point` for eight lanes.
     fn stream_point_8(&self, set: &SetShape, s: &StreamKey<U8>, k: u32) -> (F8, F8);
+    /// `Layout::stream_point_span` for eight lanes.
+    fn stream_point_span_8(&self, set: &SetShape, s: &StreamKey<U8>, k: u32, span: Option<[u32; 4]>) -> (F8, F8);
     /// `Layout::cell_span`.
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]>;
 }
@@ -138,6 +156,9 @@ impl<T: Layout> DynLayout for T {
     }
     fn stream_point_8(&self, set: &SetShape, s: &StreamKey<U8>, k: u32) -> (F8, F8) {
         self.stream_point(set, s, k)
+    }
+    fn stream_point_span_8(&self, set: &SetShape, s: &StreamKey<U8>, k: u32, span: Option<[u32; 4]>) -> (F8, F8) {
+        self.stream_point_span(set, s, k, span)
     }
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]> {
         Layout::cell_span(self, set, k)

@@ -333,6 +333,12 @@ impl PointSet {
         Stream { layout, shape: self.shape, key: layout.stream_8(&self.shape, pixel, sample, dim, seed) }
     }
 
+    /// The per-k part of point k of every stream of this set ([`Stream::point_k`]), found once.
+    #[inline]
+    pub fn point_k(&self, k: u32) -> PointK {
+        PointK { k, span: self.kind.layout().cell_span(&self.shape, k) }
+    }
+
     /// Scalar twin of [`PointSet::stream_x8`].
     #[inline]
     pub fn stream_1(&self, pixel: u32, sample: u32, dim: u32, seed: u64) -> Stream<u32> {
@@ -364,6 +370,23 @@ impl Stream<U8> {
         #[cfg(test)]
         replay::count_api_call();
         self.layout.stream_point_8(&self.shape, &self.key, k)
+    }
+}
+
+/// Point k of a set with its lane- and stream-independent work done ([`PointSet::point_k`]):
+/// for grid layouts, the cell's span.
+#[derive(Clone, Copy, Debug)]
+pub struct PointK {
+    k: u32,
+    span: Option<[u32; 4]>,
+}
+
+impl Stream<U8> {
+    /// [`Stream::point`] of `pk`'s k, bit for bit (`pk` from the same set's
+    /// [`PointSet::point_k`]); cheaper when many streams draw the same k.
+    #[inline]
+    pub fn point_k(&self, pk: &PointK) -> (F8, F8) {
+        self.layout.stream_point_span_8(&self.shape, &self.key, pk.k, pk.span)
     }
 }
 

@@ -81,6 +81,25 @@ impl Layout for Stratified {
         }
     }
 
+    #[inline]
+    fn stream_point_span<L: Lanes>(
+        &self,
+        set: &SetShape,
+        s: &StreamKey<L>,
+        k: u32,
+        span: Option<[u32; 4]>,
+    ) -> (L::F, L::F) {
+        let Some([xl, xh, yl, yh]) = span else {
+            return self.stream_point(set, s, k);
+        };
+        if self.jitter {
+            let h = mix(s.prefix, L::splat(set.grid().n.rem(k)));
+            (jittered((L::splat(xl), L::splat(xh)), h), jittered((L::splat(yl), L::splat(yh)), mix(h, L::splat(1))))
+        } else {
+            (L::splat(xl).unit24(), L::splat(yl).unit24())
+        }
+    }
+
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]> {
         let grid: Grid = set.grid();
         let (cy, cx) = grid.nx.div_rem(grid.n.rem(k));

@@ -264,6 +264,12 @@ fn streams_equal_points_bit_for_bit() {
                 let st1 = set.stream_1(p[3], s[3], dim, seed);
                 for k in [0, 1, n / 2, n.saturating_sub(1), n.wrapping_add(3), u32::MAX] {
                     let (x8, y8) = st8.point(k);
+                    let (xk, yk) = st8.point_k(&set.point_k(k));
+                    assert_eq!(
+                        (x8.to_array().map(f32::to_bits), y8.to_array().map(f32::to_bits)),
+                        (xk.to_array().map(f32::to_bits), yk.to_array().map(f32::to_bits)),
+                        "point_k: {kind:?} n={n} k={k}"
+                    );
                     let (xr, yr) = set.point_x8(pixel, sample, dim, U8::splat(k), seed);
                     assert_eq!(
                         x8.to_array().map(f32::to_bits),
