@@ -386,6 +386,8 @@ impl Stream<U8> {
     /// [`PointSet::point_k`]); cheaper when many streams draw the same k.
     #[inline]
     pub fn point_k(&self, pk: &PointK) -> (F8, F8) {
+        #[cfg(test)]
+        replay::count_api_call();
         self.layout.stream_point_span_8(&self.shape, &self.key, pk.k, pk.span)
     }
 }
