@@ -2,6 +2,7 @@
 pub mod build;
 pub mod desc;
 pub mod error;
+pub mod gather;
 pub mod limits;
 pub mod obj;
 pub mod parse;

@@ -1,0 +1,361 @@
+//! The command line's grammar: subcommands, flags and their value parsers (clap), and the
+//! conversion of render flags into [`RenderOptions`]; `main.rs` runs what was asked.
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use strata::sampler::SamplerKind;
+use strata::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
+use strata::session::{self, RenderOptions};
+
+#[derive(Parser)]
+#[command(name = "strata", version, about = "SIMD packet ray tracer on Embree 4 for sampling experiments")]
+pub(crate) struct Cli {
+    #[command(subcommand)]
+    pub(crate) cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+pub(crate) enum Cmd {
+    /// Render a CSE168 .test scene (or the built-in Cornell box) to OUT.exr and OUT.png.
+    Render(RenderArgs),
+    /// Render a high-spp reference: linear EXR with a per-pixel variance layer (and a PNG), with
+    /// progress and ETA. Same flags as `render`; give --spp and -o.
+    Reference(RenderArgs),
+    /// Compare sampling techniques against a reference: K independent runs per variant at equal spp
+    /// (--spp-ladder) or equal time (--budget); writes rows.csv, rows.json, table.md, error.svg.
+    /// Seconds are the worker threads' CPU seconds; the sampler's ns/sample and share of the render
+    /// come from the phase profiler, which every run has on.
+    Compare {
+        /// Scene file (.test); omitted: the built-in Cornell box.
+        scene: Option<PathBuf>,
+        /// Reference EXR (from `strata reference`), same size as the renders.
+        #[arg(long)]
+        reference: PathBuf,
+        /// NAME=OPTIONS, OPTIONS being render flags, e.g. strat=--light-sampler=stratified
+        /// (several flags separated by spaces). Repeat for each variant.
+        #[arg(long = "variant", required = true)]
+        variants: Vec<String>,
+        /// Independent runs per variant (seeds differ), at least 2.
+        #[arg(long, default_value_t = 4)]
+        runs: usize,
+        /// Equal time: CPU seconds of the worker threads per run (passes of one sample until spent).
+        #[arg(long, conflicts_with = "spp_ladder")]
+        budget: Option<f64>,
+        /// Equal spp: comma-separated spp values, e.g. 1,2,4,8.
+        #[arg(long, value_delimiter = ',')]
+        spp_ladder: Option<Vec<u32>>,
+        /// Image size WxH for every variant (must match the reference).
+        #[arg(long, value_parser = parse_size)]
+        size: Option<(u32, u32)>,
+        /// Worker threads (0 = all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Output folder.
+        #[arg(long, default_value = "compare")]
+        out: PathBuf,
+        /// Write each variant's phase profile over all its runs (the keys of `strata profile
+        /// --json`, plus `variant`) as a JSON list to this file.
+        #[arg(long, value_name = "FILE")]
+        profile: Option<PathBuf>,
+        /// Write the variants' phase profiles as an SVG stacked bar chart (one bar per variant).
+        #[arg(long, value_name = "FILE")]
+        profile_svg: Option<PathBuf>,
+    },
+    /// Merge the part files of `render --samples A..B` shards (checkpoints) into OUT.exr and
+    /// OUT.png, bit-identical to one render of the whole range; refuses parts of another render,
+    /// unfinished parts, overlaps and gaps.
+    Merge {
+        /// Part files (.ckpt), any order.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output stem: writes OUT.exr and OUT.png.
+        #[arg(short = 'o', long = "out")]
+        out: PathBuf,
+        /// Print nothing on success.
+        #[arg(long, short = 'q')]
+        quiet: bool,
+    },
+    /// Write a procedural OBJ+MTL mesh (bumpy torus on a floor under an emissive patch) of at least
+    /// --triangles triangles, for throughput runs: OUT.obj and OUT.mtl.
+    GenMesh {
+        /// Output OBJ path (the MTL is written beside it).
+        out: PathBuf,
+        /// Minimum number of triangles of the torus.
+        #[arg(long, default_value_t = 1_000_000)]
+        triangles: usize,
+    },
+    /// Regenerate the seed experiments (direct lighting light samplers; path tracing pixel
+    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, contact sheets, plots.
+    Experiments {
+        /// Output folder.
+        #[arg(long, default_value = "docs/experiments")]
+        out: PathBuf,
+        /// The CSE168 corpus (default ../shared/cse168 beside the crate, or $STRATA_CSE168).
+        #[arg(long)]
+        corpus: Option<PathBuf>,
+        /// Independent runs per variant (K).
+        #[arg(long, default_value_t = 16)]
+        runs: usize,
+        /// Image width (heights keep each scene's aspect).
+        #[arg(long, default_value_t = 160)]
+        width: u32,
+        /// Light samples of each half of the direct-lighting reference.
+        #[arg(long, default_value_t = 4096)]
+        ref_light_samples: u32,
+        /// spp of the path-tracing references.
+        #[arg(long, default_value_t = 1024)]
+        ref_spp: u32,
+        /// Worker threads (0 = all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Contact-sheet tiles are the images box-downsampled by this factor.
+        #[arg(long, default_value_t = 2)]
+        sheet_factor: u32,
+    },
+    /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
+    Rays {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Break the worker threads' time into phases (sampler by dimension group, emitter sampling,
+    /// Embree intersect/occluded, user geometry, hit gather, BSDF sampling and eval, MIS,
+    /// accumulation, film, other) with % of render, ns per sample and ns per ray; the overhead is
+    /// measured by rendering the same job unprofiled, interleaved.
+    Profile {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Also write the profile as JSON to this file.
+        #[arg(long = "json", value_name = "FILE")]
+        json_file: Option<PathBuf>,
+        /// Also write the phases as an SVG stacked bar chart (shares in %, legend) to this file.
+        #[arg(long = "svg", value_name = "FILE")]
+        svg_file: Option<PathBuf>,
+        /// Renders per mode (profiling off and on, interleaved); the fastest of each counts.
+        #[arg(long, default_value_t = strata::session::profile::REPEATS)]
+        repeats: usize,
+    },
+}
+
+#[derive(clap::Args)]
+pub(crate) struct RenderArgs {
+    /// Scene file (.test, or .obj for a whole-scene OBJ); omitted: the built-in Cornell box.
+    pub(crate) scene: Option<PathBuf>,
+    /// Camera "ex ey ez cx cy cz ux uy uz fovy" (the format's camera arguments), replacing the
+    /// scene's (for an .obj, the default one framing its bounds).
+    #[arg(long, value_parser = session::parse_camera, allow_hyphen_values = true)]
+    pub(crate) camera: Option<strata::scene::desc::CameraDesc>,
+    /// Samples per pixel (default: the scene's spp).
+    #[arg(long)]
+    pub(crate) spp: Option<u32>,
+    /// Image size WxH, keeping the camera (default: the scene's size).
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<(u32, u32)>,
+    /// Base seed of every sample stream.
+    #[arg(long, default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    pub(crate) threads: usize,
+    // Light sample layout; the help lists the sampler registry.
+    #[arg(long, value_parser = parse_sampler, help = format!("Light sample layout: {}", SamplerKind::help_list()))]
+    pub(crate) light_sampler: Option<SamplerKind>,
+    /// Light samples per light (default: the scene's lightsamples).
+    #[arg(long)]
+    pub(crate) light_samples: Option<u32>,
+    // Pixel sample layout; the help lists the sampler registry.
+    #[arg(long, value_parser = parse_sampler, help = format!(
+        "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
+         puts the sample at the pixel centre)",
+        SamplerKind::help_list()
+    ))]
+    pub(crate) pixel_sampler: Option<SamplerKind>,
+    /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
+    #[arg(long, value_parser = parse_integrator)]
+    pub(crate) integrator: Option<IntegratorKind>,
+    /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
+    #[arg(long, value_parser = parse_importance_sampling)]
+    pub(crate) importance_sampling: Option<ImportanceSampling>,
+    /// Path tracer next event estimation: off, on, mis (default: the scene's nexteventestimation).
+    #[arg(long, value_parser = parse_nee)]
+    pub(crate) nee: Option<Nee>,
+    /// Path tracer Russian roulette: on, off (default: the scene's russianroulette).
+    #[arg(long, value_parser = parse_on_off)]
+    pub(crate) russian_roulette: Option<bool>,
+    /// Maximum depth, -1 = unbounded (default: the scene's maxdepth).
+    #[arg(long, allow_negative_numbers = true)]
+    pub(crate) max_depth: Option<i32>,
+    /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
+    #[arg(short = 'o', long = "out")]
+    pub(crate) out: Option<PathBuf>,
+    /// Write statistics as JSON to this file.
+    #[arg(long)]
+    pub(crate) stats: Option<PathBuf>,
+    /// Profile the render's phases (as `strata profile`, without its unprofiled re-render) and write
+    /// the profile JSON to this file; the image is bit-identical either way.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) profile: Option<PathBuf>,
+    /// Print nothing on success.
+    #[arg(long, short = 'q')]
+    pub(crate) quiet: bool,
+    /// Shading kernel: `auto` runs the one compiled for the scene's features (see `features` and
+    /// `kernel` in --stats), `general` the one with every feature compiled in. Same image either way.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "general"])]
+    pub(crate) kernel: String,
+    /// Path tracer only, opt-in and BIASED: scale each pixel sample down so its largest RGB channel is
+    /// at most MAX (trades fireflies for a darker, inconsistent estimate; off by default).
+    #[arg(long, value_name = "MAX", value_parser = parse_clamp)]
+    pub(crate) clamp: Option<f32>,
+    /// Write the accumulated state here (atomically) every --checkpoint-every seconds and at the
+    /// end; resume it with --resume. Default with --samples or on Ctrl-C: OUT.ckpt.
+    #[arg(long)]
+    pub(crate) checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (0: after every pass).
+    #[arg(long, default_value_t = session::DEFAULT_CHECKPOINT_EVERY)]
+    pub(crate) checkpoint_every: f64,
+    /// Continue the render held in this checkpoint (refused if the scene or an option differs);
+    /// it keeps being checkpointed there unless --checkpoint says otherwise.
+    #[arg(long)]
+    pub(crate) resume: Option<PathBuf>,
+    /// Render only sample indices A..B (0 <= A < B <= spp) of every pixel: a part for `strata merge`.
+    #[arg(long, value_parser = parse_range)]
+    pub(crate) samples: Option<(u32, u32)>,
+    /// Render whole passes until this many seconds are spent and record the spp reached
+    /// (independent pixel and path layouts; --spp, if given, caps the samples).
+    #[arg(long)]
+    pub(crate) time_budget: Option<f64>,
+    /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
+    /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth.
+    #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_limit)]
+    pub(crate) limits: Vec<String>,
+    /// 8-bit PNG values: truncate (the CSE168 course's writer, floor(255 c); default for .test scenes)
+    /// or round (default for .obj scenes). The EXR is linear and not affected.
+    #[arg(long, value_parser = parse_quantize)]
+    pub(crate) quantize: Option<strata::film::Quantize>,
+    /// Pixel sample 0: centre (through the pixel centre like the CSE168 course code; default for .test
+    /// scenes; O(1/spp) bias, see README) or jittered (strata's unbiased stratified layout; default for
+    /// .obj scenes). spp 1 with centre is the course's deterministic image.
+    #[arg(long, value_parser = parse_first_sample)]
+    pub(crate) first_sample: Option<strata::integrator::FirstSample>,
+    /// Path tracer NEE light selection: all (every light, `lightsamples` points each; the CSE168
+    /// convention, default for .test scenes), uniform (one light, the historical path-tracer choice;
+    /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
+    #[arg(long, value_name = "NAME")]
+    pub(crate) light_selection: Option<strata::integrator::LightSelection>,
+    /// Keep an OBJ scene without emitters unlit (by default an area light is added above and
+    /// behind the camera, announced on stderr).
+    #[arg(long)]
+    pub(crate) no_default_light: bool,
+}
+
+impl RenderArgs {
+    pub(crate) fn options(self) -> RenderOptions {
+        RenderOptions {
+            scene: self.scene,
+            spp: self.spp,
+            size: self.size,
+            seed: self.seed,
+            threads: self.threads,
+            light_sampler: self.light_sampler,
+            light_samples: self.light_samples,
+            pixel_sampler: self.pixel_sampler,
+            out: self.out,
+            stats: self.stats,
+            profile: self.profile,
+            integrator: self.integrator,
+            progress: !self.quiet,
+            general_kernel: self.kernel == "general",
+            clamp: self.clamp,
+            checkpoint: self.checkpoint,
+            checkpoint_every: Some(self.checkpoint_every),
+            resume: self.resume,
+            samples: self.samples,
+            time_budget: self.time_budget,
+            stop: None,
+            camera: self.camera,
+            importance_sampling: self.importance_sampling,
+            nee: self.nee,
+            russian_roulette: self.russian_roulette,
+            max_depth: self.max_depth,
+            limits: limits_of(&self.limits),
+            quantize: self.quantize,
+            first_sample: self.first_sample,
+            light_selection: self.light_selection,
+            no_default_light: self.no_default_light,
+            rendering: None,
+        }
+    }
+}
+
+/// Checks one `--limit NAME=VALUE` (the assignment is applied again in [`limits_of`]).
+pub(crate) fn parse_limit(s: &str) -> Result<String, String> {
+    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string()).map_err(|e| e.to_string())
+}
+
+/// The default limits with every (already checked) `--limit` applied in order.
+pub(crate) fn limits_of(assignments: &[String]) -> strata::scene::parse::Limits {
+    let mut limits = strata::scene::parse::Limits::default();
+    for a in assignments {
+        let _ = limits.set(a); // validated by `parse_limit`
+    }
+    limits
+}
+
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got `{s}`"))?;
+    let p = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected WxH with positive integers, got `{s}`"));
+    Ok((p(w)?, p(h)?))
+}
+
+pub(crate) fn parse_quantize(s: &str) -> Result<strata::film::Quantize, String> {
+    strata::film::Quantize::parse(s).ok_or_else(|| format!("expected truncate or round, got `{s}`"))
+}
+
+pub(crate) fn parse_first_sample(s: &str) -> Result<strata::integrator::FirstSample, String> {
+    strata::integrator::FirstSample::parse(s).ok_or_else(|| format!("expected centre or jittered, got `{s}`"))
+}
+
+pub(crate) fn parse_clamp(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("--clamp expects a positive finite radiance, got `{s}`")),
+    }
+}
+
+pub(crate) fn parse_range(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B, got `{s}`"))?;
+    let p =
+        |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected A..B with non-negative integers, got `{s}`"));
+    let (a, b) = (p(a)?, p(b)?);
+    if a >= b {
+        return Err(format!("expected A..B with A < B, got `{s}`"));
+    }
+    Ok((a, b))
+}
+
+pub(crate) fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
+    SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` ({})", SamplerKind::names()))
+}
+
+pub(crate) fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+    IntegratorKind::parse(s)
+        .ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
+}
+
+pub(crate) fn parse_nee(s: &str) -> Result<Nee, String> {
+    Nee::parse(s).ok_or_else(|| format!("unknown next event estimation `{s}` (off, on, mis)"))
+}
+
+pub(crate) fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got `{s}`")),
+    }
+}
+
+pub(crate) fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, String> {
+    ImportanceSampling::parse(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+}
