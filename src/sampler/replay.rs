@@ -407,6 +407,10 @@ impl Recording {
     /// away; equal for equal sets).
     pub fn replay(&self, sets: &ReplaySets, mode: ReplayMode) -> (u64, u32) {
         let mut streams: Vec<Stream<U8>> = Vec::new();
+        // The render finds point k's per-k work once for all its streams (`PointSet::point_k`,
+        // then `Stream::point_k`): so does the replay, for the last k seen.
+        let mut point_k = sets.light.point_k(0);
+        let mut last_k = 0u32;
         let (mut calls, mut sum) = (0u64, 0u32);
         let sample_on = mode == ReplayMode::Sample;
         for t in &self.tiles {
@@ -421,7 +425,10 @@ impl Recording {
                     let (si, k) = (w[i], w[i + 1]);
                     i += 2;
                     if let (true, Some(s)) = (sample_on, streams.get(si as usize)) {
-                        let (x, y) = s.point(k);
+                        if k != last_k {
+                            (point_k, last_k) = (sets.light.point_k(k), k);
+                        }
+                        let (x, y) = s.point_k(&point_k);
                         sum = fold(sum, x.to_bits() ^ y.to_bits());
                     } else {
                         sum = fold(sum, U8::splat(std::hint::black_box(si ^ k)));
