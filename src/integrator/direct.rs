@@ -108,24 +108,8 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                     continue;
                 }
                 let Some(&ls) = next_point.next() else { break };
-                let to = ls.y - sh.p;
-                let d2 = to.length_squared();
-                let inv_d = F8::ONE / d2.sqrt();
-                let wi = to.scale(inv_d);
-                let cos_i = sh.n.dot(wi);
-                let cos_l = -ls.normal.dot(wi);
-                // Smooth-shaded lanes: the light must also be above the geometric surface.
-                let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
-                let lit = shade & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves;
-                if lit.none() {
-                    continue;
-                }
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-                let f = {
-                    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-                    material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
-                };
-                let g = cos_i * cos_l * inv_d * inv_d;
+                let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, shade) else { continue };
                 sc.contrib.push(match group {
                     Group::Quad(_) => f.scale(g),
                     Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
@@ -194,22 +178,8 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
                 let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
                 (scene.emitters.place_x8(idx, inv_pmf, u, v), ok)
             };
-            let to = ls.y - sh.p;
-            let d2 = to.length_squared();
-            let inv_d = F8::ONE / d2.sqrt();
-            let wi = to.scale(inv_d);
-            let cos_i = sh.n.dot(wi);
-            let cos_l = -ls.normal.dot(wi);
-            let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
-            let lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves;
-            if lit.none() {
-                continue;
-            }
-            let f = {
-                let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-                material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
-            };
-            let g = cos_i * cos_l * inv_d * inv_d * ls.area * ls.inv_pmf * inv_n;
+            let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
+            let g = g * ls.area * ls.inv_pmf * inv_n;
             sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));
             let o = sh.ng.mul_add(scene.offset_eps(sh.p), sh.p);
             let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
@@ -220,6 +190,42 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
         let Scratch { shadow, contrib, owner, .. } = &mut **sc;
         trace_shadow_batch(tracer, shadow, contrib, owner, out);
     }
+}
+
+/// What a light sample adds at a shading packet before visibility (see [`light_term`]).
+struct LightTerm {
+    /// the BSDF value for the direction to the light
+    f: Vec3x8,
+    /// cos(th_i) cos(th_l) / d^2
+    g: F8,
+    /// 1 / d
+    inv_d: F8,
+    /// the `active` lanes the sample lights: both cosines positive, d > 0 and, on smooth-shaded
+    /// lanes, the light above the geometric surface too
+    lit: Mask8,
+}
+
+/// The light term of light points `ls` at hits `sh` on lanes `active`; None where it lights no
+/// lane.
+#[inline]
+fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) -> Option<LightTerm> {
+    let to = ls.y - sh.p;
+    let d2 = to.length_squared();
+    let inv_d = F8::ONE / d2.sqrt();
+    let wi = to.scale(inv_d);
+    let cos_i = sh.n.dot(wi);
+    let cos_l = -ls.normal.dot(wi);
+    // Smooth-shaded lanes: the light must also be above the geometric surface.
+    let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+    let lit = active & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves;
+    if lit.none() {
+        return None;
+    }
+    let f = {
+        let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
+        material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
+    };
+    Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
 }
 
 /// The material of a hit record.
