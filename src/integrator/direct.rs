@@ -61,11 +61,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
     let sample_idx = U8::splat(s);
-    // Lights shade nothing themselves (black, one-sided emitters).
-    sc.shade.clear();
-    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
-    sc.eps.clear();
-    sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
+    shading_lanes(scene, sc);
     for (gi, group) in groups(scene).enumerate() {
         let dim = DIM_LIGHT_BASE + gi as u32;
         sc.acc.clear();
@@ -135,14 +131,22 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
     }
 }
 
+/// Per camera packet of the tile: `sc.shade`, the hit lanes to shade (lights shade nothing
+/// themselves: black, one-sided emitters), and `sc.eps`, the shadow-ray origin offsets.
+fn shading_lanes(scene: &Scene, sc: &mut Scratch) {
+    sc.shade.clear();
+    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
+    sc.eps.clear();
+    sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
+}
+
 /// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
 fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
     let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
     let sample_idx = U8::splat(s);
-    sc.shade.clear();
-    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
+    shading_lanes(scene, sc);
     sc.streams.clear();
     sc.choice_streams.clear();
     {
@@ -173,15 +177,12 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
             };
             let (ls, ok) = {
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                let (idx, pmf) = it.light_sampler.sample_x8(uc, sh.p, sh.n, shade);
-                let ok = shade & pmf.simd_gt(F8::ZERO);
-                let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
-                (scene.emitters.place_x8(idx, inv_pmf, u, v), ok)
+                it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
             };
             let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
             let g = g * ls.area * ls.inv_pmf * inv_n;
             sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));
-            let o = sh.ng.mul_add(scene.offset_eps(sh.p), sh.p);
+            let o = sh.ng.mul_add(sc.eps[i], sh.p);
             let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
             let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
             sc.shadow.push((ray, lit));

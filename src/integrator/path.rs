@@ -333,10 +333,7 @@ impl Integrator {
                         LightSelection::Power | LightSelection::Spatial => {
                             let (ls, ok) = {
                                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                                let (idx, pmf) = self.light_sampler.sample_x8(u_choice, sh.p, sh.n, shade);
-                                let ok = shade & pmf.simd_gt(F8::ZERO);
-                                let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
-                                (scene.emitters.place_x8(idx, inv_pmf, u, w), ok)
+                                self.light_sampler.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
                             };
                             push(ls, None, None, ok);
                         }

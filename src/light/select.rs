@@ -26,7 +26,7 @@ mod wide;
 #[path = "select_tests.rs"]
 mod tests;
 
-use super::emitters::Emitter;
+use super::emitters::{Emitter, Emitters, LightSample8};
 use crate::simd::{mask_to_bools, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 use tree::LightTree;
@@ -223,6 +223,25 @@ impl LightSampler {
             }
             LightSelection::Spatial => self.tree.pmf(p, n, i),
         }
+    }
+
+    /// A light per lane chosen by [`LightSampler::sample_x8`] with `u_choice`, and the point
+    /// `(u, v)` on it (`emitters.place_x8`, with 1 / pmf in the sample); the mask is the `active`
+    /// lanes that got a light (pmf > 0).
+    #[inline]
+    pub fn sample_point_x8(
+        &self,
+        emitters: &Emitters,
+        u_choice: F8,
+        p: Vec3x8,
+        n: Vec3x8,
+        active: Mask8,
+        (u, v): (F8, F8),
+    ) -> (LightSample8, Mask8) {
+        let (idx, pmf) = self.sample_x8(u_choice, p, n, active);
+        let ok = active & pmf.simd_gt(F8::ZERO);
+        let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
+        (emitters.place_x8(idx, inv_pmf, u, v), ok)
     }
 
     /// Eight-lane [`LightSampler::sample`]: `(light, pmf)` per lane; lanes that are inactive or

@@ -3,7 +3,7 @@
 
 use super::tree::LightTree;
 use super::*;
-use crate::sampling::chi2::{gamma_q, Rng, CHI2_TESTS, SIGNIFICANCE};
+use crate::sampling::chi2::{gamma_q, statistic, Rng, CHI2_TESTS, SIGNIFICANCE};
 use crate::simd::{mask_all, mask_from_bools};
 
 const PICKING: [LightSelection; 3] = [LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial];
@@ -74,26 +74,11 @@ fn chi2_choice(name: &str, s: &LightSampler, p: Vec3, nrm: Vec3, n_samples: usiz
             None => observed[k] += 1,
         }
     }
-    let mut cells: Vec<(f64, f64)> =
-        expected.iter().zip(&observed).map(|(&e, &o)| (e * n_samples as f64, o as f64)).collect();
-    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (mut pe, mut po, mut chi2, mut dof) = (0.0, 0.0, 0.0, 0usize);
-    for (e, o) in cells {
-        if e <= 1e-9 {
-            assert!(o == 0.0, "{name}: {o} picks in a bin of probability 0");
-        } else if e < 5.0 || (pe > 0.0 && pe < 5.0) {
-            pe += e;
-            po += o;
-        } else {
-            chi2 += (o - e) * (o - e) / e;
-            dof += 1;
-        }
+    let expected: Vec<f64> = expected.iter().map(|&e| e * n_samples as f64).collect();
+    for (e, &o) in expected.iter().zip(&observed) {
+        assert!(*e > 1e-9 || o == 0, "{name}: {o} picks in a bin of probability 0");
     }
-    if pe > 0.0 {
-        chi2 += (po - pe) * (po - pe) / pe;
-        dof += 1;
-    }
-    let dof = dof.saturating_sub(1).max(1);
+    let (chi2, dof) = statistic(&observed, &expected, n_samples, name);
     let pv = gamma_q(0.5 * dof as f64, 0.5 * chi2);
     eprintln!("chi2 {name}: chi2 = {chi2:.1}, dof = {dof}, p = {pv:.4}, sum of pmf = {sum:.7}");
     pv

@@ -263,8 +263,9 @@ pub(crate) fn gamma_q(a: f64, x: f64) -> f64 {
     }
 }
 
-/// Pearson's statistic with pooling of small cells; returns (chi2, degrees of freedom).
-fn statistic(observed: &[u64], expected: &[f64], n: usize, name: &str) -> (f64, usize) {
+/// Pearson's statistic of `observed` counts against `expected` counts (of `n` samples), cells
+/// expected below 5 pooled; returns (chi2, degrees of freedom).
+pub(crate) fn statistic(observed: &[u64], expected: &[f64], n: usize, name: &str) -> (f64, usize) {
     let mut cells: Vec<(f64, f64)> = expected.iter().zip(observed).map(|(&e, &o)| (e, o as f64)).collect();
     cells.sort_by(|a, b| a.0.total_cmp(&b.0));
     let (mut pool_e, mut pool_o, mut chi2, mut k) = (0.0, 0.0, 0.0, 0usize);
