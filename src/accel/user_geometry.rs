@@ -268,3 +268,7 @@ pub(super) unsafe extern "C" fn ellipsoid_occluded(args: *const sys::RTCOccluded
         });
     })
 }
+
+#[cfg(test)]
+#[path = "user_geometry_tests.rs"]
+mod tests;
