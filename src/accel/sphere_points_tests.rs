@@ -61,8 +61,8 @@ fn trace(scene: &Scene, rays: &[Ray]) -> Vec<Option<Answer>> {
         let active = rh.ray.set(org, dir, lane(&|r| r.tn), lane(&|r| r.tf), mask_first(chunk.len()));
         let traced = scene.intersect8(&mut rh, false, active);
         let hit = mask_to_bools(Hits8::from_rayhit(&rh, traced).hit);
-        for i in 0..chunk.len() {
-            out.push(hit[i].then(|| Answer {
+        for (i, &hit) in hit.iter().enumerate().take(chunk.len()) {
+            out.push(hit.then(|| Answer {
                 t: rh.ray.tfar[i],
                 ng: Vec3::new(rh.hit.ng_x[i], rh.hit.ng_y[i], rh.hit.ng_z[i]),
                 prim: rh.hit.prim_id[i],
