@@ -4,12 +4,16 @@
 //! packets whose rays reach the bounding box, as Embree would call) and on random rays (random
 //! origins in a box around the primitive, aimed at random points of its bounding ball).
 //! After criterion, a table of ns per ray (median of 7 interleaved thread-CPU timings) and the
-//! share of lanes left to f64.
+//! share of lanes left to f64; then, for the sphere, the same packets through Embree
+//! (`rtcIntersect8` and `rtcOccluded8` on a scene holding only it) as today's user geometry and as
+//! Embree's own sphere point (`SceneBuilder::add_spheres`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{Mat4, Vec3};
 use std::hint::black_box;
 use strata::accel::ellipsoid::bench::{pack, Packet, Prim, Rng};
+use strata::accel::{Device, Hits8, Ray8, RayHit8, Scene, SceneBuilder};
+use strata::simd::{mask_all, Vec3x8, F8};
 
 fn packet(rays: &[(Vec3, Vec3)]) -> Packet {
     pack(&rays.iter().map(|&(o, d)| (o, d, 0.0, f32::INFINITY)).collect::<Vec<_>>())
@@ -114,6 +118,75 @@ fn ellipsoid_bench(c: &mut Criterion) {
     println!("\nprimitive  rays     lanes   hit%   f64-fallback%   scalar f64 ns/ray   packet f32 ns/ray   speedup");
     for (p, s, lanes, hits, uns, a, b) in table {
         println!("{p:10} {s:7} {lanes:6} {:6.1} {:14.2} {a:19.2} {b:19.2} {:8.2}x", hits * 100.0, uns * 100.0, a / b);
+    }
+    embree_table(centre, 0.3, &mut rng);
+}
+
+/// The packet's rays as an Embree `Ray8`.
+fn ray8(p: &Packet) -> Ray8 {
+    let v3 = |f: usize| Vec3x8::new(F8::new(p[f]), F8::new(p[f + 1]), F8::new(p[f + 2]));
+    Ray8::new(v3(0), v3(4), F8::new(p[3]), F8::new(p[8]), mask_all()).0
+}
+
+/// Closest hits of every packet: (hit lanes, sum of distances).
+fn intersect_all(scene: &Scene, pk: &[Packet]) -> (u32, f64) {
+    pk.iter().fold((0, 0.0), |(n, s), p| {
+        let mut rh = RayHit8 { ray: ray8(p), ..RayHit8::default() };
+        let traced = scene.intersect8(&mut rh, false, mask_all());
+        let h = Hits8::from_rayhit(&rh, traced);
+        let t = h.hit.select(h.t, F8::ZERO).to_array();
+        (n + h.hit.to_bitmask().count_ones(), s + t.iter().map(|&t| f64::from(t)).sum::<f64>())
+    })
+}
+
+/// Occluded lanes of every packet.
+fn occluded_all(scene: &Scene, pk: &[Packet]) -> u32 {
+    pk.iter().map(|p| scene.occluded8(&mut ray8(p), mask_all()).to_bitmask().count_ones()).sum()
+}
+
+/// The sphere of radius `r` at `c` through Embree: user geometry against sphere point.
+fn embree_table(c: Vec3, r: f32, rng: &mut Rng) {
+    let dev = Device::new().unwrap();
+    let mut b = SceneBuilder::new(&dev).unwrap();
+    b.add_spheres(&[c.extend(r)]).unwrap();
+    let points = b.commit().unwrap();
+    let mut b = SceneBuilder::new(&dev).unwrap();
+    b.add_ellipsoids(&[Mat4::from_translation(c) * Mat4::from_scale(Vec3::splat(r))]).unwrap();
+    let user = b.commit().unwrap();
+    println!("\nsphere through Embree  rays     query       user geometry ns/ray   sphere point ns/ray   point/user");
+    for (sname, pk) in [("camera", camera_packets(c, r)), ("random", random_packets(rng, c, r, 4096))] {
+        let (nu, su) = intersect_all(&user, &pk);
+        let (np, sp) = intersect_all(&points, &pk);
+        assert_eq!(nu, np, "{sname}: hit counts differ");
+        assert!((su - sp).abs() <= 1e-5 * su, "{sname}: {su} vs {sp}");
+        let lanes = (pk.len() * 8) as f64;
+        let cpu = |f: &dyn Fn() -> u32| {
+            strata::measure::thread_seconds(|| {
+                for _ in 0..20 {
+                    black_box(f());
+                }
+            }) / 20.0
+        };
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2] * 1e9 / lanes
+        };
+        for query in ["intersect8", "occluded8"] {
+            let run = |s: &Scene| -> u32 {
+                if query == "intersect8" {
+                    intersect_all(s, black_box(&pk)).0
+                } else {
+                    occluded_all(s, black_box(&pk))
+                }
+            };
+            let (mut tu, mut tp) = (Vec::new(), Vec::new());
+            for _ in 0..7 {
+                tu.push(cpu(&|| run(&user)));
+                tp.push(cpu(&|| run(&points)));
+            }
+            let (a, b) = (median(tu), median(tp));
+            println!("{:22} {sname:7}  {query:10} {a:22.2} {b:21.2} {:11.2}x", "", b / a);
+        }
     }
 }
 

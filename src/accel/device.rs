@@ -55,6 +55,14 @@ impl Device {
         Ok(Self { raw, sink })
     }
 
+    /// Whether this Embree build has point geometry (`RTC_GEOMETRY_TYPE_SPHERE_POINT`, used by
+    /// [`super::SceneBuilder::add_spheres`]).
+    pub fn supports_points(&self) -> bool {
+        // SAFETY: a live device and a property every Embree 4 build answers.
+        let v = unsafe { sys::rtcGetDeviceProperty(self.raw, sys::RTCDeviceProperty::POINT_GEOMETRY_SUPPORTED) };
+        v != 0
+    }
+
     /// Returns (and clears) the errors Embree reported since the last call.
     pub fn take_errors(&self) -> Result<(), AccelError> {
         let mut v = self.sink.0.lock().map_err(|_| AccelError("error sink poisoned".into()))?;

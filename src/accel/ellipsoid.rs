@@ -2,8 +2,9 @@
 //! once, in f32 SIMD, with a per-lane running error bound: a lane whose f32 answer could differ
 //! from the exact one (hit vs miss, which root, or a hit distance off by more than [`TAU`]
 //! relative) is recomputed by the scalar f64 [`Ellipsoid::hit`], which stays the reference.
-//! Safe code only: the Embree callback in `accel/mod.rs` loads the SoA lanes and calls
-//! [`packet_hits`].
+//! Safe code only: the Embree callbacks in `accel/user_geometry.rs` load the SoA lanes and call
+//! [`hits8`] (packets of 8, Embree's case for `rtcIntersect8`/`rtcOccluded8`) or [`packet_hits`]
+//! (any other width, 8 lanes at a time).
 //!
 //! # Formulation
 //! Object space with the ellipsoid's centre `C` (world) taken out first: `D = (o - C_hi) - C_lo`
@@ -257,10 +258,34 @@ pub(super) fn fast8(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, val
     Fast8 { hit, t: hit.select(t, none), unsure }
 }
 
+/// Intersects the ellipsoid with the `live` lanes of an 8-ray packet (Embree's fields as SoA
+/// vectors): f32 SIMD ([`fast8`]), with f64 ([`Ellipsoid::hit`]) for the lanes it leaves unsure.
+/// Returns the lanes hit inside (tnear, tfar) and their distances (0 in the other lanes).
+#[inline]
+pub(super) fn hits8(e: &Ellipsoid, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, live: Mask8) -> (Mask8, F8) {
+    let r = fast8(&e.fast, org, dir, tnear, tfar, live);
+    let unsure = r.unsure.to_bitmask();
+    if unsure == 0 {
+        return (r.hit, r.t);
+    }
+    let (mut hit, mut t) = (r.hit.to_bitmask(), r.t.to_array());
+    let mut bits = unsure;
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let (o, d) = (org.lane(i), dir.lane(i));
+        if let Some(ti) = e.hit(o.to_array(), d.to_array(), tnear.as_array()[i], tfar.as_array()[i]) {
+            t[i] = ti;
+            hit |= 1 << i;
+        }
+    }
+    (crate::simd::mask_from_bools(std::array::from_fn(|i| hit & (1 << i) != 0)), F8::new(t))
+}
+
 /// Intersects the ellipsoid with the `m <= 8` lanes of a packet: `load(field)` returns the first
 /// `m` floats of Embree ray field `field` (0-2 org, 3 tnear, 4-6 dir, 8 tfar; lanes >= m
 /// anything finite), `valid(i)` whether lane i is active. Calls `on_hit(lane, t)` for every lane
-/// hit inside (tnear, tfar), f32 SIMD with f64 ([`Ellipsoid::hit`]) for the unsure lanes.
+/// hit inside (tnear, tfar), in lane order ([`hits8`]).
 #[inline]
 pub(super) fn packet_hits(
     e: &Ellipsoid,
@@ -269,36 +294,17 @@ pub(super) fn packet_hits(
     valid: impl Fn(usize) -> bool,
     mut on_hit: impl FnMut(usize, f32),
 ) {
-    let mut vb = [0f32; 8];
-    for (i, v) in vb.iter_mut().enumerate().take(m) {
-        if valid(i) {
-            *v = f32::from_bits(u32::MAX);
-        }
-    }
-    let live = F8::new(vb);
+    let live = crate::simd::mask_from_bools(std::array::from_fn(|i| i < m && valid(i)));
     if live.none() {
         return;
     }
     let v3 = |f: usize| Vec3x8::new(F8::new(load(f)), F8::new(load(f + 1)), F8::new(load(f + 2)));
-    let (org, dir, tnear, tfar) = (v3(0), v3(4), F8::new(load(3)), F8::new(load(8)));
-    let r = fast8(&e.fast, org, dir, tnear, tfar, live);
-    let (hit, unsure) = (r.hit.to_bitmask(), r.unsure.to_bitmask());
-    if hit | unsure == 0 {
-        return;
-    }
-    let t = r.t.to_array();
-    let mut bits = hit | unsure;
+    let (hit, t) = hits8(e, v3(0), v3(4), F8::new(load(3)), F8::new(load(8)), live);
+    let (mut bits, t) = (hit.to_bitmask(), t.to_array());
     while bits != 0 {
         let i = bits.trailing_zeros() as usize;
         bits &= bits - 1;
-        if hit & (1 << i) != 0 {
-            on_hit(i, t[i]);
-        } else {
-            let (o, d) = (org.lane(i), dir.lane(i));
-            if let Some(t) = e.hit(o.to_array(), d.to_array(), tnear.as_array()[i], tfar.as_array()[i]) {
-                on_hit(i, t);
-            }
-        }
+        on_hit(i, t[i]);
     }
 }
 

@@ -8,17 +8,22 @@
 //! Geometry layout of a built scene (the ids `scene::build` relies on):
 //! - geometry [`GEOM_TRIANGLES`]: one triangle mesh holding every triangle (quad lights included);
 //! - geometry [`GEOM_SPHERES`]: spheres placed by similarity transforms, as Embree sphere points
-//!   (centre, radius) in world space: Embree's own vectorized intersector;
-//! - geometry [`GEOM_ELLIPSOIDS`]: spheres under any other affine map, as one Embree user geometry
-//!   whose primitive i is the unit sphere under that map (no instancing; f64 object-space
-//!   intersection, accurate at extreme scales; slower than sphere points);
+//!   (centre, radius) in world space: Embree's own intersector, used by `scene::build` only with
+//!   `STRATA_SPHERES=embree` (slower in packets and less exact than the user geometry:
+//!   `sphere_points_tests.rs`, `benches/ellipsoid.rs`);
+//! - geometry [`GEOM_ELLIPSOIDS`]: every sphere and ellipsoid (the unit sphere under any affine
+//!   map), as one Embree user geometry whose primitive i is the unit sphere under that map (no
+//!   instancing; f32 SIMD object-space intersection with an f64 fallback chosen by an error bound,
+//!   accurate at extreme scales);
 //! - geometries from [`GEOM_FIRST_INSTANCE`] on: instances (hits report `inst_id`).
 //!
 //! Geometry kinds must be added in this order; a kind may be skipped.
 //!
 //! Files: `ffi.rs` the packet structs with their layout asserts and the query arguments;
 //! `device.rs` the device and its error callback ([`AccelError`]); `scene.rs` the scene builder, the
-//! committed scene and its 8-wide queries ([`Hits8`]); `user_geometry.rs` the ellipsoid callbacks;
+//! committed scene and its 8-wide queries ([`Hits8`]); `user_geometry.rs` the ellipsoid callbacks
+//! (`ellipsoid.rs` their intersection); `sphere_points_tests.rs` Embree's sphere points against
+//! them and the f64 reference;
 //! `ftz.rs` the FTZ/DAZ switch; `alloc.rs` the counting allocator for tests.
 
 pub mod alloc;
@@ -27,6 +32,8 @@ pub mod ellipsoid;
 mod ffi;
 mod ftz;
 mod scene;
+#[cfg(test)]
+mod sphere_points_tests;
 #[cfg(test)]
 mod tests;
 mod user_geometry;

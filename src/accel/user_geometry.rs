@@ -2,6 +2,7 @@
 //! object space one lane at a time by Embree's callbacks (bounds, intersect, occluded).
 
 use super::ffi::RayQueryContext;
+use crate::simd::{Mask8, Vec3x8, F8, U8};
 use embree4_sys as sys;
 use glam::Mat4;
 use std::cell::Cell;
@@ -131,33 +132,79 @@ unsafe fn soa(base: *mut u32, n: usize, field: usize, lane: usize) -> *mut u32 {
     unsafe { base.add(field * n + lane) }
 }
 
-/// Runs the ellipsoid `prim` against every valid lane of an Embree SoA ray block of width `n` and
-/// calls `on_hit(lane, t)` for each lane it hits inside (tnear, tfar).
+/// The ellipsoid `prim` of the Vec<Ellipsoid> behind `user`.
+///
+/// # Safety
+/// `user` must be the Vec<Ellipsoid> set in add_ellipsoids and `prim` < its length.
+#[inline]
+unsafe fn ellipsoid<'a>(user: *mut c_void, prim: u32) -> &'a Ellipsoid {
+    // SAFETY: guaranteed by the caller; the Vec lives as long as the scene that calls us.
+    unsafe { &(&*(user as *const Vec<Ellipsoid>))[prim as usize] }
+}
+
+/// Field `field` (8 lanes) of an Embree SoA ray/hit block of width 8.
+///
+/// # Safety
+/// `base` must point to an RTCRayHit8/RTCRay8 with more than `field` fields.
+#[inline]
+unsafe fn row8(base: *mut u32, field: usize) -> *mut [f32; 8] {
+    // SAFETY: guaranteed by the caller.
+    unsafe { base.add(field * 8) as *mut [f32; 8] }
+}
+
+/// Writes `v` into field `field` of a width-8 block on the lanes of `m` (others unchanged).
+///
+/// # Safety
+/// As [`row8`].
+#[inline]
+unsafe fn blend8(base: *mut u32, field: usize, m: Mask8, v: F8) {
+    // SAFETY: guaranteed by the caller (unaligned access: Embree's blocks need no 32-byte alignment).
+    unsafe {
+        let p = row8(base, field);
+        std::ptr::write_unaligned(p, m.select(v, F8::new(std::ptr::read_unaligned(p))).to_array());
+    }
+}
+
+/// Runs the ellipsoid against a width-8 Embree SoA ray block (the `rtcIntersect8`/`rtcOccluded8`
+/// case, one SIMD pass): the lanes hit inside (tnear, tfar) and their distances.
+///
+/// # Safety
+/// `valid` must hold 8 ints and `base` point to an RTCRay8 (or the ray part of an RTCRayHit8).
+#[inline]
+unsafe fn ellipsoid_hits8(e: &Ellipsoid, valid: *const i32, base: *mut u32) -> (Mask8, F8) {
+    // SAFETY: guaranteed by the caller; Embree's valid ints are -1 (active) or 0.
+    unsafe {
+        let bits = U8::new(std::ptr::read_unaligned(valid as *const [u32; 8]));
+        let live = F8::from_bits(bits.simd_eq(U8::MAX));
+        if live.none() {
+            return (live, F8::ZERO);
+        }
+        let f = |field: usize| F8::new(std::ptr::read_unaligned(row8(base, field)));
+        let v3 = |field: usize| Vec3x8::new(f(field), f(field + 1), f(field + 2));
+        super::ellipsoid::hits8(e, v3(0), v3(4), f(3), f(8), live)
+    }
+}
+
+/// Runs the ellipsoid `e` against every valid lane of an Embree SoA ray block of width `n` (any
+/// width, 8 lanes at a time) and calls `on_hit(lane, t)` for each lane it hits inside (tnear, tfar).
 ///
 /// # Safety
 /// `valid` must hold `n` ints and `base` point to an RTCRayN (or the ray part of an RTCRayHitN) of
-/// width `n`; `user` must be the Vec<Ellipsoid> set in add_ellipsoids with `prim` < its length.
+/// width `n`.
 unsafe fn each_ellipsoid_hit(
+    e: &Ellipsoid,
     valid: *const i32,
-    user: *mut c_void,
-    prim: u32,
     base: *mut u32,
     n: usize,
     mut on_hit: impl FnMut(usize, f32),
 ) {
     // SAFETY: guaranteed by the caller (see the function's contract).
     unsafe {
-        let prims = &*(user as *const Vec<Ellipsoid>);
-        let e = &prims[prim as usize];
         for start in (0..n).step_by(8) {
             let m = (n - start).min(8);
             let load = |field: usize| {
-                let p = soa(base, n, field, start) as *const f32;
-                if m == 8 {
-                    return std::ptr::read_unaligned(p as *const [f32; 8]);
-                }
                 let mut v = [0f32; 8];
-                std::ptr::copy_nonoverlapping(p, v.as_mut_ptr(), m);
+                std::ptr::copy_nonoverlapping(soa(base, n, field, start) as *const f32, v.as_mut_ptr(), m);
                 v
             };
             let valid = |i: usize| *valid.add(start + i) == -1;
@@ -174,15 +221,31 @@ pub(super) unsafe extern "C" fn ellipsoid_intersect(args: *const sys::RTCInterse
         let a = &*args;
         let (n, base) = (a.N as usize, a.rayhit as *mut u32);
         let ctx = &*(a.context as *const RayQueryContext);
-        each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, t| {
+        let e = ellipsoid(a.geometryUserPtr, a.primID);
+        // Hit record: t, Ng and u, v zero (strata computes its own normals), the ids.
+        let ids = [a.primID, a.geomID, ctx.inst_id[0], ctx.inst_prim_id[0]];
+        if n == 8 {
+            let (hit, t) = ellipsoid_hits8(e, a.valid, base);
+            if hit.none() {
+                return;
+            }
+            blend8(base, 8, hit, t);
+            for field in 12..17 {
+                blend8(base, field, hit, F8::ZERO);
+            }
+            for (field, id) in (17..21).zip(ids) {
+                blend8(base, field, hit, F8::from_bits(U8::splat(id)));
+            }
+            return;
+        }
+        each_ellipsoid_hit(e, a.valid, base, n, |lane, t| {
             *soa(base, n, 8, lane) = t.to_bits();
             for field in 12..17 {
-                *soa(base, n, field, lane) = 0; // Ng and u, v: strata computes its own normals
+                *soa(base, n, field, lane) = 0;
             }
-            *soa(base, n, 17, lane) = a.primID;
-            *soa(base, n, 18, lane) = a.geomID;
-            *soa(base, n, 19, lane) = ctx.inst_id[0];
-            *soa(base, n, 20, lane) = ctx.inst_prim_id[0];
+            for (field, id) in (17..21).zip(ids) {
+                *soa(base, n, field, lane) = id;
+            }
         });
     })
 }
@@ -192,8 +255,20 @@ pub(super) unsafe extern "C" fn ellipsoid_occluded(args: *const sys::RTCOccluded
     timed(|| unsafe {
         let a = &*args;
         let (n, base) = (a.N as usize, a.ray as *mut u32);
-        each_ellipsoid_hit(a.valid, a.geometryUserPtr, a.primID, base, n, |lane, _| {
+        let e = ellipsoid(a.geometryUserPtr, a.primID);
+        if n == 8 {
+            let (hit, _) = ellipsoid_hits8(e, a.valid, base);
+            if hit.any() {
+                blend8(base, 8, hit, F8::splat(f32::NEG_INFINITY));
+            }
+            return;
+        }
+        each_ellipsoid_hit(e, a.valid, base, n, |lane, _| {
             *soa(base, n, 8, lane) = f32::NEG_INFINITY.to_bits();
         });
     })
 }
+
+#[cfg(test)]
+#[path = "user_geometry_tests.rs"]
+mod tests;

@@ -229,10 +229,13 @@ impl Scene {
         }
         let extent = if lo.x.is_finite() { ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE) } else { 1.0 };
 
-        // Spheres and ellipsoids go to one Embree user geometry (f64 intersection). With
-        // STRATA_SPHERES=embree, spheres under similarity transforms go to Embree's own sphere
-        // points instead: faster in isolation (replayed packets), but measured 2-3x slower inside
-        // the renderer on the hw2 Cornell box, where tracing alternates with shading.
+        // Spheres and ellipsoids go to one Embree user geometry (f32 SIMD with an f64 fallback,
+        // `accel::ellipsoid`). With STRATA_SPHERES=embree, spheres under similarity transforms go
+        // to Embree's own sphere points instead (for comparisons only): in this Embree 4.4 build
+        // they are slower in packets (3x per ray against the sphere alone, `benches/ellipsoid.rs`;
+        // hw2/sphere raw 24.6 against 60.9 Mrays/s, hw3/cornellSimple 11.2 against 16.6) and less
+        // exact (hit/miss flips on grazing rays and rays from 1e5 radii away, inclusive interval
+        // ends: `accel/sphere_points_tests.rs`).
         let embree_spheres = std::env::var("STRATA_SPHERES").is_ok_and(|v| v == "embree");
         let (mut points, mut sphere_point_index, mut ell_user, mut ellipsoid_index) = (vec![], vec![], vec![], vec![]);
         for (i, m) in ell_o2w.iter().enumerate() {
@@ -249,7 +252,12 @@ impl Scene {
         }
         let device = accel::Device::new()?;
         let mut b = accel::SceneBuilder::new(&device)?;
-        if std::env::var("STRATA_BVH").as_deref() == Ok("high") {
+        let high = match std::env::var("STRATA_BVH").as_deref() {
+            Ok("high") => true,
+            Ok("medium") => false,
+            _ => indices.len() >= HIGH_QUALITY_MIN_TRIANGLES,
+        };
+        if high {
             b.high_quality();
         }
         b.add_triangles(&vertices, &indices)?;
@@ -286,6 +294,15 @@ impl Scene {
         mag.mul_add(F8::splat(3e-5), F8::splat(self.extent * 1e-5))
     }
 }
+
+/// Triangle count from which the Embree scene is built at high quality (spatial splits). On
+/// hw4/dragon (100k triangles) high quality traced 1.4% faster in Embree alone (raw rays/s, five
+/// interleaved pairs, all faster; instructions +0.1%) for 30-40 ms more build (about 80 -> 115 ms):
+/// a gain for any render long enough for that to matter. On the Cornell boxes (tens of triangles)
+/// it changes nothing measurable (identical instruction counts), so small scenes keep Embree's
+/// medium build, and their images (one golden case, the OBJ Cornell box, would change bits).
+/// `STRATA_BVH=high` / `STRATA_BVH=medium` force either (for measurements).
+const HIGH_QUALITY_MIN_TRIANGLES: usize = 10_000;
 
 /// Centre and radius if the affine map `m` takes the unit sphere to a sphere (its linear part is
 /// a rotation times a uniform scale, to 1e-5 relative).
