@@ -147,16 +147,22 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
     let inv_n = F8::splat(1.0 / n_light as f32);
     let sample_idx = U8::splat(s);
     shading_lanes(scene, sc);
+    // One light chosen uniformly: the choice is light 0 with pmf 1 whatever its sample, so the
+    // choice dimension is not drawn (every sample is a pure function of its own dimension: the
+    // others are unchanged).
+    let one_light = it.light_sampler.selection() == LightSelection::Uniform && it.light_sampler.len() == 1;
     sc.streams.clear();
     sc.choice_streams.clear();
     {
         let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
         sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE, it.seed)));
-        sc.choice_streams
-            .extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE + 1, it.seed)));
         crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, DIM_LIGHT_BASE);
-        let choice = pks.iter().map(|pk| pk.pixel);
-        crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
+        if !one_light {
+            sc.choice_streams
+                .extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE + 1, it.seed)));
+            let choice = pks.iter().map(|pk| pk.pixel);
+            crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
+        }
     }
     let n_pks = pks.len() as u32;
     for k in 0..n_light {
@@ -169,13 +175,22 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
             if shade.none() {
                 continue;
             }
-            let ((u, v), (uc, _)) = {
-                let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                crate::sampler::replay::light_point(i as u32, k);
-                crate::sampler::replay::light_point(n_pks + i as u32, k);
-                (sc.streams[i].point_k(&point_k), sc.choice_streams[i].point_k(&point_k))
-            };
-            let (ls, ok) = {
+            let (ls, ok) = if one_light {
+                let (u, v) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(i as u32, k);
+                    sc.streams[i].point_k(&point_k)
+                };
+                // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
+                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
+            } else {
+                let ((u, v), (uc, _)) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(i as u32, k);
+                    crate::sampler::replay::light_point(n_pks + i as u32, k);
+                    (sc.streams[i].point_k(&point_k), sc.choice_streams[i].point_k(&point_k))
+                };
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
             };
