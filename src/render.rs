@@ -7,7 +7,7 @@
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
 pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
-use crate::film::{leaf_moments, push_block, Block, Film, Moments};
+use crate::film::{push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::Vec3x8;
@@ -292,16 +292,18 @@ fn accumulate(
     let mut top = depth;
     for (k, &c) in carries.iter().enumerate() {
         let l = &radiance[k * stride];
-        let finite = l.is_finite().to_bitmask();
-        counters.nonfinite += u64::from((active & !finite).count_ones());
-        let (r, g, b) = (l.x.to_array(), l.y.to_array(), l.z.to_array());
+        let finite = l.is_finite();
+        counters.nonfinite += u64::from((active & !finite.to_bitmask()).count_ones());
+        // `leaf_moments` lane-wise, channel by channel (vectorized): a non-finite lane is zero in
+        // every channel.
+        let zero = crate::simd::F8::ZERO;
+        let rgb = [finite.select(l.x, zero), finite.select(l.y, zero), finite.select(l.z, zero)].map(|c| c.to_array());
         let mut acc: Moments8 = [[0.0; 8]; 6];
-        for i in 0..8 {
-            let ok = finite & (1 << i) != 0;
-            let v = if ok { [r[i], g[i], b[i]] } else { [0.0; 3] };
-            let m = leaf_moments(v);
-            for q in 0..6 {
-                acc[q][i] = m[q];
+        for (c, v) in rgb.iter().enumerate() {
+            for i in 0..8 {
+                let x = f64::from(v[i]);
+                acc[c][i] = x;
+                acc[c + 3][i] = x * x;
             }
         }
         for _ in 0..c {
@@ -327,6 +329,55 @@ fn accumulate(
 mod tests {
     use super::*;
     use crate::simd::{Vec3x8, F8};
+
+    /// Batches of samples accumulated packet-wise give the same block moments, bit for bit, as
+    /// `Film::add_sample` one sample at a time (the scalar reference), non-finite values as zero.
+    #[test]
+    fn batched_accumulation_matches_the_scalar_film() {
+        let pk = PixelPacket::new(0, 0, 4, 2);
+        let mut st = 7u64;
+        let mut next = || {
+            st = st.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((st >> 40) as f32 / 16_777_216.0) * 3.0 - 0.5
+        };
+        let mut film = Film::new(4, 2);
+        let (mut blocks, mut data, mut stack, mut c) = (Vec::new(), Vec::new(), Vec::new(), Counters::default());
+        let mut s = 0u32;
+        for batch in [1u32, 3, 16, 5, 16, 2] {
+            let vals: Vec<Vec3x8> = (0..batch)
+                .map(|k| {
+                    let mut x: [f32; 8] = std::array::from_fn(|_| next());
+                    if k == 1 {
+                        x[2] = f32::NAN;
+                    }
+                    Vec3x8::new(F8::new(x), F8::new(std::array::from_fn(|_| next())), F8::splat(next()))
+                })
+                .collect();
+            for (k, v) in vals.iter().enumerate() {
+                let ok = v.is_finite().to_bitmask();
+                let px: Vec<[f32; 3]> = (0..8)
+                    .map(|i| {
+                        if ok & (1 << i) != 0 {
+                            [v.x.to_array()[i], v.y.to_array()[i], v.z.to_array()[i]]
+                        } else {
+                            [0.0; 3]
+                        }
+                    })
+                    .collect();
+                film.add_sample(s + k as u32, &px);
+            }
+            let depth = blocks.len();
+            let carries: Vec<usize> = (s..s + batch).map(|t| push_block(&mut blocks, Block::leaf(t))).collect();
+            data.resize(depth.max(blocks.len()) * 8, [0.0; 6]);
+            accumulate(&mut data, 8, depth, &carries, &pk, (0, 0, 4), (&vals, 1), &mut stack, &mut c);
+            data.truncate(blocks.len() * 8);
+            s += batch;
+            assert_eq!(blocks, film.blocks());
+            let bits = |d: &[Moments]| d.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&data), bits(film.block_data()), "after {s} samples");
+        }
+        assert_eq!(c.nonfinite, 5, "one NaN in each batch of two or more samples");
+    }
 
     /// A NaN or infinite lane is counted in `nonfinite` and accumulated as zero; finite lanes and
     /// inactive lanes are untouched. (Without the check the NaN would reach the film's sums.)
