@@ -77,33 +77,22 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
             sc.shadow.clear();
             sc.contrib.clear();
             sc.owner.clear();
-            // Point k of every shading packet, then the light points: one batch each (profiled
-            // as two spans, not two per packet).
-            sc.light_uv.clear();
-            sc.light_points.clear();
-            {
-                let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-                for (i, stream) in sc.streams.iter().enumerate() {
-                    if sc.shade[i].any() {
-                        crate::sampler::replay::light_point(i as u32, k);
-                        sc.light_uv.push(stream.point_k(&point_k));
-                    }
-                }
-            }
-            {
-                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
-                let shading = sc.shade.iter().filter(|s| s.any());
-                for (&(u, v), &shade) in sc.light_uv.iter().zip(shading) {
-                    sc.light_points.push(group.sample(scene, u, v, shade));
-                }
-            }
-            let mut next_point = sc.light_points.iter();
+            // Per shading packet: point k of its stream, the light point, the light term and the
+            // shadow packet, in one pass (the sampler and emitter calls are leaf spans).
             for i in 0..pks.len() {
                 let (sh, shade) = (&sc.hits[i], sc.shade[i]);
                 if shade.none() {
                     continue;
                 }
-                let Some(&ls) = next_point.next() else { break };
+                let (u, v) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(i as u32, k);
+                    sc.streams[i].point_k(&point_k)
+                };
+                let ls = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                    group.sample(scene, u, v, shade)
+                };
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
                 let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, shade) else { continue };
                 sc.contrib.push(match group {
@@ -141,6 +130,7 @@ fn shading_lanes(scene: &Scene, sc: &mut Scratch) {
 }
 
 /// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
+#[inline(never)]
 fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
     let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
     let n_light = it.light_set.n();
