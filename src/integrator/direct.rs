@@ -69,8 +69,8 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
         sc.streams.clear();
         {
             let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-            sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
-            crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, dim);
+            light_streams(it, pks, &sc.shade, sample_idx, dim, &mut sc.streams);
+            crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, dim);
         }
         for k in 0..n_light {
             let point_k = it.light_set.point_k(k);
@@ -78,7 +78,9 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
             sc.contrib.clear();
             sc.owner.clear();
             // Per shading packet: point k of its stream, the light point, the light term and the
-            // shadow packet, in one pass (the sampler and emitter calls are leaf spans).
+            // shadow packet, in one pass (the sampler and emitter calls are leaf spans). Stream j
+            // is the j-th shading packet's.
+            let mut j = 0;
             for i in 0..pks.len() {
                 let (sh, shade) = (&sc.hits[i], sc.shade[i]);
                 if shade.none() {
@@ -86,9 +88,10 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 }
                 let (u, v) = {
                     let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(i as u32, k);
-                    sc.streams[i].point_k(&point_k)
+                    crate::sampler::replay::light_point(j, k);
+                    sc.streams[j as usize].point_k(&point_k)
                 };
+                j += 1;
                 let ls = {
                     let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                     group.sample(scene, u, v, shade)
@@ -129,6 +132,25 @@ fn shading_lanes(scene: &Scene, sc: &mut Scratch) {
     sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
 }
 
+/// The light streams of dimension `dim` for pixel sample `sample` of the packets of `pks` that
+/// have lanes to shade (`shade`), in packet order, into `out`.
+fn light_streams(
+    it: &Integrator,
+    pks: &[crate::camera::PixelPacket],
+    shade: &[Mask8],
+    sample: U8,
+    dim: u32,
+    out: &mut Vec<crate::sampler::Stream<U8>>,
+) {
+    let shading = pks.iter().zip(shade).filter(|(_, m)| m.any());
+    out.extend(shading.map(|(pk, _)| it.light_set.stream_x8(pk.pixel, sample, dim, it.seed)));
+}
+
+/// The pixels of the packets of `pks` that have lanes to shade (what [`light_streams`] draws for).
+fn shading_pixels<'a>(pks: &'a [crate::camera::PixelPacket], shade: &'a [Mask8]) -> impl Iterator<Item = U8> + 'a {
+    pks.iter().zip(shade).filter(|(_, m)| m.any()).map(|(pk, _)| pk.pixel)
+}
+
 /// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
 #[inline(never)]
 fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
@@ -145,31 +167,34 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
     sc.choice_streams.clear();
     {
         let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-        sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE, it.seed)));
-        crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, DIM_LIGHT_BASE);
+        light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE, &mut sc.streams);
+        crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, DIM_LIGHT_BASE);
         if !one_light {
-            sc.choice_streams
-                .extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE + 1, it.seed)));
-            let choice = pks.iter().map(|pk| pk.pixel);
+            light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE + 1, &mut sc.choice_streams);
+            let choice = shading_pixels(pks, &sc.shade);
             crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
         }
     }
-    let n_pks = pks.len() as u32;
+    // Streams (and choice streams) j are the j-th shading packet's.
+    let n_shading = sc.streams.len() as u32;
     for k in 0..n_light {
         let point_k = it.light_set.point_k(k);
         sc.shadow.clear();
         sc.contrib.clear();
         sc.owner.clear();
+        let mut j = 0;
         for i in 0..pks.len() {
             let (sh, shade) = (&sc.hits[i], sc.shade[i]);
             if shade.none() {
                 continue;
             }
+            let jj = j as usize;
+            j += 1;
             let (ls, ok) = if one_light {
                 let (u, v) = {
                     let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(i as u32, k);
-                    sc.streams[i].point_k(&point_k)
+                    crate::sampler::replay::light_point(jj as u32, k);
+                    sc.streams[jj].point_k(&point_k)
                 };
                 // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
@@ -177,9 +202,9 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
             } else {
                 let ((u, v), (uc, _)) = {
                     let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(i as u32, k);
-                    crate::sampler::replay::light_point(n_pks + i as u32, k);
-                    (sc.streams[i].point_k(&point_k), sc.choice_streams[i].point_k(&point_k))
+                    crate::sampler::replay::light_point(jj as u32, k);
+                    crate::sampler::replay::light_point(n_shading + jj as u32, k);
+                    (sc.streams[jj].point_k(&point_k), sc.choice_streams[jj].point_k(&point_k))
                 };
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
