@@ -84,6 +84,8 @@ pub struct Scratch {
     pub(super) streams: Vec<Stream<U8>>,
     /// `direct` with one light per sample: the light-choice streams
     pub(super) choice_streams: Vec<Stream<U8>>,
+    /// the camera's pixel-sample streams of the tile's packets (direct-lighting integrators)
+    pub(super) cam_streams: Vec<Stream<U8>>,
     pub(super) path: PathScratch,
     pub(super) one: Vec<Vec3x8>,
 }
