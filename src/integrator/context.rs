@@ -7,7 +7,6 @@ use super::path::PathScratch;
 use super::stats::{Counters, RayKind, RayLog};
 use crate::accel::{Ray8, RayHit8};
 use crate::camera::{Camera, PixelPacket};
-use crate::light::emitters::LightSample8;
 use crate::sampler::Stream;
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
@@ -83,11 +82,10 @@ pub struct Scratch {
     pub(super) contrib: Vec<Vec3x8>,
     pub(super) owner: Vec<u32>,
     pub(super) streams: Vec<Stream<U8>>,
-    /// `direct`: per shading packet, its unit-square light sample and its point on the light
-    pub(super) light_uv: Vec<(F8, F8)>,
-    pub(super) light_points: Vec<LightSample8>,
     /// `direct` with one light per sample: the light-choice streams
     pub(super) choice_streams: Vec<Stream<U8>>,
+    /// the camera's pixel-sample streams of the tile's packets (direct-lighting integrators)
+    pub(super) cam_streams: Vec<Stream<U8>>,
     pub(super) path: PathScratch,
     pub(super) one: Vec<Vec3x8>,
 }

@@ -69,41 +69,33 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
         sc.streams.clear();
         {
             let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-            sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, dim, it.seed)));
-            crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, dim);
+            light_streams(it, pks, &sc.shade, sample_idx, dim, &mut sc.streams);
+            crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, dim);
         }
         for k in 0..n_light {
             let point_k = it.light_set.point_k(k);
             sc.shadow.clear();
             sc.contrib.clear();
             sc.owner.clear();
-            // Point k of every shading packet, then the light points: one batch each (profiled
-            // as two spans, not two per packet).
-            sc.light_uv.clear();
-            sc.light_points.clear();
-            {
-                let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-                for (i, stream) in sc.streams.iter().enumerate() {
-                    if sc.shade[i].any() {
-                        crate::sampler::replay::light_point(i as u32, k);
-                        sc.light_uv.push(stream.point_k(&point_k));
-                    }
-                }
-            }
-            {
-                let _p = crate::profile::scope(crate::profile::Phase::Emitter);
-                let shading = sc.shade.iter().filter(|s| s.any());
-                for (&(u, v), &shade) in sc.light_uv.iter().zip(shading) {
-                    sc.light_points.push(group.sample(scene, u, v, shade));
-                }
-            }
-            let mut next_point = sc.light_points.iter();
+            // Per shading packet: point k of its stream, the light point, the light term and the
+            // shadow packet, in one pass (the sampler and emitter calls are leaf spans). Stream j
+            // is the j-th shading packet's.
+            let mut j = 0;
             for i in 0..pks.len() {
                 let (sh, shade) = (&sc.hits[i], sc.shade[i]);
                 if shade.none() {
                     continue;
                 }
-                let Some(&ls) = next_point.next() else { break };
+                let (u, v) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(j, k);
+                    sc.streams[j as usize].point_k(&point_k)
+                };
+                j += 1;
+                let ls = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                    group.sample(scene, u, v, shade)
+                };
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
                 let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, shade) else { continue };
                 sc.contrib.push(match group {
@@ -140,42 +132,80 @@ fn shading_lanes(scene: &Scene, sc: &mut Scratch) {
     sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
 }
 
+/// The light streams of dimension `dim` for pixel sample `sample` of the packets of `pks` that
+/// have lanes to shade (`shade`), in packet order, into `out`.
+fn light_streams(
+    it: &Integrator,
+    pks: &[crate::camera::PixelPacket],
+    shade: &[Mask8],
+    sample: U8,
+    dim: u32,
+    out: &mut Vec<crate::sampler::Stream<U8>>,
+) {
+    let shading = pks.iter().zip(shade).filter(|(_, m)| m.any());
+    out.extend(shading.map(|(pk, _)| it.light_set.stream_x8(pk.pixel, sample, dim, it.seed)));
+}
+
+/// The pixels of the packets of `pks` that have lanes to shade (what [`light_streams`] draws for).
+fn shading_pixels<'a>(pks: &'a [crate::camera::PixelPacket], shade: &'a [Mask8]) -> impl Iterator<Item = U8> + 'a {
+    pks.iter().zip(shade).filter(|(_, m)| m.any()).map(|(pk, _)| pk.pixel)
+}
+
 /// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
+#[inline(never)]
 fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
     let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
     let sample_idx = U8::splat(s);
     shading_lanes(scene, sc);
+    // One light chosen uniformly: the choice is light 0 with pmf 1 whatever its sample, so the
+    // choice dimension is not drawn (every sample is a pure function of its own dimension: the
+    // others are unchanged).
+    let one_light = it.light_sampler.selection() == LightSelection::Uniform && it.light_sampler.len() == 1;
     sc.streams.clear();
     sc.choice_streams.clear();
     {
         let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-        sc.streams.extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE, it.seed)));
-        sc.choice_streams
-            .extend(pks.iter().map(|pk| it.light_set.stream_x8(pk.pixel, sample_idx, DIM_LIGHT_BASE + 1, it.seed)));
-        crate::sampler::replay::light_streams(pks.iter().map(|pk| pk.pixel), sample_idx, DIM_LIGHT_BASE);
-        let choice = pks.iter().map(|pk| pk.pixel);
-        crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
+        light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE, &mut sc.streams);
+        crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, DIM_LIGHT_BASE);
+        if !one_light {
+            light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE + 1, &mut sc.choice_streams);
+            let choice = shading_pixels(pks, &sc.shade);
+            crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
+        }
     }
-    let n_pks = pks.len() as u32;
+    // Streams (and choice streams) j are the j-th shading packet's.
+    let n_shading = sc.streams.len() as u32;
     for k in 0..n_light {
         let point_k = it.light_set.point_k(k);
         sc.shadow.clear();
         sc.contrib.clear();
         sc.owner.clear();
+        let mut j = 0;
         for i in 0..pks.len() {
             let (sh, shade) = (&sc.hits[i], sc.shade[i]);
             if shade.none() {
                 continue;
             }
-            let ((u, v), (uc, _)) = {
-                let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                crate::sampler::replay::light_point(i as u32, k);
-                crate::sampler::replay::light_point(n_pks + i as u32, k);
-                (sc.streams[i].point_k(&point_k), sc.choice_streams[i].point_k(&point_k))
-            };
-            let (ls, ok) = {
+            let jj = j as usize;
+            j += 1;
+            let (ls, ok) = if one_light {
+                let (u, v) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(jj as u32, k);
+                    sc.streams[jj].point_k(&point_k)
+                };
+                // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
+                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
+            } else {
+                let ((u, v), (uc, _)) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                    crate::sampler::replay::light_point(jj as u32, k);
+                    crate::sampler::replay::light_point(n_shading + jj as u32, k);
+                    (sc.streams[jj].point_k(&point_k), sc.choice_streams[jj].point_k(&point_k))
+                };
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
             };

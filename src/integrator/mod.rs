@@ -166,6 +166,13 @@ impl Integrator {
             return kernel::with_lobe_set!(self.kernel.lobes, L => path::tile::<L>(self, &mut ctx, samples, out));
         }
         out.clear();
+        // The camera's pixel-sample streams, hashed once for the batch (if a sample draws).
+        let mut cam = std::mem::take(&mut ctx.scratch.cam_streams);
+        cam.clear();
+        if samples.clone().any(|s| ctx.camera.draws(s)) {
+            ctx.camera.streams(pks, &mut cam);
+        }
+        ctx.scratch.cam_streams = cam;
         let mut one = std::mem::take(&mut ctx.scratch.one);
         for s in samples {
             kernel::with_lobe_set!(self.kernel.lobes, L => self.camera_hits_and_shade::<L>(&mut ctx, s, &mut one));
@@ -188,8 +195,11 @@ impl Integrator {
         sc.hits.truncate(n);
         sc.hits.resize(n, SurfaceHit8::MISS);
         // Camera packets: coherent primary rays from 4x2 pixel blocks.
-        for (pk, (rh, active)) in ctx.pks.iter().zip(sc.rh.iter_mut()) {
-            let (org, dir) = ctx.camera.rays(pk, s);
+        for (i, (pk, (rh, active))) in ctx.pks.iter().zip(sc.rh.iter_mut()).enumerate() {
+            let (org, dir) = match sc.cam_streams.get(i) {
+                Some(stream) => ctx.camera.rays_in(pk, i as u32, stream, s),
+                None => ctx.camera.rays(pk, s),
+            };
             *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
         }
         ctx.tracer.intersect_all(&mut sc.rh, RayKind::Camera);

@@ -342,7 +342,17 @@ impl Emitters {
 
     pub(crate) fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let ids = idx.to_array();
-        let es = ids.map(|i| &self.list[i as usize]);
+        if ids.iter().all(|&i| i == ids[0]) {
+            // One light on every lane (one light in the scene, or a coherent choice): its fields
+            // splatted, the same values the per-lane gather below makes.
+            return self.place_one_x8(ids[0], inv_pmf, u, v);
+        }
+        self.place_lanes_x8(idx, inv_pmf, u, v)
+    }
+
+    /// [`Emitters::place_x8`], each lane's light gathered on its own.
+    fn place_lanes_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
+        let es = idx.to_array().map(|i| &self.list[i as usize]);
         let la = Vec3x8::from_lanes(es.map(|e| e.a));
         let lab = Vec3x8::from_lanes(es.map(|e| e.ab));
         let lac = Vec3x8::from_lanes(es.map(|e| e.ac));
@@ -357,6 +367,26 @@ impl Emitters {
             area: F8::new(es.map(|e| e.area)),
             inv_pmf,
             light: idx,
+        }
+    }
+
+    /// [`Emitters::place_x8`] with light `i` on every lane.
+    #[inline]
+    pub(crate) fn place_one_x8(&self, i: u32, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
+        let e = &self.list[i as usize];
+        let (u, v) = if e.triangle {
+            let fold = (u + v).simd_gt(F8::ONE);
+            (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v))
+        } else {
+            (u, v)
+        };
+        LightSample8 {
+            y: Vec3x8::splat(e.ac).mul_add(v, Vec3x8::splat(e.ab).mul_add(u, Vec3x8::splat(e.a))),
+            normal: Vec3x8::splat(e.normal),
+            radiance: Vec3x8::splat(e.radiance),
+            area: F8::splat(e.area),
+            inv_pmf,
+            light: U8::splat(i),
         }
     }
 }
@@ -467,6 +497,24 @@ mod tests {
             assert_eq!(fast.area.to_array(), general.area.to_array());
             assert_eq!(fast.inv_pmf.to_array(), general.inv_pmf.to_array());
             assert_eq!(fast.light.to_array(), general.light.to_array());
+        }
+    }
+
+    #[test]
+    fn placement_of_one_light_on_every_lane_matches_the_per_lane_gather() {
+        let e = lights();
+        let us = F8::new([0.0, 0.1, 0.62, 0.7, 0.8, 0.95, 0.999_999_94, 0.5]);
+        let vs = F8::new([0.9, 0.3, 0.77, 0.05, 0.6, 0.99, 0.2, 0.5]);
+        let inv = F8::new([1.0, 2.0, 3.0, 4.0, 0.5, 0.25, 8.0, 1.5]);
+        let bits = |v: Vec3x8| [v.x, v.y, v.z].map(|c| c.to_array().map(f32::to_bits));
+        for i in 0..e.list.len() as u32 {
+            let (one, lanes) = (e.place_x8(U8::splat(i), inv, us, vs), e.place_lanes_x8(U8::splat(i), inv, us, vs));
+            assert_eq!(bits(one.y), bits(lanes.y), "light {i}");
+            assert_eq!(bits(one.normal), bits(lanes.normal));
+            assert_eq!(bits(one.radiance), bits(lanes.radiance));
+            assert_eq!(one.area.to_array().map(f32::to_bits), lanes.area.to_array().map(f32::to_bits));
+            assert_eq!(one.inv_pmf.to_array().map(f32::to_bits), inv.to_array().map(f32::to_bits));
+            assert_eq!(one.light.to_array(), [i; 8]);
         }
     }
 

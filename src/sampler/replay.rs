@@ -4,7 +4,8 @@
 //! switched to another registered kind ([`ReplaySets::with_kind`]). `strata profile` times the
 //! replay on one thread (`session::replay`).
 //!
-//! The render's call sites report their calls here (`camera.rs`: [`pixel_point`]; `direct.rs`:
+//! The render's call sites report their calls here (`camera.rs`: [`pixel_point`], or
+//! [`camera_streams`] and [`camera_point`]; `direct.rs`:
 //! [`light_streams`], [`light_point`]; `path.rs`: [`path_point`]) and `render.rs` brackets each
 //! tile with [`tile_begin`]/[`tile_end`]. Off (the default), each report is one relaxed atomic
 //! load; recording only observes, so images are bit-identical either way.
@@ -43,6 +44,9 @@ const F_SAMPLE: u32 = 1 << 4;
 const F_SAMPLE_SPLAT: u32 = 1 << 5;
 const F_K_SPLAT: u32 = 1 << 6;
 const F_RESET: u32 = 1 << 7;
+/// On `OP_STREAM` / `OP_STREAM_POINT` (which have no k word): the camera's stream table, not the
+/// light streams' (the bit is `F_K_SPLAT` of `OP_POINT`).
+const F_CAMERA: u32 = 1 << 6;
 const DIM_SHIFT: u32 = 8;
 /// Dimensions from here on take a word of their own (escape: the op word's dim field is all ones).
 const DIM_WIDE: u32 = (1 << (32 - DIM_SHIFT)) - 1;
@@ -323,6 +327,35 @@ pub fn light_point(stream: u32, k: u32) {
     }
 }
 
+/// Reports a fresh table of camera streams, `pixel_set.stream_x8(pixel, sample, dim, seed)` for
+/// each of `pixels` in order (the pixel jitter of a batch of samples, see `camera.rs`).
+#[inline]
+pub fn camera_streams(pixels: impl IntoIterator<Item = U8>, sample: U8, dim: u32) {
+    if recording() {
+        LOG.with_borrow_mut(|l| {
+            for (i, p) in pixels.into_iter().enumerate() {
+                l.push(OP_STREAM | F_CAMERA | if i == 0 { F_RESET } else { 0 }, p, sample, dim, None);
+            }
+        });
+    }
+}
+
+/// Reports `streams[stream].point(k)` of the last table of [`camera_streams`].
+#[inline]
+pub fn camera_point(stream: u32, k: u32) {
+    if recording() {
+        LOG.with_borrow_mut(|l| {
+            if !l.counting {
+                return;
+            }
+            l.calls += 1;
+            if l.active {
+                l.words.extend([OP_STREAM_POINT | F_CAMERA, stream, k]);
+            }
+        });
+    }
+}
+
 /// The layouts a replay draws from, one per call site: what the render had (the integrator's
 /// `pixel_set`, `light_set` and `path_set`, with its spp and seed), or one kind everywhere
 /// ([`ReplaySets::with_kind`]).
@@ -407,6 +440,7 @@ impl Recording {
     /// away; equal for equal sets).
     pub fn replay(&self, sets: &ReplaySets, mode: ReplayMode) -> (u64, u32) {
         let mut streams: Vec<Stream<U8>> = Vec::new();
+        let mut cam_streams: Vec<Stream<U8>> = Vec::new();
         // The render finds point k's per-k work once for all its streams (`PointSet::point_k`,
         // then `Stream::point_k`): so does the replay, for the last k seen.
         let mut point_k = sets.light.point_k(0);
@@ -424,6 +458,15 @@ impl Recording {
                 if op & 3 == OP_STREAM_POINT {
                     let (si, k) = (w[i], w[i + 1]);
                     i += 2;
+                    if op & F_CAMERA != 0 {
+                        if let (true, Some(s)) = (sample_on, cam_streams.get(si as usize)) {
+                            let (x, y) = s.point(k);
+                            sum = fold(sum, x.to_bits() ^ y.to_bits());
+                        } else {
+                            sum = fold(sum, U8::splat(std::hint::black_box(si ^ k)));
+                        }
+                        continue;
+                    }
                     if let (true, Some(s)) = (sample_on, streams.get(si as usize)) {
                         if k != last_k {
                             (point_k, last_k) = (sets.light.point_k(k), k);
@@ -472,11 +515,16 @@ impl Recording {
                         };
                     }
                     OP_STREAM => {
+                        let (table, set) = if op & F_CAMERA != 0 {
+                            (&mut cam_streams, &sets.pixel)
+                        } else {
+                            (&mut streams, &sets.light)
+                        };
                         if op & F_RESET != 0 {
-                            streams.clear();
+                            table.clear();
                         }
                         if sample_on {
-                            streams.push(sets.light.stream_x8(pixel, sample, dim, seed));
+                            table.push(set.stream_x8(pixel, sample, dim, seed));
                         } else {
                             sum = fold(sum, std::hint::black_box(pixel ^ sample ^ U8::splat(dim)));
                         }

@@ -41,7 +41,7 @@
 
 use super::hash::{combine, combine_key};
 use super::lanes::Lanes;
-use super::layout::{Layout, SetShape};
+use super::layout::{Layout, SetShape, StreamKey};
 use crate::simd::{F8, U8};
 
 /// Point k of the n-point Owen-scrambled Sobol' set of stream (pixel, sample, dim) under seed:
@@ -73,11 +73,33 @@ impl Layout for Sobol {
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
         sobol_owen(pixel, sample, dim, k, set.n(), seed)
     }
+
+    /// The stream's key (hash of pixel, dim and seed) in `prefix` and its first index
+    /// `sample * n` in `base`, hashed once for all the points of the stream.
+    #[inline]
+    fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
+        StreamKey { prefix: stream_key(pixel, dim, seed), base: sample.mul(L::splat(set.n().max(1))), sample, dim, seed }
+    }
+
+    #[inline]
+    fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
+        keyed_point(s.prefix, s.base.add(L::splat(k)))
+    }
+}
+
+/// The scramble key of the streams of `pixel` in dimension `dim` under `seed`.
+#[inline]
+fn stream_key<L: Lanes>(pixel: L, dim: u32, seed: u64) -> L {
+    combine(L::splat(combine_key(TAG_SOBOL, seed, dim)), pixel)
 }
 
 fn sobol_owen<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
-    let key = combine(L::splat(combine_key(TAG_SOBOL, seed, dim)), pixel);
-    let index = sample.mul(L::splat(n.max(1))).add(k);
+    keyed_point(stream_key(pixel, dim, seed), sample.mul(L::splat(n.max(1))).add(k))
+}
+
+/// Point `index` of the sequence scrambled with stream key `key`.
+#[inline]
+fn keyed_point<L: Lanes>(key: L, index: L) -> (L::F, L::F) {
     // The index shuffle i' = nus(index) = rev(lk(rev(index))).
     let i = reverse_bits(lk_permute(reverse_bits(index), combine(key, L::splat(1))));
     let (x, y) = scrambled_point(i, key);

@@ -91,7 +91,71 @@ impl Scene {
         let p = dir.mul_add(hits.t, org);
         let valid = hits.hit;
         let bits = valid.to_bitmask();
+        if bits == 0 {
+            // No lane hit: the miss record (what the lane loop below gives every missed lane).
+            *out = SurfaceHit8 { p, wo: -dir, ..SurfaceHit8::MISS };
+            return;
+        }
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());
+        let first = prim[bits.trailing_zeros() as usize];
+        let same = F8::from_bits(hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES)) & hits.prim.simd_eq(U8::splat(first)));
+        let one_triangle = same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
+        let Lanes8 { n, m, light, le, any_tri } = if one_triangle {
+            self.one_triangle(first as usize, valid)
+        } else {
+            self.lane_by_lane(bits, valid, geom, prim, p, dir)
+        };
+        // Shade two-sided: flip the normal to face the incoming ray (the scalar Vec3::dot's
+        // operation order, so the sign is the same as per lane).
+        let facing = (n.x * dir.x + n.y * dir.y) + n.z * dir.z;
+        let ng = Vec3x8::select(valid & facing.simd_gt(F8::ZERO), -n, n);
+        let (ns, smooth) = if any_tri && !self.desc.triangle_normals.is_empty() {
+            self.smooth_normals(bits, geom, prim, hits, dir, ng)
+        } else {
+            (ng, crate::simd::mask_from_bools([false; 8]))
+        };
+        out.valid = valid;
+        out.p = p;
+        out.n = ns;
+        out.ng = ng;
+        out.smooth = smooth;
+        out.wo = -dir;
+        out.kd = m.kd;
+        out.ks = m.ks;
+        out.shininess = m.shininess;
+        out.roughness = m.roughness;
+        out.ggx = m.ggx;
+        out.emitted = m.emitted;
+        out.ambient = m.ambient;
+        out.le = le;
+        out.light = light;
+    }
+
+    /// The per-lane fields of hit lanes `valid` that all hit triangle `t`, not a light's: its
+    /// normal and material splatted (what [`Scene::lane_by_lane`] gives such lanes).
+    #[inline]
+    fn one_triangle(&self, t: usize, valid: Mask8) -> Lanes8 {
+        Lanes8 {
+            n: Vec3x8::select(valid, Vec3x8::splat(self.tri_normal[t]), Z8),
+            m: self.uniform_materials(self.tri_material[t], valid),
+            light: U8::MAX,
+            le: Vec3x8::ZERO,
+            any_tri: true,
+        }
+    }
+
+    /// The per-lane fields of the hit lanes `bits` (`valid`), one table lookup per lane: normal,
+    /// material, light index and light emission; points `p` (spheres and ellipsoids) and ray
+    /// directions `dir`.
+    fn lane_by_lane(
+        &self,
+        bits: u32,
+        valid: Mask8,
+        geom: &[u32; 8],
+        prim: &[u32; 8],
+        p: Vec3x8,
+        dir: Vec3x8,
+    ) -> Lanes8 {
         let mut n = Lanes3::splat(Vec3::Z);
         let mut mat = [0u32; 8];
         let mut light = [INVALID_ID; 8];
@@ -123,32 +187,7 @@ impl Scene {
                 _ => {}
             }
         }
-        // Shade two-sided: flip the normal to face the incoming ray (the scalar Vec3::dot's
-        // operation order, so the sign is the same as per lane).
-        let n = n.get();
-        let facing = (n.x * dir.x + n.y * dir.y) + n.z * dir.z;
-        let ng = Vec3x8::select(valid & facing.simd_gt(F8::ZERO), -n, n);
-        let (ns, smooth) = if any_tri && !self.desc.triangle_normals.is_empty() {
-            self.smooth_normals(bits, geom, prim, hits, dir, ng)
-        } else {
-            (ng, crate::simd::mask_from_bools([false; 8]))
-        };
-        let m = self.gather_materials(bits, valid, &mat);
-        out.valid = valid;
-        out.p = p;
-        out.n = ns;
-        out.ng = ng;
-        out.smooth = smooth;
-        out.wo = -dir;
-        out.kd = m.kd;
-        out.ks = m.ks;
-        out.shininess = m.shininess;
-        out.roughness = m.roughness;
-        out.ggx = m.ggx;
-        out.emitted = m.emitted;
-        out.ambient = m.ambient;
-        out.le = le.get();
-        out.light = U8::new(light);
+        Lanes8 { n: n.get(), m: self.gather_materials(bits, valid, &mat), light: U8::new(light), le: le.get(), any_tri }
     }
 
     /// Shading normals from the triangles' vertex normals (see the module docs) on the triangle
@@ -185,34 +224,31 @@ impl Scene {
         (ns.get(), crate::simd::mask_from_bools(smooth))
     }
 
+    /// The fields of material `m0` on the hit lanes `valid`, the miss record's on the others.
+    #[inline]
+    fn uniform_materials(&self, m0: u32, valid: Mask8) -> Materials8 {
+        let (m, z) = (&self.materials[m0 as usize], &MISS_MATERIAL);
+        let pick3 = |a: Vec3, b: Vec3| Vec3x8::select(valid, Vec3x8::splat(a), Vec3x8::splat(b));
+        let pick = |a: f32, b: f32| valid.select(F8::splat(a), F8::splat(b));
+        Materials8 {
+            kd: pick3(m.diffuse, z.diffuse),
+            ks: pick3(m.specular, z.specular),
+            shininess: pick(m.shininess, z.shininess),
+            roughness: pick(m.roughness, z.roughness),
+            ggx: if m.brdf == BrdfKind::Ggx { valid } else { crate::simd::mask_from_bools([false; 8]) },
+            // 0 + emission, as the per-lane sum did (-0 becomes +0)
+            emitted: Vec3x8::ZERO + pick3(m.emission, z.emission),
+            ambient: pick3(m.ambient, z.ambient),
+        }
+    }
+
     /// The material fields of the hit lanes `bits` (`mat`: material index per lane), the miss
     /// record's on the other lanes.
     fn gather_materials(&self, bits: u32, valid: Mask8, mat: &[u32; 8]) -> Materials8 {
-        let miss = Material {
-            diffuse: Vec3::ZERO,
-            specular: Vec3::ZERO,
-            shininess: 0.0,
-            emission: Vec3::ZERO,
-            ambient: Vec3::ZERO,
-            brdf: BrdfKind::Phong,
-            roughness: 1.0,
-        };
         let first = if bits == 0 { None } else { Some(mat[bits.trailing_zeros() as usize]) };
         let uniform = first.filter(|&m0| lanes_of(bits).all(|i| mat[i] == m0));
         if let Some(m0) = uniform {
-            let (m, z) = (&self.materials[m0 as usize], &miss);
-            let pick3 = |a: Vec3, b: Vec3| Vec3x8::select(valid, Vec3x8::splat(a), Vec3x8::splat(b));
-            let pick = |a: f32, b: f32| valid.select(F8::splat(a), F8::splat(b));
-            return Materials8 {
-                kd: pick3(m.diffuse, z.diffuse),
-                ks: pick3(m.specular, z.specular),
-                shininess: pick(m.shininess, z.shininess),
-                roughness: pick(m.roughness, z.roughness),
-                ggx: if m.brdf == BrdfKind::Ggx { valid } else { crate::simd::mask_from_bools([false; 8]) },
-                // 0 + emission, as the per-lane sum did (-0 becomes +0)
-                emitted: Vec3x8::ZERO + pick3(m.emission, z.emission),
-                ambient: pick3(m.ambient, z.ambient),
-            };
+            return self.uniform_materials(m0, valid);
         }
         let (mut kd, mut ks, mut emitted, mut ambient) = (
             Lanes3::splat(Vec3::ZERO),
@@ -241,6 +277,28 @@ impl Scene {
             ambient: ambient.get(),
         }
     }
+}
+
+/// The material of the miss record's lanes.
+const MISS_MATERIAL: Material = Material {
+    diffuse: Vec3::ZERO,
+    specular: Vec3::ZERO,
+    shininess: 0.0,
+    emission: Vec3::ZERO,
+    ambient: Vec3::ZERO,
+    brdf: BrdfKind::Phong,
+    roughness: 1.0,
+};
+
+/// The fields of a [`SurfaceHit8`] looked up per hit (the rest is 8-wide arithmetic).
+struct Lanes8 {
+    /// geometric normal, not yet flipped (+z on missed lanes)
+    n: Vec3x8,
+    m: Materials8,
+    light: U8,
+    le: Vec3x8,
+    /// some lane hit a triangle
+    any_tri: bool,
 }
 
 /// Material fields of 8 lanes (a part of [`SurfaceHit8`]).
@@ -291,4 +349,115 @@ fn lanes_of(mut bits: u32) -> impl Iterator<Item = usize> {
             i
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{limits::Limits, parse::parse_str};
+    use crate::simd::mask_from_bools;
+
+    /// A floor of two triangles (two materials), a quad light and a sphere.
+    fn scene() -> Scene {
+        let text = "size 8 8\ncamera 0 1 -4 0 0 0 0 1 0 45\nmaxverts 4\n\
+                    vertex -1 0 -1\nvertex -1 0 1\nvertex 1 0 -1\nvertex 1 0 1\n\
+                    diffuse 0.3 0.3 0.5\ntri 0 1 2\ndiffuse 0.5 0.2 0.1\nspecular 0.2 0.2 0.2\ntri 1 3 2\n\
+                    quadLight -1 2 -1 0 0 2 2 0 0 5 5 5\nsphere 0 1 0 0.5\n";
+        let desc = parse_str(text, std::path::Path::new("t.test"), &Limits::default()).expect("scene");
+        Scene::build(desc).expect("build")
+    }
+
+    fn hits(hit: [bool; 8], geom: [u32; 8], prim: [u32; 8]) -> Hits8 {
+        let f = |a: [f32; 8]| F8::new(a);
+        Hits8 {
+            hit: mask_from_bools(hit),
+            t: f([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]),
+            prim: U8::new(prim),
+            geom: U8::new(geom),
+            inst: U8::splat(INVALID_ID),
+            u: f([0.1; 8]),
+            v: f([0.2; 8]),
+        }
+    }
+
+    fn rays() -> (Vec3x8, Vec3x8) {
+        let d = |i: usize| Vec3::new(i as f32 * 0.1 - 0.35, -1.0, 0.3 - i as f32 * 0.05).normalize();
+        (Vec3x8::splat(Vec3::new(0.0, 3.0, 0.0)), Vec3x8::from_lanes(std::array::from_fn(d)))
+    }
+
+    fn bits(v: Vec3x8) -> [[u32; 8]; 3] {
+        [v.x, v.y, v.z].map(|c| c.to_array().map(f32::to_bits))
+    }
+
+    fn same_record(a: &SurfaceHit8, b: &SurfaceHit8) {
+        let f = |x: F8| x.to_array().map(f32::to_bits);
+        assert_eq!(f(a.valid), f(b.valid));
+        for (x, y) in [(a.p, b.p), (a.n, b.n), (a.ng, b.ng), (a.wo, b.wo), (a.kd, b.kd), (a.ks, b.ks)] {
+            assert_eq!(bits(x), bits(y));
+        }
+        for (x, y) in [(a.emitted, b.emitted), (a.ambient, b.ambient), (a.le, b.le)] {
+            assert_eq!(bits(x), bits(y));
+        }
+        for (x, y) in [(a.smooth, b.smooth), (a.shininess, b.shininess), (a.roughness, b.roughness), (a.ggx, b.ggx)] {
+            assert_eq!(f(x), f(y));
+        }
+        assert_eq!(a.light.to_array(), b.light.to_array());
+    }
+
+    /// Packets whose hit lanes all hit one (non-light) triangle take the splat path: the same
+    /// fields, bit for bit, as the lane-by-lane lookups.
+    #[test]
+    fn one_triangle_packets_match_the_lane_by_lane_gather() {
+        let sc = scene();
+        let (_, dir) = rays();
+        let light_tri = sc.tri_light.iter().position(|&l| l != INVALID_ID).expect("a light triangle") as u32;
+        for (t, hit) in [(0u32, [true; 8]), (1, [true, false, true, true, false, true, true, false])] {
+            assert_eq!(sc.tri_light[t as usize], INVALID_ID, "floor triangle {t} is not a light");
+            let valid = mask_from_bools(hit);
+            let b = valid.to_bitmask();
+            let (geom, prim) = ([GEOM_TRIANGLES; 8], [t; 8]);
+            let p = Vec3x8::splat(Vec3::new(0.1, 0.0, 0.2));
+            let fast = sc.one_triangle(t as usize, valid);
+            let slow = sc.lane_by_lane(b, valid, &geom, &prim, p, dir);
+            assert_eq!(bits(fast.n), bits(slow.n));
+            assert_eq!(fast.light.to_array(), slow.light.to_array());
+            assert_eq!(bits(fast.le), bits(slow.le));
+            assert_eq!(fast.any_tri, slow.any_tri);
+            for (x, y) in [(fast.m.kd, slow.m.kd), (fast.m.ks, slow.m.ks), (fast.m.emitted, slow.m.emitted)] {
+                assert_eq!(bits(x), bits(y));
+            }
+            assert_eq!(bits(fast.m.ambient), bits(slow.m.ambient));
+            let f = |x: F8| x.to_array().map(f32::to_bits);
+            assert_eq!(f(fast.m.shininess), f(slow.m.shininess));
+            assert_eq!(f(fast.m.roughness), f(slow.m.roughness));
+            assert_eq!(f(fast.m.ggx), f(slow.m.ggx));
+        }
+        // Packets the splat path must not take still gather per lane: a light triangle, two
+        // triangles, a sphere lane.
+        let (org, dir) = rays();
+        let sphere = if sc.sphere_point_index.is_empty() { GEOM_ELLIPSOIDS } else { GEOM_SPHERES };
+        for (geom, prim) in [
+            ([GEOM_TRIANGLES; 8], [light_tri; 8]),
+            ([GEOM_TRIANGLES; 8], [0, 1, 0, 1, 0, 0, 1, 1]),
+            ([GEOM_TRIANGLES, sphere, GEOM_TRIANGLES, 0, 0, 0, 0, 0], [0; 8]),
+        ] {
+            let h = hits([true; 8], geom, prim);
+            let mut out = SurfaceHit8::MISS;
+            sc.gather_into(org, dir, &h, &mut out);
+            assert!(out.valid.to_bitmask() == 0xff);
+        }
+    }
+
+    /// A packet with no hit gets exactly the miss record (with its points and `wo`).
+    #[test]
+    fn a_packet_that_hits_nothing_gets_the_miss_record() {
+        let sc = scene();
+        let (org, dir) = rays();
+        let h = hits([false; 8], [INVALID_ID; 8], [INVALID_ID; 8]);
+        let mut out = SurfaceHit8::MISS;
+        out.kd = Vec3x8::splat(Vec3::ONE); // stale contents of a reused buffer
+        sc.gather_into(org, dir, &h, &mut out);
+        let want = SurfaceHit8 { p: dir.mul_add(h.t, org), wo: -dir, ..SurfaceHit8::MISS };
+        same_record(&out, &want);
+    }
 }
