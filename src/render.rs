@@ -1,9 +1,8 @@
 //! Tiles, threads and accumulation: the only place with threads. (The tile's packets are made in
 //! `camera`, their radiance in `integrator`; this module imports both, neither imports it.)
 //!
-//! The image is cut into 16x16-pixel tiles; a tile is cut into 4x2-pixel packets. Rows of tiles
-//! run in parallel under rayon, each writing its band of the film's new block moments in place;
-//! each pixel's samples are accumulated in f64 dyadic blocks (see `film`) in
+//! The image is cut into 16x16-pixel tiles; a tile is cut into 4x2-pixel packets. Tiles run in
+//! parallel under rayon; each pixel's samples are accumulated in f64 dyadic blocks (see `film`) in
 //! increasing sample order, and every sample value is a pure function of (pixel, sample,
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
@@ -106,75 +105,54 @@ pub fn render_counted(
     }
     stats.samples = u64::from(w) * u64::from(h) * samples.len() as u64;
     let tiles_x = w.div_ceil(TILE);
-    // The film's blocks after the samples (the same for every pixel), and the film-wide moments
-    // they will hold, written by the tiles in place: each task is a row of tiles and owns its
-    // band of rows in every block (no per-tile result buffer to merge and copy afterwards).
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let start = Instant::now();
+    let film_in: &Film = film;
+    type Done = (TileResult, Counters, f64, [u64; crate::profile::N_PHASES], u64);
+    let results: Vec<Done> = pool.install(|| {
+        tiles
+            .par_iter()
+            .map_init(Scratch::default, |scratch, &(tx, ty)| {
+                let t0 = cpu_time::ThreadTime::now();
+                let profiling = crate::profile::enabled();
+                let w0 = profiling.then(Instant::now);
+                crate::profile::tile_begin();
+                crate::sampler::replay::tile_begin(ty * tiles_x + tx);
+                let mut counters = Counters::default();
+                let mut r = {
+                    let _f = crate::profile::scope(crate::profile::Phase::Film);
+                    TileResult::from_film(film_in, tx * TILE, ty * TILE)
+                };
+                render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
+                crate::sampler::replay::tile_end();
+                let phases = crate::profile::tile_end();
+                let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
+                tiles_done.fetch_add(1, Ordering::Relaxed);
+                (r, counters, t0.elapsed().as_secs_f64(), phases, wall)
+            })
+            .collect()
+    });
+    stats.seconds = start.elapsed().as_secs_f64();
+    // The merge below runs on the calling thread, outside the tiles: timed with `Instant` into the
+    // film phase and the profiled total when profiling.
+    let merge_start = crate::profile::enabled().then(Instant::now);
     let first = if have.is_empty() { samples.start } else { have.start };
     let mut blocks = film.blocks().to_vec();
     samples.clone().for_each(|s| {
         push_block(&mut blocks, Block::leaf(s));
     });
     let n = film.pixels();
+    film.drop_block_data(); // the tiles hold the continued blocks: peak memory 2x the state, not 3x
     let mut data = vec![[0.0; 6]; blocks.len() * n];
-    let mut rows: Vec<Vec<&mut [Moments]>> = (0..h.div_ceil(TILE)).map(|_| Vec::new()).collect();
-    for block in data.chunks_mut(n.max(1)) {
-        for (band, row) in block.chunks_mut((TILE * w) as usize).zip(rows.iter_mut()) {
-            row.push(band);
-        }
-    }
-    let start = Instant::now();
-    let film_in: &Film = film;
-    let final_blocks = &blocks;
-    type Done = (Counters, f64, [u64; crate::profile::N_PHASES], u64);
-    let results: Vec<Vec<Done>> = pool.install(|| {
-        rows.into_par_iter()
-            .enumerate()
-            .map_init(
-                || (Scratch::default(), Vec::new()),
-                |(scratch, buf), (ty, mut bands)| {
-                    let ty = ty as u32;
-                    let mut done = Vec::with_capacity(tiles_x as usize);
-                    for tx in 0..tiles_x {
-                        let t0 = cpu_time::ThreadTime::now();
-                        let profiling = crate::profile::enabled();
-                        let w0 = profiling.then(Instant::now);
-                        crate::profile::tile_begin();
-                        crate::sampler::replay::tile_begin(ty * tiles_x + tx);
-                        let mut counters = Counters::default();
-                        let mut r = {
-                            let _f = crate::profile::scope(crate::profile::Phase::Film);
-                            TileResult::from_film(film_in, tx * TILE, ty * TILE, std::mem::take(buf))
-                        };
-                        render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
-                        {
-                            let _f = crate::profile::scope(crate::profile::Phase::Film);
-                            debug_assert_eq!(&r.blocks, final_blocks);
-                            r.store(&mut bands, w);
-                        }
-                        *buf = r.data;
-                        crate::sampler::replay::tile_end();
-                        let phases = crate::profile::tile_end();
-                        let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
-                        tiles_done.fetch_add(1, Ordering::Relaxed);
-                        done.push((counters, t0.elapsed().as_secs_f64(), phases, wall));
-                    }
-                    done
-                },
-            )
-            .collect()
-    });
-    stats.seconds = start.elapsed().as_secs_f64();
-    // The rest runs on the calling thread, outside the tiles: timed with `Instant` into the film
-    // phase and the profiled total when profiling.
-    let merge_start = crate::profile::enabled().then(Instant::now);
-    film.drop_block_data(); // the new moments replace the old: peak memory 2x the state
-    for (c, busy, phases, wall) in results.iter().flatten() {
+    for (tile, c, busy, phases, wall) in &results {
         stats.counters.merge(c);
         stats.cpu_seconds += busy;
         stats.profiled_ns += wall;
         for (a, b) in stats.phase_ns.iter_mut().zip(phases) {
             *a += b;
         }
+        debug_assert_eq!(tile.blocks, blocks);
+        tile.store(&mut data, w, n);
     }
     film.set_state(first..samples.end, blocks, data);
     if let Some(t) = merge_start {
@@ -199,12 +177,11 @@ struct TileResult {
 impl TileResult {
     /// The film's current blocks for the tile at (x0, y0): samples continue the same binary
     /// counter, so an image is bit-identical however its samples are split into passes.
-    /// `data` is a buffer to reuse (its contents are dropped).
-    fn from_film(film: &Film, x0: u32, y0: u32, mut data: Vec<Moments>) -> Self {
+    fn from_film(film: &Film, x0: u32, y0: u32) -> Self {
         let (tw, th) = (TILE.min(film.width - x0), TILE.min(film.height - y0));
         let n = film.pixels();
         let src = film.block_data();
-        data.clear();
+        let mut data = Vec::with_capacity(film.blocks().len() * (tw * th) as usize);
         for b in 0..film.blocks().len() {
             for ty in 0..th {
                 let row = b * n + ((y0 + ty) * film.width + x0) as usize;
@@ -214,15 +191,14 @@ impl TileResult {
         Self { x0, y0, tw, th, blocks: film.blocks().to_vec(), data }
     }
 
-    /// Writes the tile's blocks into `bands`: per block, the film-wide rows of the tile's row of
-    /// tiles (image width `w`, first row the tile's `y0`).
-    fn store(&self, bands: &mut [&mut [Moments]], w: u32) {
+    /// Writes the tile's blocks into the film-wide block-major array (`n` pixels, width `w`).
+    fn store(&self, data: &mut [Moments], w: u32, n: usize) {
         let tn = (self.tw * self.th) as usize;
-        for (b, band) in bands.iter_mut().enumerate().take(self.blocks.len()) {
+        for b in 0..self.blocks.len() {
             for ty in 0..self.th {
                 let i = b * tn + (ty * self.tw) as usize;
-                let j = (ty * w + self.x0) as usize;
-                band[j..j + self.tw as usize].copy_from_slice(&self.data[i..i + self.tw as usize]);
+                let j = b * n + ((self.y0 + ty) * w + self.x0) as usize;
+                data[j..j + self.tw as usize].copy_from_slice(&self.data[i..i + self.tw as usize]);
             }
         }
     }
