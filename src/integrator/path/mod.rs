@@ -327,7 +327,7 @@ impl Bounce<'_> {
         if nee_here {
             let (u, w) = it.path_point(&self.dk[0], pixel, s);
             let shadow = &mut *self.shadow;
-            let mut push = |ls: LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
+            let mut push = |ls: &LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
                 let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
                 let to = y - sh.p;
                 let d2 = to.length_squared();
@@ -374,7 +374,7 @@ impl Bounce<'_> {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                         scene.emitters.sample_x8(u_choice, u, w, shade)
                     };
-                    push(ls, None, None, shade)
+                    push(&ls, None, None, shade)
                 }
                 // Every light, N points each (a lattice rotated by (u, w)), each weighted 1/N
                 // and, with MIS, against N p_light.
@@ -392,7 +392,7 @@ impl Bounce<'_> {
                                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                                 e.sample_x8(uj, wj)
                             };
-                            push(ls, scale, mis_n, shade);
+                            push(&ls, scale, mis_n, shade);
                         }
                     }
                 }
@@ -401,7 +401,7 @@ impl Bounce<'_> {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                         it.light_sampler.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
                     };
-                    push(ls, None, None, ok);
+                    push(&ls, None, None, ok);
                 }
             }
         }

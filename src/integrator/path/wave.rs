@@ -104,7 +104,7 @@ impl<const K: usize> Columns<K> {
         if self.cols[0].len() >= packets {
             return;
         }
-        let to = packets.max(2 * self.cols[0].len());
+        let to = packets.max(2 * self.cols[0].len()).max(64);
         for c in &mut self.cols {
             if c.len() < to {
                 c.resize(to, F8::ZERO);
