@@ -162,7 +162,7 @@ impl<const K: usize> Columns<K> {
     /// Sets the lanes of column `c` past `len` up to the packet boundary to `v`.
     pub(super) fn fill_tail(&mut self, c: usize, v: F8) {
         let p = self.len / 8;
-        if self.len % 8 != 0 {
+        if !self.len.is_multiple_of(8) {
             let keep = crate::simd::mask_first(self.len % 8);
             self.cols[c][p] = keep.select(self.cols[c][p], v);
         }
