@@ -46,12 +46,6 @@ impl Pack {
     pub(super) fn count(&self) -> usize {
         self.count
     }
-
-    /// `v` with the kept lanes moved to the front, in order (the other lanes: any of `v`'s).
-    #[inline]
-    pub(super) fn apply(&self, v: F8) -> F8 {
-        permute(v, self.idx)
-    }
 }
 
 /// Lane `idx[j]` of `v` in lane j.
@@ -60,18 +54,22 @@ fn permute(v: F8, idx: U8) -> F8 {
     bytemuck::cast(crate::simd::permute_lanes(bytemuck::cast(v), idx))
 }
 
-/// `K` columns of lanes in packets of 8. Lanes past `len` up to the packet boundary hold
-/// whatever the last append left there (see [`Columns::fill_tail`]).
+/// `K` columns of lanes in packets of 8, stored packet by packet (the K columns of a packet are
+/// adjacent, so one packet's state is one bounds check and a few cache lines). Lanes past `len` up
+/// to the packet boundary hold whatever the last append left there (see [`Columns::fill_tail`]).
 pub(super) struct Columns<const K: usize> {
-    cols: [Vec<F8>; K],
+    rows: Vec<[F8; K]>,
     len: usize,
 }
 
 impl<const K: usize> Default for Columns<K> {
     fn default() -> Self {
-        Self { cols: std::array::from_fn(|_| Vec::new()), len: 0 }
+        Self { rows: Vec::new(), len: 0 }
     }
 }
+
+/// Lane indices 0..8.
+const IOTA: [u32; 8] = [0, 1, 2, 3, 4, 5, 6, 7];
 
 impl<const K: usize> Columns<K> {
     /// No lanes (buffers kept).
@@ -98,57 +96,59 @@ impl<const K: usize> Columns<K> {
         self.len = 8 * n;
     }
 
-    /// Makes every column at least `packets` packets long (they stay of equal length).
+    /// Makes room for at least `packets` packets.
     #[cold]
     fn grow(&mut self, packets: usize) {
-        if self.cols[0].len() >= packets {
-            return;
-        }
-        let to = packets.max(2 * self.cols[0].len()).max(64);
-        for c in &mut self.cols {
-            if c.len() < to {
-                c.resize(to, F8::ZERO);
-            }
+        if self.rows.len() < packets {
+            let to = packets.max(2 * self.rows.len()).max(64);
+            self.rows.resize(to, [F8::ZERO; K]);
         }
     }
 
     /// Writes packet `p` of column `c` (p below [`Columns::packets`]).
     #[inline]
     pub(super) fn set(&mut self, c: usize, p: usize, v: F8) {
-        self.cols[c][p] = v;
+        self.rows[p][c] = v;
     }
 
     /// Packet `p` of column `c`.
     #[inline]
     pub(super) fn get(&self, c: usize, p: usize) -> F8 {
-        self.cols[c][p]
+        self.rows[p][c]
     }
 
     /// Packet `p` of column `c` as u32 lanes.
     #[inline]
     pub(super) fn get_u(&self, c: usize, p: usize) -> U8 {
-        bytemuck::cast(self.cols[c][p])
+        bytemuck::cast(self.rows[p][c])
     }
 
     /// Packet `p` of columns `c..c + 3` as vectors.
     #[inline]
     pub(super) fn get3(&self, c: usize, p: usize) -> Vec3x8 {
-        Vec3x8::new(self.cols[c][p], self.cols[c + 1][p], self.cols[c + 2][p])
+        let r = &self.rows[p];
+        Vec3x8::new(r[c], r[c + 1], r[c + 2])
     }
 
     /// Appends the lanes `pack` keeps of `vals` to the columns `first..first + M` at the end;
     /// [`Columns::advance`] then counts them (so several calls can fill one row of columns).
+    /// The kept lanes land at lanes `l..` of the last packet (l = len % 8) and spill into lanes
+    /// `..l` of the next: one permute rotated by l per column, a blend into the last packet, and
+    /// a whole-packet store into the next (it holds no lane below `len`).
     #[inline(always)]
     pub(super) fn write<const M: usize>(&mut self, first: usize, pack: &Pack, vals: &[F8; M]) {
-        let at = self.len;
-        // Room for a whole packet at `at` (8 lanes are stored whatever `pack` keeps).
-        if self.cols[0].len() < at / 8 + 2 {
-            self.grow(at / 8 + 2);
+        let (q, l) = (self.len / 8, (self.len % 8) as u32);
+        if self.rows.len() < q + 2 {
+            self.grow(q + 2);
         }
-        for (j, v) in vals.iter().enumerate() {
-            let flat: &mut [f32] = bytemuck::cast_slice_mut(self.cols[first + j].as_mut_slice());
-            if let Some(dst) = flat.get_mut(at..at + 8) {
-                dst.copy_from_slice(pack.apply(*v).as_array());
+        let iota = U8::new(IOTA);
+        let idx = crate::simd::permute_lanes(pack.idx, (iota + U8::splat(8 - l)) & U8::splat(7));
+        let below: Mask8 = bytemuck::cast(iota.simd_lt(U8::splat(l)));
+        if let [a, b, ..] = &mut self.rows[q..] {
+            for (j, v) in vals.iter().enumerate() {
+                let v = permute(*v, idx);
+                a[first + j] = below.select(a[first + j], v);
+                b[first + j] = v;
             }
         }
     }
@@ -164,7 +164,7 @@ impl<const K: usize> Columns<K> {
         let p = self.len / 8;
         if !self.len.is_multiple_of(8) {
             let keep = crate::simd::mask_first(self.len % 8);
-            self.cols[c][p] = keep.select(self.cols[c][p], v);
+            self.rows[p][c] = keep.select(self.rows[p][c], v);
         }
     }
 }
