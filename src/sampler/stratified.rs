@@ -250,7 +250,7 @@ impl GridTable {
 
     /// The path tracer's point of dimension `d` for pixel samples `s`: bit for bit
     /// `point_x8(pixel, 0, dim, shuffled_index_x8(s, spp, pixel, dim, seed), seed)`.
-    #[inline]
+    #[inline(always)]
     pub fn path_point_x8(&self, d: &PathDim, pixel: U8, s: U8) -> (F8, F8) {
         let k = d.shuffle.index_x8(s, pixel);
         if self.spans.is_empty() {

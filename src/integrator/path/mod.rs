@@ -81,7 +81,7 @@ pub struct PathScratch {
 
 impl Integrator {
     /// Stratified 2D point of dimension `d` for pixel samples `s`, strata shuffled per (pixel, dim).
-    #[inline]
+    #[inline(always)]
     fn path_point(&self, d: &PathDim, pixel: U8, s: U8) -> (F8, F8) {
         let _p = crate::profile::leaf(crate::profile::Phase::SamplerPath);
         crate::sampler::replay::path_point(pixel, s, d.dim());
