@@ -79,7 +79,11 @@ impl Lobe for Phong {
     }
     #[inline]
     fn lanes(m: &Material8) -> Mask8 {
-        !m.ggx
+        // Lanes without a specular term (ks = 0, finite shininess) get exactly nothing from the
+        // lobe: f_spec = 0 cos^s, and its pdf enters weighted by specular_probability = 0. Leaving
+        // them out lets a packet of diffuse hits skip the lobe.
+        let no_spec = m.ks.x.simd_eq(F8::ZERO) & m.ks.y.simd_eq(F8::ZERO) & m.ks.z.simd_eq(F8::ZERO);
+        !m.ggx & !(no_spec & m.shininess.is_finite())
     }
     #[inline]
     fn eval_pdf_x8(m: &Material8, wo: Vec3x8, wi: Vec3x8) -> (Vec3x8, F8) {

@@ -43,8 +43,8 @@ pub use grid::strata_shape;
 pub use halton::radical_inverse;
 pub use lanes::Lanes;
 pub use layout::{DynLayout, Layout, SetShape, StreamKey};
-pub use permute::{permute, permute_x8, shuffled_index_x8};
-pub use stratified::GridTable;
+pub use permute::{permute, permute_x8, shuffled_index_x8, ShuffleKey};
+pub use stratified::{GridTable, PathDim};
 
 use hash::{hash, unit};
 

@@ -42,26 +42,51 @@ fn rotation<L: Lanes>(key: L, n: u32) -> L {
 /// Eight lanes of [`permute`] with a lane-uniform n and per-lane keys, bit-identical to it per
 /// lane: the rounds run on all lanes until every lane has walked back into 0..n.
 pub fn permute_x8(i: U8, n: u32, key: U8) -> U8 {
-    let n = n.max(1);
-    if n == 1 {
-        return U8::splat(0);
+    Domain::new(n).permute_x8(i, key)
+}
+
+/// The lane-uniform part of [`permute_x8`] for one n: its divisor and power-of-two domain, found
+/// once (a 64-bit division and a leading-zero count) for every packet permuted over n.
+#[derive(Clone, Copy, Debug)]
+struct Domain {
+    n: Divisor,
+    mask: u32,
+    half: u32,
+}
+
+impl Domain {
+    /// The domain of n (n == 0 acts as 1).
+    fn new(n: u32) -> Self {
+        let n = n.max(1);
+        let (mask, half) = if n == 1 { (0, 1) } else { permute_domain(n) };
+        Self { n: Divisor::new(n), mask, half }
     }
-    let (mask, half) = permute_domain(n);
-    let key = fmix(key ^ U8::splat(0x6a09_e667));
-    let r = rotation(key, n);
-    let nn = U8::splat(n);
-    let mut x = Divisor::new(n).rem(i);
-    let mut out = U8::splat(0);
-    let mut done = U8::splat(0);
-    loop {
-        x = permute_round(x, key, mask, half);
-        // First round in range wins: lanes already done keep their value.
-        let inside = x.simd_lt(nn) & !done;
-        out = inside.select(x, out);
-        done |= inside;
-        if done.all() {
-            let y = out + r;
-            return y.simd_lt(nn).select(y, y - nn);
+
+    /// [`permute_x8`] over this domain's n.
+    #[inline]
+    fn permute_x8(&self, i: U8, key: U8) -> U8 {
+        let n = self.n.d;
+        if n == 1 {
+            return U8::splat(0);
+        }
+        let (mask, half) = (self.mask, self.half);
+        let key = fmix(key ^ U8::splat(0x6a09_e667));
+        let r = rotation(key, n);
+        let nn = U8::splat(n);
+        // (Pixel sample indices are below n: the reduction is then the identity.)
+        let mut x = if i.simd_lt(nn).all() { i } else { self.n.rem(i) };
+        let mut out = U8::splat(0);
+        let mut done = U8::splat(0);
+        loop {
+            x = permute_round(x, key, mask, half);
+            // First round in range wins: lanes already done keep their value.
+            let inside = x.simd_lt(nn) & !done;
+            out = inside.select(x, out);
+            done |= inside;
+            if done.all() {
+                let y = out + r;
+                return y.simd_lt(nn).select(y, y - nn);
+            }
         }
     }
 }
@@ -91,6 +116,32 @@ fn permute_round<L: Lanes>(x: L, key: L, mask: u32, half: u32) -> L {
 /// dimensions are stratified independently of one another.
 #[inline]
 pub fn shuffled_index_x8(s: U8, n: u32, pixel: U8, dim: u32, seed: u64) -> U8 {
-    let key_base = (seed as u32) ^ ((seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
-    permute_x8(s, n, U8::splat(key_base) ^ (pixel * U8::splat(0x9e37_79b1)))
+    ShuffleKey::new(n, dim, seed).index_x8(s, pixel)
+}
+
+/// [`shuffled_index_x8`] for one (n, dim, seed) with its lane-uniform work (key, divisor, domain)
+/// done once, for every packet that draws dimension `dim`.
+#[derive(Clone, Copy, Debug)]
+pub struct ShuffleKey {
+    key_base: u32,
+    domain: Domain,
+}
+
+impl ShuffleKey {
+    /// The key of dimension `dim` of a set of n samples under `seed`.
+    pub fn new(n: u32, dim: u32, seed: u64) -> Self {
+        let key_base = (seed as u32) ^ ((seed >> 32) as u32).rotate_left(16) ^ dim.wrapping_mul(0x85eb_ca77);
+        Self { key_base, domain: Domain::new(n) }
+    }
+
+    /// The permutation's n (>= 1): every index is below it.
+    pub fn n(&self) -> u32 {
+        self.domain.n.d
+    }
+
+    /// `shuffled_index_x8(s, n, pixel, dim, seed)`, bit for bit.
+    #[inline]
+    pub fn index_x8(&self, s: U8, pixel: U8) -> U8 {
+        self.domain.permute_x8(s, U8::splat(self.key_base) ^ (pixel * U8::splat(0x9e37_79b1)))
+    }
 }

@@ -22,8 +22,7 @@
 //! that fits the cap. Every call of every tile is still counted ([`Recording::calls`]), so a
 //! replay of the kept tiles scales by `calls / recorded_calls`.
 
-use super::permute::shuffled_index_x8;
-use super::{GridTable, PointSet, SamplerKind, Stream};
+use super::{GridTable, PathDim, PointSet, SamplerKind, Stream};
 use crate::simd::U8;
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -445,6 +444,7 @@ impl Recording {
         // then `Stream::point_k`): so does the replay, for the last k seen.
         let mut point_k = sets.light.point_k(0);
         let mut last_k = 0u32;
+        let mut path_dims: Vec<Option<PathDim>> = Vec::new();
         let (mut calls, mut sum) = (0u64, 0u32);
         let sample_on = mode == ReplayMode::Sample;
         for t in &self.tiles {
@@ -531,8 +531,14 @@ impl Recording {
                     }
                     _ => {
                         sum = if sample_on {
-                            let k = shuffled_index_x8(sample, sets.path_n, pixel, dim, seed);
-                            let (x, y) = sets.path.point_x8(pixel, U8::splat(0), dim, k, seed);
+                            // The render hoists a dimension's lane-uniform work out of its
+                            // packets (once per bounce): so does the replay, once per dim.
+                            let at = dim as usize;
+                            if path_dims.len() <= at {
+                                path_dims.resize(at + 1, None);
+                            }
+                            let d = *path_dims[at].get_or_insert_with(|| sets.path.path_dim(sets.path_n, dim, seed));
+                            let (x, y) = sets.path.path_point_x8(&d, pixel, sample);
                             fold(sum, x.to_bits() ^ y.to_bits())
                         } else {
                             fold(sum, std::hint::black_box(pixel ^ sample ^ U8::splat(dim)))

@@ -8,6 +8,7 @@ use super::grid::{cell_centre, cell_span, jittered, Grid};
 use super::hash::{hash, mix, stream_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
+use super::permute::ShuffleKey;
 use super::PointSet;
 use crate::simd::{F8, U8};
 
@@ -123,6 +124,47 @@ pub struct GridTable {
     set: PointSet,
     /// per cell k: [x lo, x hi, y lo, y hi] in 24-bit fixed point (grid centres: lo == hi)
     spans: Vec<[u32; 4]>,
+    /// the same spans per axis when both axes have at most 8 cells (and the spans are a product
+    /// of the axes): looked up by lane permutes instead of per-lane loads
+    axes: Option<Axes>,
+}
+
+/// The spans of a grid of at most 8 x 8 cells per axis: [x lo, x hi, y lo, y hi] of column or
+/// row c in lane c.
+#[derive(Clone, Copy, Debug)]
+struct Axes {
+    nx: Divisor,
+    spans: [U8; 4],
+}
+
+impl Axes {
+    /// The axes of `spans` (cells of `grid`), if both have at most 8 cells and every cell's span
+    /// is that of its column and row.
+    fn of(spans: &[[u32; 4]], grid: super::grid::Grid) -> Option<Self> {
+        let (nx, ny) = (grid.nx.d as usize, grid.ny.d as usize);
+        if spans.is_empty() || nx > 8 || ny > 8 || spans.len() != nx * ny {
+            return None;
+        }
+        let lane = |j: usize, c: usize, stride: usize| spans.get(c * stride).map_or(0, |s| s[j]);
+        let col = |j: usize, n: usize, stride: usize| {
+            U8::new(std::array::from_fn(|c| if c < n { lane(j, c, stride) } else { 0 }))
+        };
+        let a = Self { nx: grid.nx, spans: [col(0, nx, 1), col(1, nx, 1), col(2, ny, nx), col(3, ny, nx)] };
+        let product = spans.iter().enumerate().all(|(k, s)| {
+            let (cx, cy) = (k % nx, k / nx);
+            let ax = |j: usize, c: usize| a.spans[j].to_array()[c];
+            *s == [ax(0, cx), ax(1, cx), ax(2, cy), ax(3, cy)]
+        });
+        product.then_some(a)
+    }
+
+    /// The spans of cells `k` (each below the set's n).
+    #[inline]
+    fn spans(&self, k: U8) -> [U8; 4] {
+        let (cy, cx) = self.nx.div_rem(k);
+        let p = crate::simd::permute_lanes;
+        [p(self.spans[0], cx), p(self.spans[1], cx), p(self.spans[2], cy), p(self.spans[3], cy)]
+    }
 }
 
 impl GridTable {
@@ -137,7 +179,8 @@ impl GridTable {
         } else {
             Vec::new()
         };
-        Self { set, spans }
+        let axes = Axes::of(&spans, shape.grid());
+        Self { set, spans, axes }
     }
 
     /// The point set this table belongs to.
@@ -166,9 +209,67 @@ impl GridTable {
         #[cfg(test)]
         super::replay::count_api_call();
         let k = self.set.shape().grid().n.rem(k);
+        if let Some(a) = &self.axes {
+            return jitter_in(a.spans(k), pixel, sample, dim, k, seed);
+        }
         let ks = k.to_array();
         let cells: [[u32; 4]; 8] = std::array::from_fn(|i| self.spans[ks[i] as usize]);
         let col = |j: usize| U8::new(std::array::from_fn(|i| cells[i][j]));
         jitter_in([col(0), col(1), col(2), col(3)], pixel, sample, dim, k, seed)
+    }
+}
+
+/// One dimension of the path tracer's points ([`GridTable::path_point_x8`]): its lane-uniform work
+/// (the shuffle's key and domain, the jitter hash's (tag, seed, dim) prefix) done once, for every
+/// packet of a bounce that draws the dimension.
+#[derive(Clone, Copy, Debug)]
+pub struct PathDim {
+    dim: u32,
+    seed: u64,
+    shuffle: ShuffleKey,
+    /// `stream_key(TAG_STRATIFIED, seed, dim)`: the hash state before (pixel, sample, k)
+    key: u32,
+    /// every shuffled index is below the set's n (the cell index needs no reduction)
+    in_range: bool,
+}
+
+impl PathDim {
+    /// The dimension.
+    pub fn dim(&self) -> u32 {
+        self.dim
+    }
+}
+
+impl GridTable {
+    /// Dimension `dim` of the path tracer's points over `spp` pixel samples under `seed`.
+    pub fn path_dim(&self, spp: u32, dim: u32, seed: u64) -> PathDim {
+        let shuffle = ShuffleKey::new(spp, dim, seed);
+        let key = stream_key(TAG_STRATIFIED, seed, dim);
+        PathDim { dim, seed, shuffle, key, in_range: shuffle.n() <= self.set.n() }
+    }
+
+    /// The path tracer's point of dimension `d` for pixel samples `s`: bit for bit
+    /// `point_x8(pixel, 0, dim, shuffled_index_x8(s, spp, pixel, dim, seed), seed)`.
+    #[inline(always)]
+    pub fn path_point_x8(&self, d: &PathDim, pixel: U8, s: U8) -> (F8, F8) {
+        let k = d.shuffle.index_x8(s, pixel);
+        if self.spans.is_empty() {
+            return self.set.point_x8(pixel, U8::splat(0), d.dim, k, d.seed);
+        }
+        #[cfg(test)]
+        super::replay::count_api_call();
+        let k = if d.in_range { k } else { self.set.shape().grid().n.rem(k) };
+        let [xl, xh, yl, yh] = match &self.axes {
+            Some(a) => a.spans(k),
+            None => {
+                let ks = k.to_array();
+                let cells: [[u32; 4]; 8] =
+                    std::array::from_fn(|i| self.spans.get(ks[i] as usize).copied().unwrap_or_default());
+                std::array::from_fn(|j| U8::new(std::array::from_fn(|i| cells[i][j])))
+            }
+        };
+        // `hash(TAG_STRATIFIED, seed, dim, [pixel, 0, k])` from its hoisted prefix.
+        let h = mix(mix(mix(U8::splat(d.key), pixel), U8::splat(0)), k);
+        (jittered((xl, xh), h), jittered((yl, yh), mix(h, U8::splat(1))))
     }
 }

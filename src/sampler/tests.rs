@@ -204,6 +204,34 @@ fn permute_x8_and_grid_table_equal_their_scalar_forms_bit_for_bit() {
     }
 }
 
+/// The path tracer's hoisted points (`GridTable::path_dim` + `path_point_x8`) equal the
+/// per-call form `point_x8(pixel, 0, dim, shuffled_index_x8(..))` bit for bit, for every layout,
+/// with the spp equal to, above and below the set's n (and the equal-time `u32::MAX`).
+#[test]
+fn path_points_with_hoisted_dimensions_equal_the_per_call_form() {
+    let mut st = 29u64;
+    for n in interesting_n() {
+        for kind in SamplerKind::ALL {
+            let table = GridTable::new(PointSet::new(kind, n));
+            for spp in [n, n + 3, n / 2, u32::MAX] {
+                let seed = u64::from(lcg(&mut st)) << 32 | u64::from(lcg(&mut st));
+                for dim in [64, 65, 130] {
+                    let d = table.path_dim(spp, dim, seed);
+                    assert_eq!(d.dim(), dim);
+                    let pixel = u8_from(|_| lcg(&mut st) % 100_000);
+                    let s = u8_from(|l| if l == 7 { u32::MAX } else { lcg(&mut st) % spp.max(1) });
+                    let k = shuffled_index_x8(s, spp, pixel, dim, seed);
+                    assert_eq!(k.to_array(), ShuffleKey::new(spp, dim, seed).index_x8(s, pixel).to_array());
+                    let (ex, ey) = table.point_x8(pixel, U8::splat(0), dim, k, seed);
+                    let (x, y) = table.path_point_x8(&d, pixel, s);
+                    assert_eq!(x.to_array().map(f32::to_bits), ex.to_array().map(f32::to_bits), "{kind:?} n={n}");
+                    assert_eq!(y.to_array().map(f32::to_bits), ey.to_array().map(f32::to_bits), "{kind:?} n={n}");
+                }
+            }
+        }
+    }
+}
+
 /// Unbiasedness of shuffled strata needs, for a fixed sample index, the strata two dimensions
 /// give it to be jointly uniform over pixels (keys): chi-square of the (dim a, dim b) stratum
 /// pairs over 20000 pixel keys, derived as the path tracer derives them, for every sample

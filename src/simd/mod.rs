@@ -67,6 +67,22 @@ pub fn u8_to_f8(v: U8) -> F8 {
     F8::new(a.map(|x| x as f32))
 }
 
+/// Lane `idx[j] % 8` of `v` in lane j: an 8-entry table look-up per lane (AVX2: one `vpermd`).
+#[cfg(target_feature = "avx2")]
+#[inline]
+pub fn permute_lanes(v: U8, idx: U8) -> U8 {
+    use wide::bytemuck::cast;
+    cast(safe_arch::shuffle_av_i32_all_m256i(cast(v), cast(idx)))
+}
+
+/// Lane `idx[j] % 8` of `v` in lane j (portable form).
+#[cfg(not(target_feature = "avx2"))]
+#[inline]
+pub fn permute_lanes(v: U8, idx: U8) -> U8 {
+    let (a, i) = (v.to_array(), idx.to_array());
+    U8::new(std::array::from_fn(|j| a[i[j] as usize & 7]))
+}
+
 /// Three coordinates of eight vectors, structure of arrays.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Vec3x8 {
@@ -293,6 +309,16 @@ mod tests {
             assert!((n.lane(i) - b[i].normalize_or_zero()).length() < 1e-6);
         }
         assert_eq!(Vec3x8::ZERO.normalize_or_zero().lane(3), Vec3::ZERO);
+    }
+
+    #[test]
+    fn permute_lanes_looks_up_every_lane() {
+        let v = U8::new([10, 11, 12, 13, 14, 15, 16, 0xffff_ffff]);
+        for r in 0..8u32 {
+            let idx = U8::new(std::array::from_fn(|j| (j as u32 * 5 + r) % 8 + if j == 3 { 8 * r } else { 0 }));
+            let want: [u32; 8] = std::array::from_fn(|j| v.to_array()[idx.to_array()[j] as usize % 8]);
+            assert_eq!(permute_lanes(v, idx).to_array(), want);
+        }
     }
 
     #[test]

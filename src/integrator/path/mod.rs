@@ -1,0 +1,493 @@
+//! `pathtracer`: unidirectional path tracing with next event estimation (off, on, MIS with the
+//! power heuristic), Russian roulette and the format's importance-sampling strategies, run as a
+//! wavefront over a tile's paths. After every bounce the live paths are compacted into full packets
+//! of 8, so Embree sees full packets past the first bounce; shadow rays of a bounce are batched.
+//!
+//! Vertex numbering: vertex 1 is the camera hit. `maxdepth N` (FORMAT.md): with NEE, direct light
+//! is gathered at vertices 1..N (N = 1 is direct lighting); without NEE, emission is counted at
+//! vertices 1..N+1. Emission of area lights (quads, emissive triangles) follows the NEE mode (off:
+//! always; on: vertex 1 only; MIS: vertex 1, then weighted against the light-sampling pdf);
+//! `emission` of materials is not light-sampled and is counted at every vertex. Estimators stay
+//! unbiased: no clamping unless `--clamp` asks for it (biased, reported).
+//!
+//! Sampler dimensions of vertex v: `DIM_PATH_BASE + 4 (v-1) + {0: light point, 1: (light choice,
+//! lobe choice), 2: BSDF direction, 3: (Russian roulette, -)}`. Each is a stratified set over the
+//! pixel's spp samples whose strata are shuffled per (pixel, dimension), so dimensions are
+//! stratified independently of one another.
+
+use super::context::{masked, TileCtx};
+use super::direct::material;
+use super::{Integrator, RayKind};
+use crate::accel::{Hits8, Ray8, RayHit8};
+use crate::bsdf::LobeSet;
+use crate::light::emitters::LightSample8;
+use crate::light::select::LightSelection;
+use crate::sampler::PathDim;
+use crate::sampling::power_heuristic_x8;
+use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::desc::{ImportanceSampling, Nee};
+use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
+use glam::Vec3;
+use wave::{add_lanes, bits, Columns, Pack};
+
+mod wave;
+
+/// First sampler dimension of the path tracer's vertices.
+pub const DIM_PATH_BASE: u32 = 64;
+/// Hard cap on path vertices when `maxdepth -1` (Russian roulette normally ends paths far sooner).
+pub const MAX_VERTICES_UNBOUNDED: u32 = 4096;
+
+// Columns of a live path (`Columns<PATH_COLS>`): the index of (tile packet, lane) whose pixel
+// sample it is, `packet * 8 + lane` (u32::MAX: a placeholder lane, traced inactive); the linear
+// pixel index and the pixel sample index (sampler inputs); the next ray's origin and unit
+// direction; the throughput; the solid-angle pdf with which the direction was sampled (for the
+// MIS weight of emission found along it).
+const SLOT: usize = 0;
+const PIXEL: usize = 1;
+const SAMPLE: usize = 2;
+const O: usize = 3;
+const D: usize = 6;
+const BETA: usize = 9;
+const PDF: usize = 12;
+const PATH_COLS: usize = 13;
+// Columns of the previous vertex's shading point and normal as NEE used them (for a
+// point-dependent light selection's pmf in the MIS weight of emission found along the path),
+// kept only when that selection needs them.
+const PREV_P: usize = 0;
+const PREV_N: usize = 3;
+// Columns of a shadow ray: pixel sample slot, origin, unnormalized direction to the light
+// sample, interval end, and the contribution added to the slot if it is unoccluded.
+const S_SLOT: usize = 0;
+const S_O: usize = 1;
+const S_D: usize = 4;
+const S_TFAR: usize = 7;
+const S_C: usize = 8;
+const SHADOW_COLS: usize = 11;
+
+/// Per-thread buffers of the path wavefront: the live paths of a bounce and the next one's,
+/// structure of arrays in packets of 8 (see [`wave`]), their Embree packets, the shadow rays.
+#[derive(Default)]
+pub struct PathScratch {
+    paths: Columns<PATH_COLS>,
+    next: Columns<PATH_COLS>,
+    prev: Columns<6>,
+    next_prev: Columns<6>,
+    rh: Vec<(RayHit8, Mask8)>,
+    sh: Option<Box<SurfaceHit8>>,
+    radiance: Vec<Vec3x8>,
+    shadow: Columns<SHADOW_COLS>,
+    shadow_rays: Vec<(Ray8, Mask8)>,
+}
+
+impl Integrator {
+    /// Stratified 2D point of dimension `d` for pixel samples `s`, strata shuffled per (pixel, dim).
+    #[inline(always)]
+    fn path_point(&self, d: &PathDim, pixel: U8, s: U8) -> (F8, F8) {
+        let _p = crate::profile::leaf(crate::profile::Phase::SamplerPath);
+        crate::sampler::replay::path_point(pixel, s, d.dim());
+        self.path_set.path_point_x8(d, pixel, s)
+    }
+}
+
+/// Radiance of pixel samples `samples` for each packet of the tile by path tracing, into `out`
+/// (sample-major: `out[si * pks.len() + p]`). All paths of all these samples form one wavefront,
+/// so packets stay full even when Russian roulette thins the paths out.
+pub(super) fn tile<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    samples: std::ops::Range<u32>,
+    out: &mut Vec<Vec3x8>,
+) {
+    it.path_tile::<L>(ctx, samples, out)
+}
+
+/// Vertex of the path packet being shaded: where it is and what it carries.
+struct Vertex<'a> {
+    sh: &'a SurfaceHit8,
+    rh: &'a RayHit8,
+    slot: U8,
+    pixel: U8,
+    s: U8,
+    beta: Vec3x8,
+}
+
+impl Integrator {
+    fn path_tile<L: LobeSet>(&self, ctx: &mut TileCtx, samples: std::ops::Range<u32>, out: &mut Vec<Vec3x8>) {
+        let TileCtx { scene, camera, pks, tracer, scratch } = ctx;
+        let PathScratch { paths, next, prev, next_prev, rh, sh, radiance, shadow, shadow_rays } = &mut scratch.path;
+        let sh = &mut **sh.get_or_insert_with(|| Box::new(SurfaceHit8::MISS));
+        let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
+        // The previous vertex is kept only for a point-dependent light choice's MIS weight.
+        let keep_prev = self.nee == Nee::Mis && self.light_sampler.depends_on_point();
+        let n_samples = samples.len();
+        radiance.clear();
+        radiance.resize(pks.len() * n_samples, Vec3x8::ZERO);
+        // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks); lanes
+        // outside the image travel as inactive placeholders in the first packets.
+        let n = pks.len() * n_samples;
+        paths.set_packets(n);
+        prev.set_packets(if keep_prev { n } else { 0 });
+        rh.truncate(n);
+        rh.resize(n, (RayHit8::default(), F8::ZERO));
+        let lane = U8::new([0, 1, 2, 3, 4, 5, 6, 7]);
+        for (si, s) in samples.enumerate() {
+            for (p, pk) in pks.iter().enumerate() {
+                let ci = si * pks.len() + p;
+                let (org, dir) = camera.rays(pk, s);
+                let (r, active) = &mut rh[ci];
+                *active = r.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
+                let slot = U8::splat(ci as u32 * 8) + lane;
+                paths.set(SLOT, ci, pk.active.select(bits(slot), bits(U8::MAX)));
+                paths.set(PIXEL, ci, bits(pk.pixel));
+                paths.set(SAMPLE, ci, bits(U8::splat(s)));
+                for c in 0..3 {
+                    paths.set(BETA + c, ci, F8::ONE);
+                }
+                paths.set(PDF, ci, F8::ZERO);
+                if keep_prev {
+                    for c in 0..6 {
+                        prev.set(c, ci, if c == PREV_N + 2 { F8::ONE } else { F8::ZERO });
+                    }
+                }
+            }
+        }
+        let mut v = 1u32;
+        while paths.len() > 0 && v <= max_v {
+            let n_packets = paths.packets();
+            if v > 1 {
+                // Full packets of 8 live paths, written in place (Embree resets a packet's hit
+                // ids itself).
+                rh.truncate(n_packets);
+                rh.resize(n_packets, (RayHit8::default(), F8::ZERO));
+                for (ci, (r, active)) in rh.iter_mut().enumerate() {
+                    let live = F8::from_bits(!paths.get_u(SLOT, ci).simd_eq(U8::MAX));
+                    let (o, d) = (paths.get3(O, ci), paths.get3(D, ci));
+                    *active = r.ray.set(o, d, F8::ZERO, F8::splat(f32::INFINITY), live);
+                }
+            }
+            tracer.intersect_all(rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
+            next.clear();
+            next_prev.clear();
+            shadow.clear();
+            let dims = DIM_PATH_BASE + 4 * (v - 1);
+            let dk: [PathDim; 4] =
+                std::array::from_fn(|j| self.path_set.path_dim(self.spp, dims + j as u32, self.seed));
+            let mut b = Bounce { it: self, scene, v, max_v, dk: &dk, keep_prev, next, next_prev, shadow };
+            for (ci, (r, traced)) in rh.iter().enumerate() {
+                // A packet without a traced lane hits nothing: no emission, no continuation.
+                if traced.none() {
+                    continue;
+                }
+                scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
+                if sh.valid.none() {
+                    continue;
+                }
+                let vx = Vertex {
+                    sh,
+                    rh: r,
+                    slot: paths.get_u(SLOT, ci),
+                    pixel: paths.get_u(PIXEL, ci),
+                    s: paths.get_u(SAMPLE, ci),
+                    beta: paths.get3(BETA, ci),
+                };
+                let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
+                let le = b.emission(&vx, paths.get(PDF, ci), pp, pn);
+                add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
+                b.shade::<L>(&vx);
+            }
+            // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
+            shadow.fill_tail(S_SLOT, bits(U8::MAX));
+            let n_shadow = shadow.packets();
+            shadow_rays.truncate(n_shadow);
+            shadow_rays.resize(n_shadow, (Ray8::default(), F8::ZERO));
+            for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
+                let active = F8::from_bits(!shadow.get_u(S_SLOT, j).simd_eq(U8::MAX));
+                let (o, d) = (shadow.get3(S_O, j), shadow.get3(S_D, j));
+                *lit = ray.set(o, d, F8::ZERO, shadow.get(S_TFAR, j), active);
+            }
+            let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
+            for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
+                let occluded = tracer.occluded(ray, *lit);
+                add_lanes(radiance, shadow.get_u(S_SLOT, j), shadow.get3(S_C, j), *lit & !occluded);
+            }
+            drop(occluded_batch);
+            next.fill_tail(SLOT, bits(U8::MAX));
+            std::mem::swap(paths, next);
+            std::mem::swap(prev, next_prev);
+            v += 1;
+        }
+        // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
+        // non-finite samples are left as they are, for the film to count and drop.
+        if let Some(m) = self.clamp {
+            for r in radiance.iter_mut() {
+                let mut l = r.to_lanes();
+                for c in l.iter_mut() {
+                    let top = c.max_element();
+                    if top > m {
+                        *c *= m / top;
+                    }
+                }
+                *r = Vec3x8::from_lanes(l);
+            }
+        }
+        std::mem::swap(out, radiance);
+    }
+}
+
+/// +z in every lane.
+const Z: Vec3x8 = Vec3x8 { x: F8::ZERO, y: F8::ZERO, z: F8::ONE };
+
+/// One bounce of the wavefront: what shading a packet reads and where it writes (the next
+/// bounce's paths, this bounce's shadow rays).
+struct Bounce<'a> {
+    it: &'a Integrator,
+    scene: &'a Scene,
+    v: u32,
+    max_v: u32,
+    dk: &'a [PathDim; 4],
+    keep_prev: bool,
+    next: &'a mut Columns<PATH_COLS>,
+    next_prev: &'a mut Columns<6>,
+    shadow: &'a mut Columns<SHADOW_COLS>,
+}
+
+impl Bounce<'_> {
+    /// Emission found at the vertex: materials always; area lights (quads, emissive triangles)
+    /// by the NEE mode, weighted with MIS against the light-sampling pdf (`pdf` is the pdf the
+    /// direction was sampled with; `pp`, `pn` the previous vertex for a point-dependent choice).
+    #[inline]
+    fn emission(&self, vx: &Vertex, pdf: F8, pp: Vec3x8, pn: Vec3x8) -> Vec3x8 {
+        let (it, sh, v) = (self.it, vx.sh, self.v);
+        let hit = sh.valid;
+        let mut le = masked(sh.emitted, hit);
+        let is_light = hit & F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
+        // No light hit: the area-light term is zero (sh.le and the weight are zero off lights).
+        if is_light.none() {
+            return le;
+        }
+        let light_w = match it.nee {
+            Nee::Off => F8::ONE,
+            Nee::On => F8::splat(if v == 1 { 1.0 } else { 0.0 }),
+            Nee::Mis if v == 1 => F8::ONE,
+            Nee::Mis => {
+                let _p = crate::profile::leaf(crate::profile::Phase::Mis);
+                let p_light = match it.light_selection {
+                    LightSelection::Uniform => light_pdf_at_hit(self.scene, sh, vx.rh, is_light),
+                    // N points on every light: multi-sample MIS against N p_light.
+                    LightSelection::All => {
+                        let pmf = F8::splat(it.light_set.n().max(1) as f32);
+                        light_pdf_at_hit_pmf(self.scene, sh, vx.rh, is_light, pmf)
+                    }
+                    _ => {
+                        let pmf = it.light_sampler.pmf_x8(pp, pn, sh.light, is_light);
+                        light_pdf_at_hit_pmf(self.scene, sh, vx.rh, is_light, pmf)
+                    }
+                };
+                power_heuristic_x8(pdf, p_light, is_light)
+            }
+        };
+        le += masked(sh.le, hit).scale(light_w);
+        le
+    }
+
+    /// NEE and the continuation at the vertex's shaded lanes (hits off the lights): shadow rays
+    /// into `shadow`, surviving paths into `next`.
+    #[inline]
+    fn shade<L: LobeSet>(&mut self, vx: &Vertex) {
+        let (it, scene, sh, v, max_v) = (self.it, self.scene, vx.sh, self.v, self.max_v);
+        let (nee, n_lights) = (it.nee, scene.emitters.len() as u32);
+        let is_light = F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
+        // Shading frame: the normal faces wo, so wo.z > 0 in local coordinates.
+        let shade = sh.valid & !is_light;
+        let nee_here = nee != Nee::Off && n_lights > 0 && v < max_v;
+        let bounce_here = match nee {
+            Nee::On => v + 1 < max_v,
+            _ => v < max_v,
+        };
+        if shade.none() || (!nee_here && !bounce_here) {
+            return;
+        }
+        let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
+        let frame = Frame8::from_normal(sh.n);
+        let wo = frame.to_local(sh.wo);
+        let mat = material(sh);
+        let eps = scene.offset_eps(sh.p);
+        // Offsets along the geometric normal (the shading one may point into the surface).
+        let o = sh.ng.mul_add(eps, sh.p);
+        // Smooth-shaded lanes: directions must also leave the geometric surface.
+        let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+        // (light choice, lobe choice): drawn only where one of them is used (several lights, or
+        // BRDF sampling's lobe pick); skipping it changes no other dimension.
+        let (u_choice, u_lobe) = if n_lights > 1 || it.strategy == ImportanceSampling::Brdf {
+            it.path_point(&self.dk[1], pixel, s)
+        } else {
+            (F8::ZERO, F8::ZERO)
+        };
+
+        if nee_here {
+            let (u, w) = it.path_point(&self.dk[0], pixel, s);
+            let shadow = &mut *self.shadow;
+            let mut push = |ls: &LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
+                let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
+                let to = y - sh.p;
+                let d2 = to.length_squared();
+                let inv_d = F8::ONE / d2.sqrt();
+                let wi = to.scale(inv_d);
+                let cos_i = sh.n.dot(wi);
+                let cos_l = -ln.dot(wi);
+                let lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
+                if lit.none() {
+                    return;
+                }
+                let (f, pdf_b) = {
+                    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
+                    mat.eval_pdf_k::<L>(it.strategy, wo, frame.to_local(wi), lit)
+                };
+                // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
+                let mut g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
+                if let Some(k) = scale {
+                    g *= k;
+                }
+                // (The NEE side's weight is a few flops per lane: cheaper than a scope, so it
+                // stays in `other`; the light-hit side is timed as `mis weights`.)
+                let w_light = if nee == Nee::Mis {
+                    let p_light = d2 / (area * cos_l * inv_pmf);
+                    let p_light = if let Some(k) = mis_n { p_light * k } else { p_light };
+                    power_heuristic_x8(p_light, pdf_b, lit)
+                } else {
+                    F8::ONE
+                };
+                let c = beta.mul_elem(f).mul_elem(l_rad).scale(g * w_light);
+                let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
+                let d = y - o;
+                // The lit lanes, left-packed onto the bounce's shadow rays.
+                let pack = Pack::of(lit);
+                shadow.write(S_SLOT, &pack, &[bits(vx.slot), o.x, o.y, o.z, d.x, d.y, d.z, tfar, c.x, c.y, c.z]);
+                shadow.advance(&pack);
+            };
+            match it.light_selection {
+                // One light chosen by `scene.emitters.all` (uniform among quads, by power with
+                // emissive triangles), one point on it, uniform in area: the historical path,
+                // kept bit-identical.
+                LightSelection::Uniform => {
+                    let ls = {
+                        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                        scene.emitters.sample_x8(u_choice, u, w, shade)
+                    };
+                    push(&ls, None, None, shade)
+                }
+                // Every light, N points each (a lattice rotated by (u, w)), each weighted 1/N
+                // and, with MIS, against N p_light.
+                LightSelection::All => {
+                    let n_all = it.light_set.n().max(1);
+                    let (scale, mis_n) = if n_all > 1 {
+                        (Some(F8::splat(1.0 / n_all as f32)), Some(F8::splat(n_all as f32)))
+                    } else {
+                        (None, None)
+                    };
+                    for e in &scene.emitters.list {
+                        for j in 0..n_all {
+                            let (uj, wj) = lattice_point(u, w, j, n_all);
+                            let ls = {
+                                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                                e.sample_x8(uj, wj)
+                            };
+                            push(&ls, scale, mis_n, shade);
+                        }
+                    }
+                }
+                LightSelection::Power | LightSelection::Spatial => {
+                    let (ls, ok) = {
+                        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                        it.light_sampler.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
+                    };
+                    push(&ls, None, None, ok);
+                }
+            }
+        }
+
+        // Continue the path: sample the BSDF, then Russian roulette.
+        if bounce_here {
+            let u2 = it.path_point(&self.dk[2], pixel, s);
+            let (wi_l, pdf, f) = {
+                let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
+                mat.sample_k::<L>(it.strategy, wo, [u2.0, u2.1], u_lobe, shade)
+            };
+            let cos = wi_l.z;
+            let wi = frame.to_world(wi_l);
+            let ok =
+                shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO) & leaves(wi);
+            let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
+            let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
+            if it.russian_roulette {
+                let (u_rr, _) = it.path_point(&self.dk[3], pixel, s);
+                let q = nb.max_elem().min(F8::ONE);
+                alive &= u_rr.simd_lt(q);
+                nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
+            }
+            if alive.any() {
+                // The surviving lanes, left-packed onto the next bounce's paths.
+                let pack = Pack::of(alive);
+                let row = [bits(vx.slot), bits(pixel), bits(s), o.x, o.y, o.z, wi.x, wi.y, wi.z, nb.x, nb.y, nb.z, pdf];
+                self.next.write(SLOT, &pack, &row);
+                self.next.advance(&pack);
+                if self.keep_prev {
+                    let (p, n) = (sh.p, sh.n);
+                    self.next_prev.write(PREV_P, &pack, &[p.x, p.y, p.z, n.x, n.y, n.z]);
+                    self.next_prev.advance(&pack);
+                }
+            }
+        }
+    }
+}
+
+/// Solid-angle pdf with which NEE would have picked the point hit on a light: pmf d^2 / (A cos_l)
+/// (pmf = 1/#lights without emissive triangles); zero where `is_light` is off.
+#[inline]
+fn light_pdf_at_hit(scene: &Scene, sh: &crate::scene::build::SurfaceHit8, rh: &RayHit8, is_light: Mask8) -> F8 {
+    let ids = sh.light.to_array();
+    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
+    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
+    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
+    let inv_pmf = scene.emitters.inv_pmf_x8(sh.light, is_light);
+    let t = F8::new(rh.ray.tfar);
+    let cos_l = ln.dot(sh.wo);
+    let p = t * t / (area * cos_l * inv_pmf);
+    is_light.select(p, F8::ZERO)
+}
+
+/// Solid-angle pdf of NEE at a light hit for a light chosen with probability `pmf` (per lane):
+/// pmf d^2 / (A cos_l); zero where `is_light` is off or `pmf` is 0.
+#[inline]
+fn light_pdf_at_hit_pmf(
+    scene: &Scene,
+    sh: &crate::scene::build::SurfaceHit8,
+    rh: &RayHit8,
+    is_light: Mask8,
+    pmf: F8,
+) -> F8 {
+    let ids = sh.light.to_array();
+    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
+    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
+    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
+    let t = F8::new(rh.ray.tfar);
+    let cos_l = ln.dot(sh.wo);
+    let p = pmf * t * t / (area * cos_l);
+    is_light.select(p, F8::ZERO)
+}
+
+/// Point `j` of `n` on one light for `all`: a Fibonacci-like rank-1 lattice rotated by `(u, w)`
+/// (every point uniform on the unit square; point 0 is `(u, w)` itself).
+#[inline]
+fn lattice_point(u: F8, w: F8, j: u32, n: u32) -> (F8, F8) {
+    if j == 0 {
+        return (u, w);
+    }
+    let fr = |x: F8| x - x.floor();
+    let a = F8::splat(j as f32 / n as f32);
+    let b = F8::splat((j as f32 * 0.618_034).fract());
+    (fr(u + a).min(F8::splat(ONE_MINUS)), fr(w + b).min(F8::splat(ONE_MINUS)))
+}
+
+/// Largest f32 below 1.
+const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
