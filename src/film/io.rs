@@ -182,6 +182,19 @@ pub fn write_png_quantized(
     gamma: f32,
     q: Quantize,
 ) -> io::Result<()> {
+    write_atomic(path, &encode_png_quantized(path, width, height, rgb, gamma, q)?)
+}
+
+/// The bytes [`write_png_quantized`] writes to `path` (named in errors only), encoded in memory,
+/// so that a caller can encode on one thread and write the file later.
+pub fn encode_png_quantized(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[[f32; 3]],
+    gamma: f32,
+    q: Quantize,
+) -> io::Result<Vec<u8>> {
     if rgb.len() != width as usize * height as usize {
         let msg = format!("PNG {}: {} pixels, expected {width}x{height}", path.display(), rgb.len());
         return Err(io::Error::new(io::ErrorKind::InvalidInput, msg));
@@ -197,7 +210,7 @@ pub fn write_png_quantized(
     let mut writer = encoder.write_header()?;
     writer.write_image_data(&data)?;
     writer.finish()?;
-    write_atomic(path, &bytes)
+    Ok(bytes)
 }
 
 /// Writes `bytes` to `path` atomically: to `<path>.tmp-<pid>` (created or truncated), fsync, rename

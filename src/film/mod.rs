@@ -20,8 +20,8 @@
 
 mod io;
 pub use io::{
-    read_exr, stem_of, to_u8, to_u8_quantized, with_ext, write_atomic, write_exr, write_png, write_png_quantized,
-    ExrImage, Metadata, Quantize,
+    encode_png_quantized, read_exr, stem_of, to_u8, to_u8_quantized, with_ext, write_atomic, write_exr, write_png,
+    write_png_quantized, ExrImage, Metadata, Quantize,
 };
 
 use std::ops::Range;

@@ -313,6 +313,12 @@ pub fn light_streams_append(pixels: impl IntoIterator<Item = U8>, sample: U8, di
 /// Reports `streams[stream].point(k)` of the last table of [`light_streams`].
 #[inline]
 pub fn light_point(stream: u32, k: u32) {
+    stream_point(OP_STREAM_POINT, stream, k);
+}
+
+/// Logs one stream-point call `op` (`OP_STREAM_POINT`, with `F_CAMERA` for the camera table).
+#[inline]
+fn stream_point(op: u32, stream: u32, k: u32) {
     if recording() {
         LOG.with_borrow_mut(|l| {
             if !l.counting {
@@ -320,7 +326,7 @@ pub fn light_point(stream: u32, k: u32) {
             }
             l.calls += 1;
             if l.active {
-                l.words.extend([OP_STREAM_POINT, stream, k]);
+                l.words.extend([op, stream, k]);
             }
         });
     }
@@ -342,17 +348,7 @@ pub fn camera_streams(pixels: impl IntoIterator<Item = U8>, sample: U8, dim: u32
 /// Reports `streams[stream].point(k)` of the last table of [`camera_streams`].
 #[inline]
 pub fn camera_point(stream: u32, k: u32) {
-    if recording() {
-        LOG.with_borrow_mut(|l| {
-            if !l.counting {
-                return;
-            }
-            l.calls += 1;
-            if l.active {
-                l.words.extend([OP_STREAM_POINT | F_CAMERA, stream, k]);
-            }
-        });
-    }
+    stream_point(OP_STREAM_POINT | F_CAMERA, stream, k);
 }
 
 /// The layouts a replay draws from, one per call site: what the render had (the integrator's

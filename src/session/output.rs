@@ -39,16 +39,19 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
     let var = out.film.variance_of_mean();
     let (exr, png) = (with_ext(&stem, "exr"), with_ext(&stem, "png"));
     let (gamma, quantize, meta) = (out.scene.desc.gamma, super::options::default_quantize(opts), metadata(&out));
-    // The two encodes are independent: the PNG is written on a second thread while this one writes
+    // The two encodes are independent: the PNG is encoded on a second thread while this one writes
     // the EXR (whose ZIP blocks dominate a short render's wall time), so encoding costs the longer
-    // of the two, not their sum. Both files are written atomically; an error names its file.
-    let (exr_result, png_result) = std::thread::scope(|s| {
-        let png_job = s.spawn(|| film::write_png_quantized(&png, w, h, &mean, gamma, quantize));
+    // of the two, not their sum. The files are still written in order, atomically: the PNG only
+    // once the EXR is in place (a failed EXR write leaves the old PNG), an error naming its file.
+    let (exr_result, png_bytes) = std::thread::scope(|s| {
+        let png_job = s.spawn(|| film::encode_png_quantized(&png, w, h, &mean, gamma, quantize));
         let exr_result = film::write_exr(&exr, w, h, &mean, Some(&var), &meta);
         (exr_result, png_job.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
     });
     exr_result.map_err(|source| SessionError::Output { path: exr.clone(), source })?;
-    png_result.map_err(|source| SessionError::Output { path: png.clone(), source })?;
+    png_bytes
+        .and_then(|bytes| film::write_atomic(&png, &bytes))
+        .map_err(|source| SessionError::Output { path: png.clone(), source })?;
     out.out = Some(stem);
     if let Some(p) = &opts.profile {
         // The encoding ran on this thread after the render: its own phase, added to the total.
