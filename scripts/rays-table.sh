@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The issue-15 throughput table: `strata rays` (whole renderer vs Embree raw on the same packets,
 # one thread, thread CPU time) on the five target scenes, for one or more strata binaries run
-# interleaved (binary 1 scene 1, binary 2 scene 1, ...) for ROUNDS rounds, as a Markdown table.
+# interleaved (binary 1 scene 1, binary 2 scene 1, ...) for ROUNDS rounds, as a Markdown table
+# (each round's value, and the median of the rounds' ratios).
 #   scripts/rays-table.sh [-r ROUNDS] [-s WxH] [-p SPP] BIN [BIN ...]
 # Default: 2 rounds, 256x256, 4 spp. Needs ../shared/cse168 beside the checkout and python3.
 set -euo pipefail
@@ -37,12 +38,13 @@ python3 - "$tmp" "$rounds" "$@" <<'EOF'
 import json, sys
 tmp, rounds, bins = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
 names = ["cornellSimple", "dragon", "analytic", "sphere", "direct3x3"]
-print("| scene | binary | renderer Mrays/s | Embree raw Mrays/s | renderer / raw |")
-print("|---|---|---:|---:|---:|")
+print("| scene | binary | renderer Mrays/s | Embree raw Mrays/s | renderer / raw | median ratio |")
+print("|---|---|---:|---:|---:|---:|")
 for n in names:
     for b, path in enumerate(bins, 1):
         rs = [json.load(open(f"{tmp}/{n}.{b}.{r}.json")) for r in range(1, rounds + 1)]
         cell = lambda k, f: " / ".join(f.format(x[k]) for x in rs)
         print(f"| {n} | {path} | {cell('renderer_mrays', '{:.2f}')} | {cell('raw_mixed_mrays', '{:.1f}')} "
-              f"| {' / '.join('{:.1f} %'.format(100 * x['ratio']) for x in rs)} |")
+              f"| {' / '.join('{:.1f} %'.format(100 * x['ratio']) for x in rs)} "
+              f"| {100 * sorted(x['ratio'] for x in rs)[len(rs) // 2]:.1f} % |")
 EOF
