@@ -7,7 +7,7 @@
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
 pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
-use crate::film::{push_block, Block, Film, Moments};
+use crate::film::{leaf_moments8, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
 use crate::simd::Vec3x8;
@@ -294,18 +294,10 @@ fn accumulate(
         let l = &radiance[k * stride];
         let finite = l.is_finite();
         counters.nonfinite += u64::from((active & !finite.to_bitmask()).count_ones());
-        // `leaf_moments` lane-wise, channel by channel (vectorized): a non-finite lane is zero in
-        // every channel.
+        // A non-finite lane is zero in every channel.
         let zero = crate::simd::F8::ZERO;
         let rgb = [finite.select(l.x, zero), finite.select(l.y, zero), finite.select(l.z, zero)].map(|c| c.to_array());
-        let mut acc: Moments8 = [[0.0; 8]; 6];
-        for (c, v) in rgb.iter().enumerate() {
-            for i in 0..8 {
-                let x = f64::from(v[i]);
-                acc[c][i] = x;
-                acc[c + 3][i] = x * x;
-            }
-        }
+        let mut acc: Moments8 = leaf_moments8(rgb);
         for _ in 0..c {
             top -= 1;
             let left = &stack[top];

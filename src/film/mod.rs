@@ -155,6 +155,21 @@ pub fn leaf_moments(rgb: [f32; 3]) -> Moments {
     [r, g, b, r * r, g * g, b * b]
 }
 
+/// [`leaf_moments`] of 8 sample values at once, `[moment][lane]` from `[channel][lane]`: the same
+/// values per lane, computed channel by channel (the loops vectorize).
+#[inline(always)]
+pub fn leaf_moments8(rgb: [[f32; 8]; 3]) -> [[f64; 8]; 6] {
+    let mut m = [[0.0; 8]; 6];
+    for (c, v) in rgb.iter().enumerate() {
+        for i in 0..8 {
+            let x = f64::from(v[i]);
+            m[c][i] = x;
+            m[c + 3][i] = x * x;
+        }
+    }
+    m
+}
+
 /// Per-pixel f64 accumulation of a contiguous range of sample indices, kept as dyadic blocks (see
 /// the module doc), with the per-pixel totals: per-channel sum, per-channel sum of squares (second
 /// moment) and sample count.

@@ -188,27 +188,25 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
             if shade.none() {
                 continue;
             }
-            let jj = j as usize;
-            j += 1;
+            let (u, v) = {
+                let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+                crate::sampler::replay::light_point(j, k);
+                sc.streams[j as usize].point_k(&point_k)
+            };
             let (ls, ok) = if one_light {
-                let (u, v) = {
-                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(jj as u32, k);
-                    sc.streams[jj].point_k(&point_k)
-                };
                 // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
             } else {
-                let ((u, v), (uc, _)) = {
+                let (uc, _) = {
                     let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(jj as u32, k);
-                    crate::sampler::replay::light_point(n_shading + jj as u32, k);
-                    (sc.streams[jj].point_k(&point_k), sc.choice_streams[jj].point_k(&point_k))
+                    crate::sampler::replay::light_point(n_shading + j, k);
+                    sc.choice_streams[j as usize].point_k(&point_k)
                 };
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
             };
+            j += 1;
             let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
             let g = g * ls.area * ls.inv_pmf * inv_n;
             sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));

@@ -167,12 +167,10 @@ impl Integrator {
         }
         out.clear();
         // The camera's pixel-sample streams, hashed once for the batch (if a sample draws).
-        let mut cam = std::mem::take(&mut ctx.scratch.cam_streams);
-        cam.clear();
+        ctx.scratch.cam_streams.clear();
         if samples.clone().any(|s| ctx.camera.draws(s)) {
-            ctx.camera.streams(pks, &mut cam);
+            ctx.camera.streams(pks, &mut ctx.scratch.cam_streams);
         }
-        ctx.scratch.cam_streams = cam;
         let mut one = std::mem::take(&mut ctx.scratch.one);
         for s in samples {
             kernel::with_lobe_set!(self.kernel.lobes, L => self.camera_hits_and_shade::<L>(&mut ctx, s, &mut one));

@@ -356,12 +356,9 @@ impl Emitters {
         let la = Vec3x8::from_lanes(es.map(|e| e.a));
         let lab = Vec3x8::from_lanes(es.map(|e| e.ab));
         let lac = Vec3x8::from_lanes(es.map(|e| e.ac));
-        // Fold onto the triangle where the lane's light is one and u + v > 1.
         let tri = crate::simd::mask_from_bools(es.map(|e| e.triangle));
-        let fold = tri & (u + v).simd_gt(F8::ONE);
-        let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
         LightSample8 {
-            y: lac.mul_add(v, lab.mul_add(u, la)),
+            y: point_x8(la, lab, lac, tri, u, v),
             normal: Vec3x8::from_lanes(es.map(|e| e.normal)),
             radiance: Vec3x8::from_lanes(es.map(|e| e.radiance)),
             area: F8::new(es.map(|e| e.area)),
@@ -374,14 +371,9 @@ impl Emitters {
     #[inline]
     pub(crate) fn place_one_x8(&self, i: u32, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let e = &self.list[i as usize];
-        let (u, v) = if e.triangle {
-            let fold = (u + v).simd_gt(F8::ONE);
-            (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v))
-        } else {
-            (u, v)
-        };
+        let tri = crate::simd::mask_from_bools([e.triangle; 8]);
         LightSample8 {
-            y: Vec3x8::splat(e.ac).mul_add(v, Vec3x8::splat(e.ab).mul_add(u, Vec3x8::splat(e.a))),
+            y: point_x8(Vec3x8::splat(e.a), Vec3x8::splat(e.ab), Vec3x8::splat(e.ac), tri, u, v),
             normal: Vec3x8::splat(e.normal),
             radiance: Vec3x8::splat(e.radiance),
             area: F8::splat(e.area),
@@ -389,6 +381,15 @@ impl Emitters {
             light: U8::splat(i),
         }
     }
+}
+
+/// Points a + u ab + v ac of 8 lights (a, ab, ac per lane) for the unit-square samples (u, v),
+/// folded onto the triangle where the lane's light is one (`tri`) and u + v > 1.
+#[inline]
+fn point_x8(a: Vec3x8, ab: Vec3x8, ac: Vec3x8, tri: Mask8, u: F8, v: F8) -> Vec3x8 {
+    let fold = tri & (u + v).simd_gt(F8::ONE);
+    let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
+    ac.mul_add(v, ab.mul_add(u, a))
 }
 
 #[cfg(test)]

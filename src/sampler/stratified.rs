@@ -209,13 +209,19 @@ impl GridTable {
         #[cfg(test)]
         super::replay::count_api_call();
         let k = self.set.shape().grid().n.rem(k);
+        jitter_in(self.cell_spans(k), pixel, sample, dim, k, seed)
+    }
+
+    /// The spans [x lo, x hi, y lo, y hi] of cells `k` (each below the set's n): by lane permutes
+    /// from the axes where the grid has them, else one table load per lane.
+    #[inline(always)]
+    fn cell_spans(&self, k: U8) -> [U8; 4] {
         if let Some(a) = &self.axes {
-            return jitter_in(a.spans(k), pixel, sample, dim, k, seed);
+            return a.spans(k);
         }
         let ks = k.to_array();
         let cells: [[u32; 4]; 8] = std::array::from_fn(|i| self.spans[ks[i] as usize]);
-        let col = |j: usize| U8::new(std::array::from_fn(|i| cells[i][j]));
-        jitter_in([col(0), col(1), col(2), col(3)], pixel, sample, dim, k, seed)
+        std::array::from_fn(|j| U8::new(std::array::from_fn(|i| cells[i][j])))
     }
 }
 
@@ -259,15 +265,7 @@ impl GridTable {
         #[cfg(test)]
         super::replay::count_api_call();
         let k = if d.in_range { k } else { self.set.shape().grid().n.rem(k) };
-        let [xl, xh, yl, yh] = match &self.axes {
-            Some(a) => a.spans(k),
-            None => {
-                let ks = k.to_array();
-                let cells: [[u32; 4]; 8] =
-                    std::array::from_fn(|i| self.spans.get(ks[i] as usize).copied().unwrap_or_default());
-                std::array::from_fn(|j| U8::new(std::array::from_fn(|i| cells[i][j])))
-            }
-        };
+        let [xl, xh, yl, yh] = self.cell_spans(k);
         // `hash(TAG_STRATIFIED, seed, dim, [pixel, 0, k])` from its hoisted prefix.
         let h = mix(mix(mix(U8::splat(d.key), pixel), U8::splat(0)), k);
         (jittered((xl, xh), h), jittered((yl, yh), mix(h, U8::splat(1))))
