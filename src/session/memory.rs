@@ -5,8 +5,9 @@
 //!
 //! The model (bytes; `px` pixels, `B` the most dyadic blocks the film holds at once over the
 //! sample range, `T` triangles, `E` spheres and ellipsoids, `n` threads):
-//! - film: `52 px` (sums, squares, counts) + `48 px B` (the block moments), twice the blocks during
-//!   a pass (the tiles' continued blocks and the film's);
+//! - film: `52 px` (sums, squares, counts) + `48 px B` (the block moments); during a pass the
+//!   tiles' continued blocks (their vectors' capacity: up to the next power of two of `B`) and the
+//!   film's new blocks are alive together;
 //! - outputs, after the passes: the film plus the larger of the images (`100 px`: mean and variance,
 //!   EXR channels and their compressed bytes, PNG) and the checkpoint bytes (`48 px B`);
 //! - scene: [`PER_TRIANGLE`] per triangle (description, build tables, vertex normals when given)
@@ -26,13 +27,13 @@ pub const BASE: u64 = 24 << 20;
 /// Per worker thread: stack and tile scratch buffers.
 pub const PER_THREAD: u64 = 4 << 20;
 /// Per triangle, besides the BVH: its description (40), the built vertices (36), index (12),
-/// material and light ids (8), normal (12), slack of the growing vectors.
-pub const PER_TRIANGLE: u64 = 160;
+/// material and light ids (8), normal (12) (measured with a 2M-triangle OBJ: see docs/robustness.md).
+pub const PER_TRIANGLE: u64 = 110;
 /// Per triangle with vertex normals: the normals in the description and in the built table.
 pub const PER_TRIANGLE_NORMALS: u64 = 72;
 /// Embree's BVH per triangle (medium quality; the high-quality build with spatial splits takes
 /// [`BVH_HIGH_FACTOR`] times as much).
-pub const BVH_PER_TRIANGLE: u64 = 120;
+pub const BVH_PER_TRIANGLE: u64 = 80;
 /// The high-quality BVH against the medium one.
 pub const BVH_HIGH_FACTOR: u64 = 2;
 /// Per sphere or ellipsoid: description, matrices, material, Embree's user primitive.
@@ -78,7 +79,8 @@ pub fn estimate(desc: &SceneDesc, range: std::ops::Range<u32>, threads: usize) -
     let px = u64::from(desc.width) * u64::from(desc.height);
     let b = max_blocks(range);
     let state = 52 * px + 48 * px * b;
-    let film = (52 * px + 96 * px * b).max(state + (100 * px).max(48 * px * b));
+    let pass = 52 * px + 48 * px * (b + b.next_power_of_two());
+    let film = pass.max(state + (100 * px).max(48 * px * b));
     let tris = (desc.triangles.len() + desc.emissive_triangles.len() + 2 * desc.quad_lights.len()) as u64;
     let normals = if desc.triangle_normals.is_empty() { 0 } else { PER_TRIANGLE_NORMALS * tris };
     let high = match std::env::var("STRATA_BVH").as_deref() {
