@@ -75,8 +75,11 @@ pub fn corpus() -> PathBuf {
     p
 }
 
-/// The pixel channels (name, f32 bits) and the text metadata of an EXR.
-pub fn exr(path: &Path) -> (Vec<(String, Vec<u32>)>, Vec<(String, String)>) {
+/// The pixel channels of an EXR: (layer name, f32 bits).
+pub type Channels = Vec<(String, Vec<u32>)>;
+
+/// The pixel channels and the text metadata of an EXR.
+pub fn exr(path: &Path) -> (Channels, strata::film::Metadata) {
     let img = strata::film::read_exr(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let bits = |v: &[[f32; 3]]| v.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<u32>>();
     let mut ch = vec![("rgb".to_string(), bits(&img.rgb))];
