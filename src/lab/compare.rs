@@ -89,16 +89,16 @@ pub fn compare_profiled(
                 let mut film = Film::new(img.width, img.height);
                 let (seconds, spp) = match (step, mode) {
                     (Some(spp), _) => {
-                        it = it.resampled(Some(spp));
+                        it = it.resampled(spp);
                         let st = render::render(&scene, &it, &mut film, 0..spp, &pool);
                         step_stats.merge(&st);
                         (st.cpu_seconds, spp)
                     }
                     (None, Mode::Budget(b)) => {
                         // Equal time: whole passes of one sample until the budget (the workers' CPU
-                        // seconds) is spent. The pixel layout assumes an spp it cannot know in
-                        // advance: independent.
-                        it = it.resampled(None);
+                        // seconds) is spent. Progressive layouts continue their sequences pass
+                        // after pass; one that needs its count in advance is refused.
+                        it = it.equal_time().map_err(session::SessionError::from)?;
                         let (mut t, mut s) = (0.0, 0u32);
                         while t < *b {
                             let st = render::render(&scene, &it, &mut film, s..s + 1, &pool);

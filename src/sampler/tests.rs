@@ -205,7 +205,8 @@ fn permute_x8_and_grid_table_equal_their_scalar_forms_bit_for_bit() {
 }
 
 /// The path tracer's hoisted points (`GridTable::path_dim` + `path_point_x8`) equal the
-/// per-call form `point_x8(pixel, 0, dim, shuffled_index_x8(..))` bit for bit, for every layout,
+/// per-call form `point_x8(pixel, 0, dim, shuffled_index_x8(..))` (grids) or
+/// `point_x8(pixel, 0, dim, s)` (sequences) bit for bit, for every layout,
 /// with the spp equal to, above and below the set's n (and the equal-time `u32::MAX`).
 #[test]
 fn path_points_with_hoisted_dimensions_equal_the_per_call_form() {
@@ -222,6 +223,7 @@ fn path_points_with_hoisted_dimensions_equal_the_per_call_form() {
                     let s = u8_from(|l| if l == 7 { u32::MAX } else { lcg(&mut st) % spp.max(1) });
                     let k = shuffled_index_x8(s, spp, pixel, dim, seed);
                     assert_eq!(k.to_array(), ShuffleKey::new(spp, dim, seed).index_x8(s, pixel).to_array());
+                    let k = if table.is_grid() { k } else { s };
                     let (ex, ey) = table.point_x8(pixel, U8::splat(0), dim, k, seed);
                     let (x, y) = table.path_point_x8(&d, pixel, s);
                     assert_eq!(x.to_array().map(f32::to_bits), ex.to_array().map(f32::to_bits), "{kind:?} n={n}");

@@ -33,7 +33,7 @@ pub struct ZSobol;
 
 /// Its entry in the registry [`super::SAMPLERS`].
 pub(super) const INFO: super::SamplerInfo =
-    super::SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &ZSobol);
+    super::SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &ZSobol).needs_count();
 
 /// The 24 permutations of the four quadrants, lexicographic: entry `4 p + d` is digit d under
 /// permutation p.

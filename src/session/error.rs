@@ -62,6 +62,9 @@ pub enum SessionError {
         /// how to raise the cap
         hint: String,
     },
+    /// An equal-time run (`--time-budget`) of a sampler that needs its sample count.
+    #[error(transparent)]
+    NotProgressive(#[from] crate::integrator::NotProgressive),
     /// `--time-budget` not a positive number.
     #[error("--time-budget {0}: expected a positive number of seconds")]
     TimeBudget(f64),

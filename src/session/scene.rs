@@ -111,8 +111,13 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
             if n == 1 { "" } else { "s" }
         );
     }
-    let mut integrator =
-        Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    let samplers = crate::integrator::SamplerChoice {
+        sampler: opts.sampler,
+        pixel: opts.pixel_sampler,
+        light: opts.light_sampler,
+    };
+    let mut integrator = Integrator::new(&scene, spp, opts.seed, samplers, opts.light_samples);
+    integrator.light_choice = opts.light_choice.unwrap_or(crate::light::select::LightChoice::Reuse);
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
