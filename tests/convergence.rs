@@ -8,7 +8,8 @@
 //! - a block z-test (8x8-pixel blocks, the film's variance of the mean plus the reference's; the
 //!   iid variance over-estimates a low-discrepancy layout's, so the test is conservative) passes;
 //! - no sampler is worse than independent beyond noise (MSE at most 1.3x independent's);
-//! - on a smooth direct-lighting scene (hw2 direct9, one light sample per pixel sample) the
+//! - on a smooth direct-lighting scene (`scenes/three_lights.test`: three lights, no occluder, one
+//!   light sample per pixel sample, uniform choice) the
 //!   low-discrepancy samplers (period-free sequences and pmj02) fit an RMSE slope of -0.7 or
 //!   steeper over 16, 64, 256 spp.
 //!
@@ -204,15 +205,16 @@ fn every_sampler_converges_in_every_configuration() {
 }
 
 /// Low-discrepancy samplers converge faster than Monte Carlo on a smooth direct-lighting scene
-/// (hw2 direct9: one area light over unoccluded diffuse geometry, one light sample per pixel
-/// sample): a
+/// (`scenes/three_lights.test`: three coloured area lights over an unoccluded diffuse floor, one
+/// light sample per pixel sample, the light chosen uniformly): a
 /// least-squares slope of log RMSE over log spp (16, 64, 256) of -0.7 or steeper. Every
 /// progressive registered sampler except independent, plus zsobol: the low-discrepancy ones.
 #[test]
 fn low_discrepancy_samplers_beat_the_monte_carlo_rate() {
     let mut case = cases().into_iter().find(|c| c.name == "direct-uniform sphere").expect("case");
-    case.scene = corpus().join("hw2/direct9.test");
-    let reference = render(&options(&case, SamplerKind::INDEPENDENT, 4 * REF_SPP, 1_000_003));
+    case.scene = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/three_lights.test"));
+    let big = |o: RenderOptions| RenderOptions { size: Some((48, 36)), ..o };
+    let reference = render(&big(options(&case, SamplerKind::INDEPENDENT, 4 * REF_SPP, 1_000_003)));
     let ladder = [16u32, 64, 256];
     let ld = samplers().into_iter().filter(|k| ![SamplerKind::INDEPENDENT, SamplerKind::STRATIFIED].contains(k));
     let mut failures = Vec::new();
@@ -220,7 +222,7 @@ fn low_discrepancy_samplers_beat_the_monte_carlo_rate() {
         let pts: Vec<(f64, f64)> = ladder
             .iter()
             .map(|&spp| {
-                let img = render(&options(&case, kind, spp, 5)).0;
+                let img = render(&big(options(&case, kind, spp, 5))).0;
                 (f64::from(spp).ln(), mse(&img, &reference).max(1e-30).sqrt().ln())
             })
             .collect();
