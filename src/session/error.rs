@@ -62,6 +62,14 @@ pub enum SessionError {
         /// how to raise the cap
         hint: String,
     },
+    /// A flag that changes nothing for the integrator that runs.
+    #[error("{flag} changes nothing here: {why}")]
+    FlagIgnored {
+        /// the flag
+        flag: &'static str,
+        /// why it changes nothing
+        why: String,
+    },
     /// An equal-time run (`--time-budget`) of a sampler that needs its sample count.
     #[error(transparent)]
     NotProgressive(#[from] crate::integrator::NotProgressive),
