@@ -271,9 +271,15 @@ fn time_budget_renders_whole_passes_and_records_spp() {
     run_ok(c);
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!((j["pixel_sampler"].as_str(), j["sampler"].as_str()), (Some("pmj02"), Some("pmj02")));
-    for (flag, name) in [("--pixel-sampler", "stratified"), ("--sampler", "zsobol"), ("--light-sampler", "grid-center")] {
+    for (flag, name) in [("--pixel-sampler", "stratified"), ("--sampler", "zsobol"), ("--light-sampler", "grid-center")]
+    {
         let err = run_err(render_cmd(24, &d.join("r"), &["--time-budget", "1", flag, name]));
-        assert!(err.contains(flag) && err.contains(name) && err.contains("progressive samplers: independent, halton, sobol, pmj02"), "{err}");
+        assert!(
+            err.contains(flag)
+                && err.contains(name)
+                && err.contains("progressive samplers: independent, halton, sobol, pmj02"),
+            "{err}"
+        );
     }
     std::fs::remove_dir_all(&d).ok();
 }

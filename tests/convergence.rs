@@ -187,7 +187,12 @@ fn every_sampler_converges_in_every_configuration() {
                 4 * n
             );
             if !(fall >= 1.8) {
-                failures.push(format!("{} {}: RMSE fell only {fall:.2}x from {n} to {} spp", case.name, kind.name(), 4 * n));
+                failures.push(format!(
+                    "{} {}: RMSE fell only {fall:.2}x from {n} to {} spp",
+                    case.name,
+                    kind.name(),
+                    4 * n
+                ));
             }
             if !(z < 5.0) {
                 failures.push(format!("{} {}: block z {z:.2}", case.name, kind.name()));

@@ -9,7 +9,7 @@
 
 mod common;
 
-use strata::integrator::{LightSelection, FirstSample};
+use strata::integrator::{FirstSample, LightSelection};
 use strata::sampler::{SamplerKind, SAMPLERS};
 use strata::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use strata::session::RenderOptions;
@@ -116,7 +116,10 @@ fn every_sampler_passes_the_furnace() {
             let (pixel, block, off) = z_against_half(&RenderOptions { sampler: Some(kind), ..o.clone() });
             eprintln!("{:<12} {name:<17} max pixel |z| {pixel:.2}, max block |z| {block:.2}", info.name);
             if !(pixel < 6.0 && block < 5.0 && off == 0) {
-                failures.push(format!("{} {name}: pixel |z| {pixel:.2}, block |z| {block:.2}, {off} exact pixels off", info.name));
+                failures.push(format!(
+                    "{} {name}: pixel |z| {pixel:.2}, block |z| {block:.2}, {off} exact pixels off",
+                    info.name
+                ));
             }
         }
     }

@@ -94,4 +94,3 @@ impl Lobe for Phong {
         sample_x8(wo, u, m.shininess, active)
     }
 }
-

@@ -160,16 +160,25 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
     }
     if opts.light_choice.is_some() {
         if it.light_selection == LightSelection::All {
-            return refuse("--light-choice", format!("{name} with light selection all samples every light: there is no choice"));
+            return refuse(
+                "--light-choice",
+                format!("{name} with light selection all samples every light: there is no choice"),
+            );
         }
         if scene.emitters.len() < 2 {
             return refuse("--light-choice", "the scene has fewer than two area lights: there is no choice".into());
         }
     }
-    if it.kind == IntegratorKind::PathTracer && opts.light_samples.is_some() && it.light_selection != LightSelection::All {
+    if it.kind == IntegratorKind::PathTracer
+        && opts.light_samples.is_some()
+        && it.light_selection != LightSelection::All
+    {
         return refuse(
             "--light-samples",
-            format!("the path tracer takes one light sample per vertex with light selection {}", it.light_selection.name()),
+            format!(
+                "the path tracer takes one light sample per vertex with light selection {}",
+                it.light_selection.name()
+            ),
         );
     }
     Ok(())
