@@ -285,9 +285,8 @@ fn every_sampler_flag_changes_the_path_tracer_and_useless_flags_are_refused() {
     );
     let analytic = RenderOptions { integrator: Some(IntegratorKind::AnalyticDirect), ..base.clone() };
     refused(RenderOptions { light_sampler: k("sobol"), ..analytic.clone() }, "--light-sampler");
-    refused(RenderOptions { light_samples: Some(4), ..analytic }, "--light-samples");
+    refused(RenderOptions { light_selection: Some(LightSelection::Power), ..analytic }, "--light-selection");
     let path_uniform = RenderOptions { light_selection: Some(LightSelection::Uniform), ..base };
-    refused(RenderOptions { light_samples: Some(4), ..path_uniform.clone() }, "--light-samples");
     // With a one-light choice on a one-light scene there is nothing to choose either.
     refused(
         RenderOptions { light_choice: Some(strata::integrator::LightChoice::Reuse), ..path_uniform },

@@ -137,7 +137,9 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     Ok((scene, integrator))
 }
 
-/// Refuses a light-sampling flag that changes nothing for the integrator that runs, saying why.
+/// Refuses a light-sampling flag that changes nothing for the integrator that runs, saying why:
+/// `--light-sampler`, `--light-choice`, `--light-selection` for raytracer and analyticdirect, and
+/// `--light-choice` where no light is chosen (selection `all`, fewer than two lights).
 fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<(), SessionError> {
     use crate::light::select::LightSelection;
     use crate::scene::desc::IntegratorKind;
@@ -152,7 +154,6 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
             ("--light-sampler", opts.light_sampler.is_some()),
             ("--light-choice", opts.light_choice.is_some()),
             ("--light-selection", opts.light_selection.is_some()),
-            ("--light-samples", opts.light_samples.is_some()),
         ];
         if let Some((flag, _)) = given.into_iter().find(|(_, on)| *on) {
             return refuse(flag, why.to_string());
@@ -169,18 +170,8 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
             return refuse("--light-choice", "the scene has fewer than two area lights: there is no choice".into());
         }
     }
-    if it.kind == IntegratorKind::PathTracer
-        && opts.light_samples.is_some()
-        && it.light_selection != LightSelection::All
-    {
-        return refuse(
-            "--light-samples",
-            format!(
-                "the path tracer takes one light sample per vertex with light selection {}",
-                it.light_selection.name()
-            ),
-        );
-    }
+    // (`--light-samples` is accepted everywhere: scripts pass it over whole scene sets, and the
+    // `.test` keyword it overrides is there whatever the integrator.)
     Ok(())
 }
 
