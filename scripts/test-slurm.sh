@@ -14,20 +14,25 @@
 #   5. waits for the merge job and checks that the merged image is bit-identical to the
 #      one-machine `strata render` of the same scene and flags: same PNG bytes, same EXR pixels
 #      (every channel, decoded by a small python3 reader below, since the EXR headers differ in
-#      timings and parts), strata.spp and strata.part_count as expected.
+#      timings and parts), strata.spp and strata.part_count as expected;
+#   6. mixed CPUs: one array task (SLURM_TEST_ISA_TASK, 2) runs with STRATA_EMBREE_CONFIG=isa=avx2,
+#      what an AVX2-only node runs, while the others run the default (on an AVX-512 node Embree
+#      would pick AVX-512 if strata did not pin AVX2): step 5's bit-identity covers it. Then that
+#      task's range is rendered again with isa=avx512 (what an unpinned AVX-512 node ran) and
+#      `strata merge` of it with the other parts must be refused, naming embree_isa on both sides.
 #
 # Everything it started is torn down on exit, pass or fail (jobs cancelled, daemons and job
 # processes killed by pid, temp dir removed); every wait is bounded. Prints PASS or FAIL and the
 # elapsed time. Needs root (daemons, apt-get). Knobs (env): SLURM_TEST_SPP (2048), SLURM_TEST_SHARDS
 # (4), SLURM_TEST_SIZE (96x96), SLURM_TEST_SCENE (scenes/cornell_diffuse_path.test),
-# SLURM_TEST_REQUEUE_TASK (1), SLURM_TEST_TIMEOUT (seconds for the whole run, 600), STRATA (binary;
+# SLURM_TEST_REQUEUE_TASK (1), SLURM_TEST_ISA_TASK (2), SLURM_TEST_TIMEOUT (seconds for the whole run, 600), STRATA (binary;
 # default: build target/release/strata), SLURM_TEST_KEEP=1 keeps the temp dir for a post-mortem.
 set -euo pipefail
 started=$SECONDS
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SPP=${SLURM_TEST_SPP:-2048} SHARDS=${SLURM_TEST_SHARDS:-4} SIZE=${SLURM_TEST_SIZE:-96x96}
 SCENE=${SLURM_TEST_SCENE:-$root/scenes/cornell_diffuse_path.test}
-REQ=${SLURM_TEST_REQUEUE_TASK:-1} TIMEOUT=${SLURM_TEST_TIMEOUT:-600}
+REQ=${SLURM_TEST_REQUEUE_TASK:-1} ISA_TASK=${SLURM_TEST_ISA_TASK:-2} TIMEOUT=${SLURM_TEST_TIMEOUT:-600}
 FLAGS="--size $SIZE --seed 7"
 deadline=$(( SECONDS + TIMEOUT ))
 
@@ -309,7 +314,14 @@ say "slurm up on $host ($cpus CPUs, ports $ctld_port/$slurmd_port) after $(( SEC
 # ---- 3. submit, and the one-machine render alongside -----------------------------------------
 work="$tmp/work"
 cd "$work"
-submitted=$(SCENE="$SCENE" SPP=$SPP SHARDS=$SHARDS CPUS=1 OUT="$work/ref" FLAGS="$FLAGS" STRATA="$STRATA" \
+# Mixed CPUs: array task ISA_TASK runs Embree with isa=avx2 configured explicitly (an AVX2 node).
+cat >"$tmp/strata-mixed-isa" <<EOF
+#!/bin/sh
+if [ "\${SLURM_ARRAY_TASK_ID:-}" = "$ISA_TASK" ]; then export STRATA_EMBREE_CONFIG=isa=avx2; fi
+exec "$STRATA" "\$@"
+EOF
+chmod 755 "$tmp/strata-mixed-isa"
+submitted=$(SCENE="$SCENE" SPP=$SPP SHARDS=$SHARDS CPUS=1 OUT="$work/ref" FLAGS="$FLAGS" STRATA="$tmp/strata-mixed-isa" \
   CHECKPOINT_EVERY=0 QUIET=0 "$root/examples/cluster/slurm-submit.sh")
 say "$submitted"
 read -r array merge < <(sed -E 's/^submitted array ([0-9]+) .* merge ([0-9]+) .*/\1 \2/' <<<"$submitted")
@@ -372,4 +384,24 @@ say "requeue verified: Restarts=1; SIGTERM stopped strata after $k spp with chec
 cmp "$work/whole.png" "$work/ref.png" || die "merged PNG differs from the one-machine render"
 tool exrcmp "$work/whole.exr" "$work/ref.exr" "$SPP" "$SHARDS" >"$tmp/exrcmp.txt" || { cat "$tmp/exrcmp.txt" >&2; die "merged EXR differs"; }
 say "merged = one-machine render: PNG bytes equal; EXR $(cat "$tmp/exrcmp.txt")"
+say "task $ISA_TASK ran with STRATA_EMBREE_CONFIG=isa=avx2 (an AVX2 node), the others with the default: still bit-identical"
+
+# ---- 6. a part rendered under AVX-512 does not merge ----------------------------------------------
+ia=$(( ISA_TASK * SPP / SHARDS )) ib=$(( (ISA_TASK + 1) * SPP / SHARDS ))
+if grep -qw avx512bw /proc/cpuinfo; then
+  # shellcheck disable=SC2086 # FLAGS is a list of flags
+  STRATA_EMBREE_CONFIG=isa=avx512 "$STRATA" render "$SCENE" --spp "$SPP" $FLAGS --samples "$ia..$ib" \
+    -o "$work/avx512-part" -q 2>"$tmp/log/avx512.log" || die "the isa=avx512 part failed: $(cat "$tmp/log/avx512.log")"
+  others=()
+  for i in $(seq 0 $(( SHARDS - 1 ))); do [ "$i" = "$ISA_TASK" ] || others+=("$work/ref.parts/part-$i.ckpt"); done
+  if "$STRATA" merge "${others[@]}" "$work/avx512-part.ckpt" -o "$work/mixed" -q 2>"$tmp/mixed.txt"; then
+    die "a part rendered with isa=avx512 merged with avx2 parts"
+  fi
+  grep -q 'embree_isa "avx512"' "$tmp/mixed.txt" && grep -q '"avx2")' "$tmp/mixed.txt" \
+    || die "the refusal does not name both instruction sets: $(cat "$tmp/mixed.txt")"
+  [ ! -e "$work/mixed.exr" ] || die "a refused merge wrote $work/mixed.exr"
+  say "a part of samples $ia..$ib rendered with isa=avx512 is refused: $(cat "$tmp/mixed.txt")"
+else
+  say "no AVX-512 on this CPU: the isa=avx512 part is not rendered (strata refuses isa=avx512 here)"
+fi
 passed=1

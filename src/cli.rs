@@ -74,6 +74,10 @@ pub(crate) enum Cmd {
         /// Print nothing on success.
         #[arg(long, short = 'q')]
         quiet: bool,
+        /// Merge parts written by different builds of strata (refused by default: samples may
+        /// differ between builds); the merged EXR's strata.build lists them.
+        #[arg(long)]
+        allow_other_build: bool,
     },
     /// Write a procedural OBJ+MTL mesh (bumpy torus on a floor under an emissive patch) of at least
     /// --triangles triangles, for throughput runs: OUT.obj and OUT.mtl.
@@ -243,7 +247,9 @@ pub(crate) struct RenderArgs {
     #[arg(long)]
     pub(crate) time_budget: Option<f64>,
     /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
-    /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth.
+    /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth, max_threads,
+    /// max_memory (bytes the render may use; default 80% of physical memory or the cgroup's limit),
+    /// max_file_bytes (size of a scene, OBJ or MTL file).
     #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_limit)]
     pub(crate) limits: Vec<String>,
     /// 8-bit PNG values: truncate (the CSE168 course's writer, floor(255 c); default for .test scenes)
@@ -264,6 +270,10 @@ pub(crate) struct RenderArgs {
     /// behind the camera, announced on stderr).
     #[arg(long)]
     pub(crate) no_default_light: bool,
+    /// --resume a checkpoint written by another build of strata (refused by default: samples may
+    /// differ between builds).
+    #[arg(long)]
+    pub(crate) allow_other_build: bool,
 }
 
 impl RenderArgs {
@@ -302,6 +312,7 @@ impl RenderArgs {
             first_sample: self.first_sample,
             light_selection: self.light_selection,
             no_default_light: self.no_default_light,
+            allow_other_build: self.allow_other_build,
             rendering: None,
         }
     }

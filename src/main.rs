@@ -79,8 +79,8 @@ fn main() -> ExitCode {
                 Err(e) => Err(e.to_string()),
             }
         }
-        Cmd::Merge { parts, out, quiet } => {
-            strata::checkpoint::run_merge(&parts, &out).map_err(|e| e.to_string()).map(|m| {
+        Cmd::Merge { parts, out, quiet, allow_other_build } => {
+            strata::checkpoint::run_merge(&parts, &out, allow_other_build).map_err(|e| e.to_string()).map(|m| {
                 if !quiet {
                     println!(
                         "merged {} parts: {} spp ({}..{}), {:.3} CPU seconds -> {}.exr/.png",
@@ -110,20 +110,7 @@ fn main() -> ExitCode {
             let profile_out = ProfileOut { json: profile, svg: profile_svg };
             run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out, &profile_out)
         }
-        Cmd::GenMesh { out, triangles } => {
-            let mesh = strata::scene::obj::procedural_mesh(triangles);
-            strata::scene::obj::write_obj(&out, &mesh)
-                .map(|mtl| {
-                    println!(
-                        "{}: {} triangles, {} vertices (materials {})",
-                        out.display(),
-                        mesh.faces.len(),
-                        mesh.positions.len(),
-                        mtl.display()
-                    )
-                })
-                .map_err(|e| format!("{}: {e}", out.display()))
-        }
+        Cmd::GenMesh { out, triangles } => gen_mesh(&out, triangles),
         Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
             let corpus = corpus.unwrap_or_else(strata::lab::experiments::default_corpus);
             let cfg = strata::lab::experiments::Config {
@@ -161,7 +148,7 @@ fn main() -> ExitCode {
                 |p| {
                     if let Some(f) = &json_file {
                         let text = serde_json::to_string_pretty(&p).map_err(|e| e.to_string())?;
-                        std::fs::write(f, text).map_err(|e| format!("{}: {e}", f.display()))?;
+                        session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
                     }
                     if let Some(f) = &svg_file {
                         let svg = session::profile::profile_svg(
@@ -197,6 +184,33 @@ fn exit_on_signal_outside_render(stop: Arc<AtomicBool>, rendering: Arc<AtomicBoo
         }
         std::thread::sleep(std::time::Duration::from_millis(20));
     });
+}
+
+/// `strata gen-mesh OUT --triangles N`, refused when the mesh would not fit in memory (80% of it,
+/// the default `--limit max_memory` of a render).
+fn gen_mesh(out: &std::path::Path, triangles: usize) -> Result<(), String> {
+    let need = strata::scene::obj::procedural_mesh_bytes(triangles);
+    let limit = strata::scene::parse::Limits::default().max_memory;
+    if need > limit {
+        let show = session::memory::show_bytes;
+        return Err(format!(
+            "gen-mesh --triangles {triangles}: the mesh needs about {} of memory, above {} (80% of this machine's)",
+            show(need),
+            show(limit)
+        ));
+    }
+    let mesh = strata::scene::obj::procedural_mesh(triangles);
+    strata::scene::obj::write_obj(out, &mesh)
+        .map(|mtl| {
+            println!(
+                "{}: {} triangles, {} vertices (materials {})",
+                out.display(),
+                mesh.faces.len(),
+                mesh.positions.len(),
+                mtl.display()
+            )
+        })
+        .map_err(|e| format!("{}: {e}", out.display()))
 }
 
 /// Where `compare` writes its variants' profiles (`--profile`, `--profile-svg`).

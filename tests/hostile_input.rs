@@ -4,6 +4,7 @@
 //! (32 bytes per input byte plus 4 MiB, measured by a counting allocator on the parsing thread),
 //! and every failure is an error naming the file and a line that holds a command. The resource
 //! caps name the limit and how to raise it (`--limit NAME=VALUE`), through the library and the CLI.
+//! Issue 25's findings (CPUs and builds, outputs, resources) are in `hostile/`.
 
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
@@ -551,3 +552,14 @@ fn unlit_obj_gets_a_default_light() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+// Issue 25 (the same pixels on every node, never a lost render, never a clobbered file): one
+// module per group of findings, sharing the runner in `hostile/run.rs`.
+#[path = "hostile/cpus.rs"]
+mod cpus;
+#[path = "hostile/outputs.rs"]
+mod outputs;
+#[path = "hostile/resources.rs"]
+mod resources;
+#[path = "hostile/run.rs"]
+mod run;

@@ -1,4 +1,6 @@
-//! The Embree device and its error callback, which turns Embree's errors into [`AccelError`]s.
+//! The Embree device and its error callback, which turns Embree's errors into [`AccelError`]s, and
+//! the Embree configuration ([`EmbreeConfig`]): the instruction set is pinned so that every node
+//! traces the same hits.
 
 use embree4_sys as sys;
 use std::ffi::{c_char, c_void, CStr};
@@ -29,6 +31,7 @@ unsafe extern "C" fn error_callback(user: *mut c_void, code: sys::RTCError, msg:
 pub struct Device {
     pub(super) raw: sys::RTCDevice,
     sink: Box<ErrorSink>,
+    isa: &'static str,
 }
 
 // SAFETY: Embree devices are thread-safe for the calls we make (scene creation and commit happen on
@@ -38,12 +41,12 @@ unsafe impl Send for Device {}
 unsafe impl Sync for Device {}
 
 impl Device {
-    /// Creates a device with the error callback installed. The Embree configuration string is
-    /// `verbose=0`, or `$STRATA_EMBREE_CONFIG` when set (e.g. `isa=avx2`).
+    /// Creates a device with the error callback installed, configured by [`EmbreeConfig::from_env`]
+    /// (the instruction set pinned to AVX2 unless `$STRATA_EMBREE_CONFIG` asks for AVX-512).
     pub fn new() -> Result<Self, AccelError> {
-        let config = std::env::var("STRATA_EMBREE_CONFIG").unwrap_or_else(|_| "verbose=0".into());
-        let config = std::ffi::CString::new(config)
-            .map_err(|_| AccelError("STRATA_EMBREE_CONFIG contains a NUL byte".into()))?;
+        let setup = EmbreeConfig::from_env()?;
+        let config = std::ffi::CString::new(setup.config)
+            .map_err(|_| AccelError(format!("{CONFIG_VAR} contains a NUL byte")))?;
         // SAFETY: a NUL-terminated config string; a null return is checked.
         let raw = unsafe { sys::rtcNewDevice(config.as_ptr()) };
         if raw.is_null() {
@@ -52,7 +55,19 @@ impl Device {
         let sink = Box::new(ErrorSink(Mutex::new(Vec::new())));
         // SAFETY: `raw` is a live device; the sink pointer stays valid until after rtcReleaseDevice.
         unsafe { sys::rtcSetDeviceErrorFunction(raw, Some(error_callback), &*sink as *const ErrorSink as *mut c_void) };
-        Ok(Self { raw, sink })
+        Ok(Self { raw, sink, isa: setup.isa })
+    }
+
+    /// The instruction set Embree runs (`avx2` or `avx512`, as configured).
+    pub fn isa(&self) -> &'static str {
+        self.isa
+    }
+
+    /// The Embree library's version, e.g. `4.4.0` (part of a render's identity).
+    pub fn version(&self) -> String {
+        // SAFETY: a live device and a property every Embree 4 build answers.
+        let v = unsafe { sys::rtcGetDeviceProperty(self.raw, sys::RTCDeviceProperty::VERSION) };
+        format!("{}.{}.{}", v / 10000, v / 100 % 100, v % 100)
     }
 
     /// Whether this Embree build has point geometry (`RTC_GEOMETRY_TYPE_SPHERE_POINT`, used by
@@ -79,5 +94,145 @@ impl Drop for Device {
         // SAFETY: the device was created by rtcNewDevice and is released once; all scenes hold
         // their own reference so releasing here is safe even if a Scene outlives this handle.
         unsafe { sys::rtcReleaseDevice(self.raw) };
+    }
+}
+
+/// The environment variable with extra Embree configuration (`key=value`, comma-separated).
+pub const CONFIG_VAR: &str = "STRATA_EMBREE_CONFIG";
+
+/// The instruction set Embree is pinned to by default: every x86-64-v3 node (the CPUs strata is
+/// built for) has it, and Embree's AVX2 and AVX-512 kernels report different hits (907 of 3072
+/// pixel values of `hw4/cornellBRDF` differ), so letting Embree choose per CPU would make shards
+/// rendered on different nodes disagree.
+pub const DEFAULT_ISA: &str = "avx2";
+
+/// Keys of `STRATA_EMBREE_CONFIG` that do not change which hits Embree reports (besides `isa` and
+/// `max_isa`, which enter a render's identity through [`Device::isa`]).
+const NEUTRAL_KEYS: [&str; 6] = ["verbose", "threads", "user_threads", "set_affinity", "start_threads", "hugepages"];
+
+/// Embree instruction-set names below AVX2 (refused: strata needs AVX2, and Embree's SSE kernels
+/// crashed in `rtcOccluded8` with the high-quality BVH).
+const BELOW_AVX2: [&str; 9] = ["sse", "sse2", "sse3", "ssse3", "sse4.1", "sse41", "sse4.2", "sse42", "avx"];
+
+/// The Embree configuration string of a device and the instruction set it selects.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EmbreeConfig {
+    /// `avx2` or `avx512`: what Embree runs
+    pub isa: &'static str,
+    /// the string given to `rtcNewDevice`
+    pub config: String,
+}
+
+impl EmbreeConfig {
+    /// [`EmbreeConfig::parse`] of `$STRATA_EMBREE_CONFIG` (unset: the defaults) on this CPU.
+    pub fn from_env() -> Result<Self, AccelError> {
+        let raw = std::env::var(CONFIG_VAR).ok();
+        Self::parse(raw.as_deref().unwrap_or(""), cpu_has_avx512())
+    }
+
+    /// Parses `key=value` items (separated by commas or spaces) of an Embree configuration:
+    /// `isa` or `max_isa` (`avx2`, `avx512`; lower instruction sets are refused) and the keys that
+    /// do not change hits (`verbose`, `threads`, ...); an unknown key is refused. The instruction
+    /// set is `avx2` unless `isa=avx512` (refused on a CPU without AVX-512, `avx512` saying whether
+    /// it has it) or `max_isa=avx512` on a CPU with it.
+    pub fn parse(raw: &str, avx512: bool) -> Result<Self, AccelError> {
+        let bad = |m: String| AccelError(format!("{CONFIG_VAR}={raw:?}: {m}"));
+        let mut isa = DEFAULT_ISA;
+        let mut isa_key: Option<&str> = None;
+        let mut rest = Vec::new();
+        let mut verbose = false;
+        for item in raw.split([',', ' ', '\t']).filter(|s| !s.is_empty()) {
+            let (key, value) = item.split_once('=').ok_or_else(|| bad(format!("`{item}`: expected key=value")))?;
+            let (key, value) = (key.trim(), value.trim());
+            match key {
+                "isa" | "max_isa" => {
+                    if let Some(k) = isa_key {
+                        return Err(bad(format!("`{key}` after `{k}`: give the instruction set once")));
+                    }
+                    isa_key = Some(key);
+                    let v = value.to_ascii_lowercase();
+                    isa = match v.as_str() {
+                        "avx2" => "avx2",
+                        "avx512" | "avx512skx" => match (avx512, key) {
+                            (true, _) => "avx512",
+                            (false, "max_isa") => "avx2",
+                            _ => return Err(bad("this CPU has no AVX-512 (AVX512F/CD/DQ/BW/VL)".into())),
+                        },
+                        v if BELOW_AVX2.contains(&v) => {
+                            return Err(bad(format!(
+                                "{key}={value} is below AVX2, which strata needs (x86-64-v3); use avx2 or avx512"
+                            )))
+                        }
+                        _ => return Err(bad(format!("unknown instruction set `{value}` (avx2, avx512)"))),
+                    };
+                }
+                k if NEUTRAL_KEYS.contains(&k) => {
+                    verbose |= k == "verbose";
+                    rest.push(format!("{key}={value}"));
+                }
+                _ => {
+                    return Err(bad(format!(
+                        "unknown key `{key}` (known: isa, max_isa, {}); keys that change the hits are not accepted",
+                        NEUTRAL_KEYS.join(", ")
+                    )))
+                }
+            }
+        }
+        let mut config = vec![format!("isa={isa}")];
+        if !verbose {
+            config.push("verbose=0".into());
+        }
+        config.extend(rest);
+        Ok(Self { isa, config: config.join(",") })
+    }
+}
+
+/// Whether this CPU has the AVX-512 subset Embree's `avx512` kernels use (SKX: F, CD, DQ, BW, VL).
+pub fn cpu_has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512cd")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(test)]
+mod config_tests {
+    use super::EmbreeConfig;
+
+    #[test]
+    fn the_instruction_set_is_pinned_to_avx2_unless_avx512_is_asked_for() {
+        let c = EmbreeConfig::parse("", true).unwrap();
+        assert_eq!((c.isa, c.config.as_str()), ("avx2", "isa=avx2,verbose=0"));
+        assert_eq!(EmbreeConfig::parse("isa=avx512", true).unwrap().isa, "avx512");
+        assert_eq!(EmbreeConfig::parse("max_isa=avx512", true).unwrap().isa, "avx512");
+        assert_eq!(EmbreeConfig::parse("max_isa=avx512", false).unwrap().isa, "avx2");
+        let c = EmbreeConfig::parse("threads=2, verbose=1", true).unwrap();
+        assert_eq!(c.config, "isa=avx2,threads=2,verbose=1");
+    }
+
+    #[test]
+    fn low_instruction_sets_unknown_keys_and_missing_avx512_are_refused() {
+        for (raw, says) in [
+            ("isa=sse2", "below AVX2"),
+            ("isa=sse4.2", "below AVX2"),
+            ("max_isa=avx", "below AVX2"),
+            ("isa=neon", "unknown instruction set"),
+            ("tri_accel=bvh4.triangle4v", "unknown key `tri_accel`"),
+            ("isa", "expected key=value"),
+            ("isa=avx2,max_isa=avx512", "give the instruction set once"),
+        ] {
+            let e = EmbreeConfig::parse(raw, true).unwrap_err().to_string();
+            assert!(e.contains("STRATA_EMBREE_CONFIG") && e.contains(says), "{raw}: {e}");
+        }
+        let e = EmbreeConfig::parse("isa=avx512", false).unwrap_err().to_string();
+        assert!(e.contains("no AVX-512"), "{e}");
     }
 }

@@ -38,7 +38,7 @@ mod sphere_points_tests;
 mod tests;
 mod user_geometry;
 
-pub use device::{AccelError, Device};
+pub use device::{cpu_has_avx512, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
 pub use ftz::{set_ftz_daz, timestamp};
 pub use scene::{Hits8, Scene, SceneBuilder};

@@ -149,6 +149,8 @@ mod tests {
         .collect();
         Header {
             strata_version: "0.1.0".into(),
+            strata_build: "b1".into(),
+            strata_commit: "c1".into(),
             scene: "a.test".into(),
             scene_hash: hash_bytes(b"size 8 8\n"),
             options,
@@ -214,6 +216,12 @@ mod tests {
         let mut b = a.clone();
         b.strata_version = "9.9.9".into();
         assert!(a.mismatch(&b, "this render").unwrap().contains("9.9.9"));
+        // Another build is refused unless allowed, naming both builds.
+        let mut b = a.clone();
+        b.strata_build = "b2".into();
+        let m = a.mismatch(&b, "this render").unwrap();
+        assert!(m.contains("build b1") && m.contains("build b2") && m.contains("--allow-other-build"), "{m}");
+        assert_eq!(a.mismatch_allowing(&b, "this render", true), None);
         // Timing, ranges and parts are not identity.
         let mut b = a.clone();
         (b.cpu_seconds, b.target, b.parts) = (9.0, [0, 8], vec!["p".into()]);

@@ -13,6 +13,13 @@ use std::collections::BTreeMap;
 pub struct Header {
     /// strata version that wrote it (part of the identity: sample values may change across versions)
     pub strata_version: String,
+    /// the build that wrote it ([`BUILD`]: a hash of the sources, manifest, lock file and target
+    /// features; part of the identity unless `--allow-other-build`; empty in older checkpoints)
+    #[serde(default)]
+    pub strata_build: String,
+    /// the git commit of that build (informative)
+    #[serde(default)]
+    pub strata_commit: String,
     /// scene file as named on the command line (informative)
     pub scene: String,
     /// hash of the scene file's bytes ([`hash_bytes`], hex)
@@ -44,6 +51,26 @@ impl Header {
     /// (other scene, version, size or options), or None if it can; `label` names `want` in the
     /// message (e.g. "this render").
     pub fn mismatch(&self, want: &Header, label: &str) -> Option<String> {
+        self.mismatch_allowing(want, label, false)
+    }
+
+    /// [`Header::mismatch`], except that with `other_build` a different build (see
+    /// [`Header::strata_build`]) is accepted: the user vouches that both compute the same samples.
+    pub fn mismatch_allowing(&self, want: &Header, label: &str, other_build: bool) -> Option<String> {
+        if self.strata_build != want.strata_build && !other_build {
+            let show = |b: &str, c: &str| {
+                if b.is_empty() {
+                    "an older strata".to_string()
+                } else {
+                    format!("build {b} (commit {c})")
+                }
+            };
+            return Some(format!(
+                "it was written by {} ({label}: {}); samples may differ between builds (give --allow-other-build if you know they do not)",
+                show(&self.strata_build, &self.strata_commit),
+                show(&want.strata_build, &want.strata_commit)
+            ));
+        }
         if self.scene_hash != want.scene_hash {
             return Some(format!(
                 "it is of another scene ({} hash {}; {label}: {} hash {})",
@@ -72,6 +99,23 @@ impl Header {
     }
 }
 
+/// The build of this binary (`STRATA_BUILD` from build.rs: a hash of what was compiled into it).
+pub const BUILD: &str = env!("STRATA_BUILD");
+/// The git commit this binary was built from (`-dirty` with uncommitted source changes).
+pub const COMMIT: &str = env!("STRATA_COMMIT");
+
+/// The identity keys of the intersection backend ([`crate::scene::build::Backend`]): Embree's
+/// instruction set and version, the BVH quality and the sphere intersector.
+fn backend_options(scene: &Scene) -> [(&'static str, serde_json::Value); 4] {
+    let b = &scene.backend;
+    [
+        ("embree_isa", json!(b.isa)),
+        ("embree_version", json!(b.embree)),
+        ("bvh", json!(b.bvh)),
+        ("spheres", json!(b.spheres)),
+    ]
+}
+
 /// The identity of a render of `scene` with `it` (scene file hash `file_hash`, `time_budget`: the
 /// spp is not fixed in advance) with empty ranges and totals.
 pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bool) -> Header {
@@ -92,10 +136,13 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("light_selection", json!(it.light_selection.name())),
     ]
     .into_iter()
+    .chain(backend_options(scene))
     .map(|(k, v)| (k.to_string(), v))
     .collect();
     Header {
         strata_version: env!("CARGO_PKG_VERSION").to_string(),
+        strata_build: BUILD.to_string(),
+        strata_commit: COMMIT.to_string(),
         scene: d.source.display().to_string(),
         // The file's bytes and the parsed content (which covers included OBJ and MTL files).
         scene_hash: format!("{file_hash}-{:016x}", d.content_hash()),
@@ -119,6 +166,10 @@ pub fn header_metadata(h: &Header) -> Metadata {
         |k: &str| h.options.get(k).map_or(String::new(), |v| v.as_str().map_or_else(|| v.to_string(), str::to_string));
     let mut m: Metadata = vec![
         ("strata.version".into(), h.strata_version.clone()),
+        ("strata.build".into(), h.strata_build.clone()),
+        ("strata.commit".into(), h.strata_commit.clone()),
+        ("strata.embree_isa".into(), opt("embree_isa")),
+        ("strata.embree_version".into(), opt("embree_version")),
         ("strata.scene".into(), h.scene.clone()),
         ("strata.scene_hash".into(), h.scene_hash.clone()),
         ("strata.integrator".into(), opt("integrator")),

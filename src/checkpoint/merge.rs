@@ -18,11 +18,14 @@ pub struct MergeOutput {
 /// `strata merge PARTS... -o OUT`: checks that the parts (checkpoint files of finished `--samples`
 /// shards) belong to one render (scene hash, version, size, options) and cover its sample range
 /// without overlap or gap, merges their dyadic blocks (bit-identical to one render of the whole
-/// range) and writes OUT.exr (metadata: total spp, CPU seconds, the parts) and OUT.png.
-pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, CheckpointError> {
+/// range) and writes OUT.exr (metadata: total spp, CPU seconds, the parts) and OUT.png. Parts
+/// written by another build of strata are refused unless `allow_other_build` (the merged
+/// `strata.build` then lists every build).
+pub fn run_merge(parts: &[PathBuf], out: &Path, allow_other_build: bool) -> Result<MergeOutput, CheckpointError> {
     if parts.is_empty() {
         return Err(CheckpointError::NoParts);
     }
+    film::check_stem(out).map_err(|source| CheckpointError::Output { path: out.to_path_buf(), source })?;
     let mut loaded: Vec<(PathBuf, Header, Film)> = Vec::new();
     for p in parts {
         let (h, f) = format::read(p)?;
@@ -30,7 +33,7 @@ pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, Checkpoin
             return Err(CheckpointError::Unfinished { path: p.clone(), samples: h.samples, target: h.target });
         }
         if let Some((p0, h0, _)) = loaded.first() {
-            if let Some(why) = h.mismatch(h0, &p0.display().to_string()) {
+            if let Some(why) = h.mismatch_allowing(h0, &p0.display().to_string(), allow_other_build) {
                 return Err(CheckpointError::Foreign { path: p.clone(), first: p0.clone(), why });
             }
         }
@@ -74,6 +77,9 @@ pub fn run_merge(parts: &[PathBuf], out: &Path) -> Result<MergeOutput, Checkpoin
         header.cpu_seconds += ph.cpu_seconds;
         header.render_seconds += ph.render_seconds;
         header.rays += ph.rays;
+        if !header.strata_build.split(" + ").any(|b| b == ph.strata_build) {
+            header.strata_build = format!("{} + {}", header.strata_build, ph.strata_build);
+        }
         if ph.parts.is_empty() {
             header.parts.push(name(p, ph));
         } else {

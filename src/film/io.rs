@@ -213,26 +213,74 @@ pub fn encode_png_quantized(
     Ok(bytes)
 }
 
-/// Writes `bytes` to `path` atomically: to `<path>.tmp-<pid>` (created or truncated), fsync, rename
-/// over `path`, then fsync the directory (best effort). On failure the temporary file is removed and
-/// an existing file at `path` is left untouched. Two threads of one process must not write the same
-/// `path` at the same time (they would share the temporary name).
+/// Writes `bytes` to `path` atomically: to a temporary file created exclusively (`O_EXCL`, an
+/// unpredictable name, `tempfile`) in `path`'s directory, fsync, rename over `path`, then fsync the
+/// directory (best effort). `path` must be a regular file or a new name ([`check_target`]): a
+/// symbolic link, directory or device is refused, never replaced. On failure the temporary file is
+/// removed and an existing file at `path` is left untouched. A link planted at any temporary name
+/// is never followed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(format!(".tmp-{}", std::process::id()));
-    let tmp = PathBuf::from(tmp);
-    let mut file = File::create(&tmp)?;
-    let result = file.write_all(bytes).and_then(|()| file.sync_all()).and_then(|()| {
-        drop(file);
-        fs::rename(&tmp, path)
-    });
-    if let Err(e) = result {
-        let _ = fs::remove_file(&tmp);
-        return Err(e);
-    }
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    if let Ok(d) = File::open(dir) {
+    check_target(path)?;
+    let dir = dir_of(path);
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut tmp = tempfile::Builder::new().prefix(&format!(".{name}.")).suffix(".tmp").tempfile_in(&dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    if let Ok(d) = File::open(&dir) {
         let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// The directory `path` is written in ("." for a bare name).
+pub fn dir_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Refuses an output path that is neither a regular file nor a new name, saying what it is: a
+/// symbolic link (even to a regular file: the link would be replaced, or its target clobbered), a
+/// directory, a device, a FIFO or a socket (replacing `/dev/null` would break the system).
+pub fn check_target(path: &Path) -> io::Result<()> {
+    let meta = match fs::symlink_metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e),
+    };
+    let t = meta.file_type();
+    if t.is_file() {
+        return Ok(());
+    }
+    let what = if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_dir() {
+        "a directory"
+    } else {
+        "a device, FIFO or socket"
+    };
+    Err(io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!("is {what}; strata writes only regular files or new names (it replaces the file)"),
+    ))
+}
+
+/// Refuses an output stem (`-o OUT`, which names OUT.exr and OUT.png) that names a directory:
+/// ending in `/`, `.` or `..`, or an existing directory.
+pub fn check_stem(out: &Path) -> io::Result<()> {
+    let s = out.as_os_str().to_string_lossy();
+    let names_dir = s.is_empty()
+        || s.ends_with('/')
+        || out.file_name().is_none()
+        || s.ends_with("/.")
+        || fs::metadata(out).is_ok_and(|m| m.is_dir());
+    if names_dir {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "-o names a directory; give a file stem (-o DIR/NAME writes DIR/NAME.exr and DIR/NAME.png)",
+        ));
     }
     Ok(())
 }

@@ -2,8 +2,9 @@
 //! text metadata, an 8-bit gamma PNG preview, and the atomic file writer they share.
 //!
 //! Pixels are row-major, top row first, index `y * width + x`. Every writer goes through
-//! [`write_atomic`]: the bytes are built in memory, written to `<path>.tmp-<pid>`, fsynced and renamed
-//! over `path`, so a reader never sees a partial file and a failed write leaves the old file intact.
+//! [`write_atomic`]: the bytes are built in memory, written to a temporary file created exclusively
+//! with an unpredictable name beside `path`, fsynced and renamed over `path`, so a reader never sees
+//! a partial file, a failed write leaves the old file intact, and a planted link is never followed.
 //!
 //! ## Order-independent accumulation (dyadic blocks)
 //! f64 addition is not associative, so "sum of shard totals" differs in the last bits from one
@@ -20,8 +21,8 @@
 
 mod io;
 pub use io::{
-    encode_png_quantized, read_exr, stem_of, to_u8, to_u8_quantized, with_ext, write_atomic, write_exr, write_png,
-    write_png_quantized, ExrImage, Metadata, Quantize,
+    check_stem, check_target, dir_of, encode_png_quantized, read_exr, stem_of, to_u8, to_u8_quantized, with_ext,
+    write_atomic, write_exr, write_png, write_png_quantized, ExrImage, Metadata, Quantize,
 };
 
 use std::ops::Range;

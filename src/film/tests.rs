@@ -2,6 +2,7 @@
 use super::*;
 use std::fs::{self, File};
 use std::io;
+use std::os::unix::fs::FileTypeExt;
 use std::path::{Path, PathBuf};
 
 /// A fresh, empty scratch directory for one test.
@@ -227,17 +228,37 @@ fn atomic_write_failures_leave_nothing_and_keep_the_old_file() {
     // Parent is a regular file: error.
     fs::write(d.join("file"), b"f").unwrap();
     assert!(write_atomic(&d.join("file").join("x.bin"), b"data").is_err());
-    // The temporary name is occupied by a directory: error, the existing target survives.
+    // A link planted at the old predictable temporary name (`<path>.tmp-<pid>`) is never followed:
+    // the temporary file is created exclusively under an unpredictable name.
     let target = d.join("keep.exr");
     fs::write(&target, b"old").unwrap();
-    fs::create_dir(tmp_of(&target)).unwrap();
-    assert!(write_exr(&target, 1, 1, &[[1.0; 3]], None, &Vec::new()).is_err());
-    assert!(write_png(&target, 1, 1, &[[1.0; 3]], 2.2).is_err());
-    assert_eq!(fs::read(&target).unwrap(), b"old");
-    fs::remove_dir(tmp_of(&target)).unwrap();
-    // Success replaces the old file and leaves no temporary behind.
+    let victim = d.join("victim.txt");
+    fs::write(&victim, b"victim").unwrap();
+    std::os::unix::fs::symlink(&victim, tmp_of(&target)).unwrap();
     write_atomic(&target, b"new").unwrap();
+    assert_eq!(fs::read(&victim).unwrap(), b"victim", "the link's target is untouched");
+    assert!(fs::symlink_metadata(&target).unwrap().file_type().is_file(), "the output is a regular file");
     assert_eq!(fs::read(&target).unwrap(), b"new");
-    assert_eq!(fs::read_dir(&d).unwrap().count(), 2, "only `file` and `keep.exr`");
+    fs::remove_file(tmp_of(&target)).unwrap();
+    // A target that is a link, a directory or a device is refused, saying what it is, and stays.
+    let link = d.join("link.exr");
+    std::os::unix::fs::symlink(&victim, &link).unwrap();
+    fs::create_dir(d.join("dir.exr")).unwrap();
+    for (path, what) in
+        [(link.clone(), "a symbolic link"), (d.join("dir.exr"), "a directory"), ("/dev/null".into(), "a device")]
+    {
+        let e = write_atomic(&path, b"x").unwrap_err().to_string();
+        assert!(e.contains(what) && e.contains("regular files or new names"), "{}: {e}", path.display());
+        assert!(write_png(&path, 1, 1, &[[1.0; 3]], 2.2).is_err());
+    }
+    assert!(fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert_eq!(fs::read(&victim).unwrap(), b"victim");
+    assert!(fs::symlink_metadata("/dev/null").unwrap().file_type().is_char_device());
+    fs::remove_file(&link).unwrap();
+    fs::remove_dir(d.join("dir.exr")).unwrap();
+    // Success replaces the old file and leaves no temporary behind.
+    write_atomic(&target, b"newer").unwrap();
+    assert_eq!(fs::read(&target).unwrap(), b"newer");
+    assert_eq!(fs::read_dir(&d).unwrap().count(), 3, "only `file`, `keep.exr` and `victim.txt`");
     fs::remove_dir_all(&d).unwrap();
 }

@@ -101,6 +101,11 @@ pub struct Scene {
     /// zero-area triangles (scene and emissive) dropped at build: they can be neither hit nor
     /// sampled, and an exact ray through one would get no usable normal
     pub degenerate_dropped: usize,
+    /// of [`Scene::degenerate_dropped`], the triangles dropped because their area overflows f32
+    /// (finite corners, edges of about 1e19 or more), not because it is zero
+    pub overflow_dropped: usize,
+    /// what the intersection backend was set to (part of a render's identity)
+    pub backend: Backend,
     /// per triangle: light index or u32::MAX
     pub tri_light: Vec<u32>,
     /// per sphere/ellipsoid of the desc: material index
@@ -131,9 +136,29 @@ pub enum BuildError {
     NoCamera(std::path::PathBuf),
 }
 
+/// The intersection backend's settings that can change which hits a ray gets: each one is in a
+/// render's identity, so that checkpoints and shards made under different settings never mix.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Backend {
+    /// Embree's instruction set (`avx2` unless `STRATA_EMBREE_CONFIG` asks for `avx512`)
+    pub isa: &'static str,
+    /// the Embree library's version
+    pub embree: String,
+    /// `high` or `medium` quality BVH (by triangle count, or `STRATA_BVH`)
+    pub bvh: &'static str,
+    /// `strata` (the user geometry) or `embree` (`STRATA_SPHERES=embree`: Embree's sphere points)
+    pub spheres: &'static str,
+}
+
 /// A triangle without a unit normal: zero area (collinear or repeated corners) or non-finite.
 fn is_degenerate(v: &[Vec3; 3]) -> bool {
     (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero() == Vec3::ZERO
+}
+
+/// A degenerate triangle with finite corners whose edge cross product is not finite: its area
+/// overflows f32 (it is huge, not zero).
+fn area_overflows(v: &[Vec3; 3]) -> bool {
+    v.iter().all(|p| p.is_finite()) && !(v[1] - v[0]).cross(v[2] - v[0]).is_finite()
 }
 
 impl Scene {
@@ -150,10 +175,11 @@ impl Scene {
         let mut tri_material = Vec::with_capacity(indices.capacity());
         let mut tri_light = Vec::with_capacity(indices.capacity());
         let mut tri_corner_normals = Vec::new();
-        let mut degenerate_dropped = 0;
+        let (mut degenerate_dropped, mut overflow_dropped) = (0, 0);
         for (k, t) in desc.triangles.iter().enumerate() {
             if is_degenerate(&t.v) {
                 degenerate_dropped += 1;
+                overflow_dropped += usize::from(area_overflows(&t.v));
                 continue;
             }
             if !desc.triangle_normals.is_empty() {
@@ -185,6 +211,7 @@ impl Scene {
             let e = Emitter::triangle(t.v, t.radiance);
             if !(e.area > 0.0 && e.area.is_finite()) || is_degenerate(&t.v) {
                 degenerate_dropped += 1;
+                overflow_dropped += usize::from(area_overflows(&t.v) || e.area == f32::INFINITY);
                 continue;
             }
             let base = vertices.len() as u32;
@@ -264,6 +291,12 @@ impl Scene {
         b.add_spheres(&points)?;
         b.add_ellipsoids(&ell_user)?;
         let accel = b.commit()?;
+        let backend = Backend {
+            isa: device.isa(),
+            embree: device.version(),
+            bvh: if high { "high" } else { "medium" },
+            spheres: if embree_spheres { "embree" } else { "strata" },
+        };
         Ok(Self {
             desc,
             camera,
@@ -274,6 +307,8 @@ impl Scene {
             tri_normal,
             tri_corner_normals,
             degenerate_dropped,
+            overflow_dropped,
+            backend,
             tri_light,
             ell_material,
             sphere_point_index,
@@ -302,7 +337,7 @@ impl Scene {
 /// it changes nothing measurable (identical instruction counts), so small scenes keep Embree's
 /// medium build, and their images (one golden case, the OBJ Cornell box, would change bits).
 /// `STRATA_BVH=high` / `STRATA_BVH=medium` force either (for measurements).
-const HIGH_QUALITY_MIN_TRIANGLES: usize = 10_000;
+pub const HIGH_QUALITY_MIN_TRIANGLES: usize = 10_000;
 
 /// Centre and radius if the affine map `m` takes the unit sphere to a sphere (its linear part is
 /// a rotation times a uniform scale, to 1e-5 relative).

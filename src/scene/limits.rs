@@ -21,6 +21,34 @@ pub struct Limits {
     pub max_transform_depth: usize,
     /// Maximum `--threads` (default 4x the cores).
     pub max_threads: usize,
+    /// Maximum bytes a render may use by its estimate (film, outputs, threads, scene, BVH;
+    /// default [`default_max_memory`]: 80% of physical memory or of the cgroup's limit).
+    pub max_memory: u64,
+    /// Maximum size of a scene, OBJ or MTL file in bytes (default 4 GiB).
+    pub max_file_bytes: u64,
+}
+
+/// 80% of the memory this process may use: physical memory (`MemTotal` of /proc/meminfo), or the
+/// cgroup's limit (v2 `memory.max`, v1 `memory.limit_in_bytes`, as Slurm sets) when lower.
+/// 64 GiB when neither can be read.
+pub fn default_max_memory() -> u64 {
+    static CACHE: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    *CACHE.get_or_init(|| {
+        let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+            let line = t.lines().find(|l| l.starts_with("MemTotal:"))?;
+            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kib * 1024)
+        });
+        let cgroup = ["/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"]
+            .iter()
+            .filter_map(|f| std::fs::read_to_string(f).ok()?.trim().parse::<u64>().ok())
+            .min();
+        let total = match (meminfo, cgroup) {
+            (Some(m), Some(c)) => m.min(c),
+            (m, c) => m.or(c).unwrap_or(64 << 30),
+        };
+        total / 5 * 4
+    })
 }
 
 impl Default for Limits {
@@ -35,6 +63,8 @@ impl Default for Limits {
             max_light_samples: 1 << 20,
             max_transform_depth: 4096,
             max_threads: 4 * std::thread::available_parallelism().map_or(1, |n| n.get()),
+            max_memory: default_max_memory(),
+            max_file_bytes: 4 << 30,
         }
     }
 }
@@ -70,7 +100,7 @@ pub enum LimitError {
 
 impl Limits {
     /// Names of the limits, as `--limit NAME=VALUE` spells them (the field names).
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 11] = [
         "max_pixels",
         "max_side",
         "max_vertices",
@@ -80,6 +110,8 @@ impl Limits {
         "max_light_samples",
         "max_transform_depth",
         "max_threads",
+        "max_memory",
+        "max_file_bytes",
     ];
 
     /// Sets one limit from `NAME=VALUE` (the `--limit` flag); VALUE is a non-negative integer that
@@ -106,6 +138,8 @@ impl Limits {
             "max_light_samples" => self.max_light_samples = range(u32::MAX.into())? as u32,
             "max_transform_depth" => self.max_transform_depth = range(usize::MAX as u64)? as usize,
             "max_threads" => self.max_threads = range(usize::MAX as u64)? as usize,
+            "max_memory" => self.max_memory = v,
+            "max_file_bytes" => self.max_file_bytes = v,
             _ => return Err(LimitError::Unknown(name.to_string())),
         }
         Ok(())
@@ -115,4 +149,45 @@ impl Limits {
 /// How to raise a limit: the `--limit` flag with the field's name (`Limits::set`).
 pub fn limit_hint(field: &str) -> String {
     format!("raise it with --limit {field}=N")
+}
+
+/// What [`read_bounded`] found wrong: a 1-based line (0: the file as a whole) and a message.
+pub type ReadError = (usize, String);
+
+/// The message of a text file holding a NUL byte (shared with the OBJ reader's decoding).
+pub const NUL_BYTE: &str = "the file is not valid UTF-8 text (a NUL byte: UTF-16 or binary?)";
+
+/// Reads `path` (`what` names its kind in messages) in chunks, refusing it as soon as it has more
+/// than `max` bytes (`--limit max_file_bytes`) or a NUL byte (no scene, OBJ or MTL text has one;
+/// a file starting with a UTF-16 byte-order mark is left to the decoder to name), so that
+/// `/dev/zero`, a binary file or an endless pipe fails at once instead of filling memory.
+pub fn read_bounded(path: &std::path::Path, what: &str, max: u64) -> Result<Vec<u8>, ReadError> {
+    use std::io::Read;
+    let io = |e: std::io::Error| (0, format!("cannot read {what}: {e}"));
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    let mut chunk = vec![0u8; 1 << 20];
+    let mut lines_before = 0;
+    loop {
+        let n = match file.read(&mut chunk) {
+            Ok(0) => return Ok(bytes),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(io(e)),
+        };
+        let new = &chunk[..n];
+        let utf16 = bytes.get(..2).or(new.get(..2)).is_some_and(|b| b == b"\xff\xfe" || b == b"\xfe\xff");
+        if let Some(i) = new.iter().position(|&b| b == 0).filter(|_| !utf16) {
+            let line = lines_before + new[..i].iter().filter(|&&b| b == b'\n').count() + 1;
+            return Err((line, NUL_BYTE.to_string()));
+        }
+        if (bytes.len() + n) as u64 > max {
+            return Err((
+                0,
+                format!("{what} is larger than the limit of {max} bytes ({})", limit_hint("max_file_bytes")),
+            ));
+        }
+        lines_before += new.iter().filter(|&&b| b == b'\n').count();
+        bytes.extend_from_slice(new);
+    }
 }

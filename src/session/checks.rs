@@ -1,8 +1,9 @@
-//! Command-line checks made before any expensive work (thread cap, writable output directories,
-//! sampler periods) and the default light of an OBJ scene without emitters.
+//! Command-line checks made before any expensive work (thread cap, outputs: writable directories,
+//! regular files or new names, no two the same file nor an input; sampler periods) and the
+//! default light of an OBJ scene without emitters.
 
 use super::{RenderOptions, SessionError};
-use crate::film::stem_of;
+use crate::film::{self, stem_of, with_ext};
 use crate::sampler::SamplerKind;
 use crate::scene::desc::{QuadLightDesc, SceneDesc};
 use crate::scene::parse;
@@ -10,8 +11,8 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 /// Checks what the command line alone decides, before the scene is read: `--threads` within
-/// `max_threads`, and every directory the render will write to (image, checkpoint, stats, profile)
-/// writable (a probe file is created and removed), so that a bad path fails before any sample.
+/// `max_threads`, `-o` not a directory, and the outputs ([`check_outputs`] with the `-o` stem, or
+/// "strata"; [`super::prepare`] checks them again with the scene's `output` name).
 pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
     let max = opts.limits.max_threads;
     if opts.threads > max {
@@ -23,27 +24,87 @@ pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
             hint: parse::limit_hint("max_threads"),
         });
     }
-    let stem = opts.out.as_ref().map(|o| stem_of(o)).unwrap_or_else(|| PathBuf::from("strata"));
-    let files = [Some(stem), opts.checkpoint.clone(), opts.resume.clone(), opts.stats.clone(), opts.profile.clone()];
-    for f in files.iter().flatten() {
-        check_writable(&dir_of(f))?;
+    // STRATA_EMBREE_CONFIG: refused before the scene is read (the device checks it again).
+    crate::accel::EmbreeConfig::from_env().map_err(|e| SessionError::Build(e.into()))?;
+    match &opts.out {
+        Some(o) => {
+            film::check_stem(o).map_err(|e| SessionError::BadOutput { path: o.clone(), why: e.to_string() })?;
+            check_outputs(opts, &stem_of(o))
+        }
+        // The stem comes from the scene's `output`: checked again once the scene is read.
+        None => check_outputs(opts, Path::new("strata")),
+    }
+}
+
+/// The files a render of `opts` may write with output stem `stem`, each with what names it:
+/// OUT.exr, OUT.png, the checkpoint (`--checkpoint`, else `--resume`, else OUT.ckpt, written with
+/// `--samples` or on an interruption), `--stats` and `--profile`.
+pub fn output_files(opts: &RenderOptions, stem: &Path) -> Vec<(String, PathBuf)> {
+    let (exr, png) = (with_ext(stem, "exr"), with_ext(stem, "png"));
+    let ckpt = opts.checkpoint.clone().or_else(|| opts.resume.clone()).unwrap_or_else(|| with_ext(stem, "ckpt"));
+    let mut out =
+        vec![("the image".to_string(), exr), ("the image".to_string(), png), ("the checkpoint".to_string(), ckpt)];
+    out.extend(opts.stats.iter().map(|p| ("--stats".to_string(), p.clone())));
+    out.extend(opts.profile.iter().map(|p| ("--profile".to_string(), p.clone())));
+    out
+}
+
+/// Checks the outputs of a render with output stem `stem` before any sample: each a regular file
+/// or a new name ([`film::check_target`]) in a writable directory (a probe file is created and
+/// removed), none the same file as another output or as an input (the scene file, `--resume`
+/// unless it is also the checkpoint).
+pub fn check_outputs(opts: &RenderOptions, stem: &Path) -> Result<(), SessionError> {
+    let outputs = output_files(opts, stem);
+    for (_, f) in &outputs {
+        check_writable(&film::dir_of(f))?;
+        film::check_target(f).map_err(|e| SessionError::BadOutput { path: f.clone(), why: e.to_string() })?;
+    }
+    let mut inputs: Vec<(String, PathBuf)> =
+        opts.scene.iter().map(|p| ("the scene file".to_string(), p.clone())).collect();
+    let ckpt = &outputs[2].1;
+    inputs
+        .extend(opts.resume.iter().filter(|r| *r != ckpt).map(|p| ("the --resume checkpoint".to_string(), p.clone())));
+    let keys: Vec<Option<FileKey>> = outputs.iter().chain(&inputs).map(|(_, p)| FileKey::of(p)).collect();
+    for (i, (what, path)) in outputs.iter().enumerate() {
+        for (j, (other, other_path)) in outputs.iter().chain(&inputs).enumerate().skip(i + 1) {
+            if keys[i].is_some() && keys[i] == keys[j] {
+                let label = if what == "the image" { format!("the image {}", path.display()) } else { what.clone() };
+                let why = format!(
+                    "{label} and {other} ({}) are the same file: one would overwrite the other",
+                    other_path.display()
+                );
+                return Err(SessionError::BadOutput { path: path.clone(), why });
+            }
+        }
     }
     Ok(())
 }
 
-/// Checks that the directory `file` would be written in is writable (a probe file), for outputs
-/// the render options do not name (`strata profile --json/--svg`, `compare --profile`), so a bad
-/// path fails before the renders.
-pub fn check_output_file(file: &Path) -> Result<(), SessionError> {
-    check_writable(&dir_of(file))
+/// What makes two paths one file: the device and inode of an existing file, else the resolved
+/// directory and the name.
+#[derive(PartialEq, Eq)]
+enum FileKey {
+    Inode(u64, u64),
+    New(PathBuf),
 }
 
-/// The directory a file is written in ("." for a bare name).
-fn dir_of(f: &Path) -> PathBuf {
-    match f.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
+impl FileKey {
+    fn of(p: &Path) -> Option<Self> {
+        use std::os::unix::fs::MetadataExt;
+        if let Ok(m) = std::fs::metadata(p) {
+            return Some(Self::Inode(m.dev(), m.ino()));
+        }
+        let dir = std::fs::canonicalize(film::dir_of(p)).ok()?;
+        Some(Self::New(dir.join(p.file_name()?)))
     }
+}
+
+/// Checks that the directory `file` would be written in is writable (a probe file) and that
+/// `file` is a regular file or a new name, for outputs the render options do not name (`strata
+/// profile --json/--svg`, `compare --profile`), so a bad path fails before the renders.
+pub fn check_output_file(file: &Path) -> Result<(), SessionError> {
+    check_writable(&film::dir_of(file))?;
+    film::check_target(file).map_err(|e| SessionError::BadOutput { path: file.to_path_buf(), why: e.to_string() })
 }
 
 /// Creates and removes a probe file in `dir` (named by process and a per-process counter, so

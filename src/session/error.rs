@@ -148,6 +148,47 @@ pub enum SessionError {
         /// a sampler without that limit
         alternative: &'static str,
     },
+    /// The render ended without a single sample (time budget spent or interrupted before the
+    /// first pass): nothing is written, the outputs of an earlier run stay as they were.
+    #[error("no sample was rendered ({0}); nothing written, existing outputs left as they were")]
+    NoSamples(String),
+    /// `--spp 0` or `--light-samples 0` (as `spp 0` / `lightsamples 0` in a scene file).
+    #[error("--{flag} 0: expected at least 1 (as in a scene file)")]
+    Zero {
+        /// the flag without dashes
+        flag: &'static str,
+    },
+    /// An output path that cannot be used: a directory, a link or device, or one that collides
+    /// with another output or an input; found before rendering.
+    #[error("{}: {why}; checked before rendering, nothing was traced", path.display())]
+    BadOutput {
+        /// the path
+        path: PathBuf,
+        /// what is wrong with it
+        why: String,
+    },
+    /// The render would need more memory than `--limit max_memory` allows.
+    #[error("{what}: the render needs about {need} ({breakdown}), above the limit of {limit} ({hint})")]
+    Memory {
+        /// what is rendered (scene and size)
+        what: String,
+        /// the estimate, formatted
+        need: String,
+        /// the estimate's parts
+        breakdown: String,
+        /// the limit, formatted
+        limit: String,
+        /// how to raise the limit
+        hint: String,
+    },
+    /// The final checkpoint could not be written after the images were.
+    #[error("{source} (the images {}.exr and {}.png were written; only the checkpoint is missing)", images.display(), images.display())]
+    CheckpointAfterImages {
+        /// the output stem written
+        images: PathBuf,
+        /// the checkpoint error
+        source: Box<SessionError>,
+    },
     /// A signal handler could not be installed.
     #[error("signal handler: {0}")]
     Signal(std::io::Error),

@@ -9,13 +9,16 @@
 //! - [`output`] — output naming, EXR metadata, [`run_render`];
 //! - [`stats`] — the `--stats` JSON and the summary line;
 //! - [`rays`] — `strata rays`;
-//! - [`checks`] — command-line checks before rendering, the default light;
+//! - [`checks`] — command-line checks before rendering (outputs: no directory, link or device,
+//!   no collision), the default light;
+//! - [`memory`] — the render's memory estimate, refused above `--limit max_memory`;
 //! - [`profile`] — `strata profile`;
 //! - [`replay`] — the sampler replay of `strata profile`;
 //! - [`error`] — [`SessionError`].
 
 pub mod checks;
 pub mod error;
+pub mod memory;
 pub mod options;
 pub mod output;
 pub mod pass;

@@ -85,6 +85,8 @@ pub struct RenderOptions {
     pub light_selection: Option<crate::light::select::LightSelection>,
     /// `--no-default-light`: an OBJ scene without emitters stays unlit (default: a light is added)
     pub no_default_light: bool,
+    /// `--allow-other-build`: resume a checkpoint written by another build of strata
+    pub allow_other_build: bool,
     /// set while the pass loop runs (a signal then stops after the pass and checkpoints; outside
     /// it the binary exits at once with code 130)
     pub rendering: Option<Arc<AtomicBool>>,

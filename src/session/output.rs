@@ -1,8 +1,9 @@
 //! The outputs of `strata render`: the output stem, EXR metadata, OUT.exr (with a variance layer),
 //! OUT.png and the `--stats` file.
 
+use super::pass::{render_passes, write_checkpoint};
 use super::stats::stats_json;
-use super::{render_to_film, RenderOptions, RenderOutput, SessionError};
+use super::{RenderOptions, RenderOutput, SessionError};
 use crate::checkpoint::header_metadata;
 use crate::film::{self, stem_of, with_ext, Metadata};
 use crate::scene::desc::SceneDesc;
@@ -28,10 +29,20 @@ pub fn metadata(out: &RenderOutput) -> Metadata {
     m
 }
 
-/// `strata render`: render, write OUT.exr (with a variance layer) and OUT.png, the stats JSON and,
-/// with `--profile`, the profile JSON (the phases of the render and of the image encoding).
+/// `strata render`: render, write OUT.exr (with a variance layer) and OUT.png, the stats JSON,
+/// with `--profile` the profile JSON (the phases of the render and of the image encoding), then the
+/// checkpoint (last: one that cannot be written is an error, the images stay). Non-finite samples
+/// (counted as zero) are reported on stderr.
 pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
-    let mut out = render_to_film(opts)?;
+    let mut out = render_passes(opts)?;
+    let nonfinite = out.stats.counters.nonfinite;
+    if nonfinite > 0 {
+        eprintln!(
+            "strata: warning: {nonfinite} non-finite sample{} (NaN or infinite radiance) counted as zero: the image is \
+             biased low where they fell (`nonfinite_samples` in --stats); check the scene's emission and material values",
+            if nonfinite == 1 { "" } else { "s" }
+        );
+    }
     let encode_start = std::time::Instant::now();
     let stem = output_stem(opts, &out.scene.desc);
     let (w, h) = (out.film.width, out.film.height);
@@ -65,5 +76,9 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
         let text = serde_json::to_string_pretty(&stats_json(&out))?;
         film::write_atomic(p, text.as_bytes()).map_err(|source| SessionError::Output { path: p.clone(), source })?;
     }
+    write_checkpoint(&out).map_err(|e| SessionError::CheckpointAfterImages {
+        images: out.out.clone().unwrap_or_default(),
+        source: Box::new(e),
+    })?;
     Ok(out)
 }

@@ -33,7 +33,8 @@ pub struct RenderOutput {
     pub out: Option<PathBuf>,
     /// identity and totals over every session of this render (as in its checkpoint)
     pub header: Header,
-    /// the checkpoint written last, if any
+    /// the checkpoint of this render (written last by [`render_to_film`]; by `run_render` after
+    /// the images), if any
     pub checkpoint: Option<PathBuf>,
     /// stopped by the `stop` flag (a signal) before the sample range was done
     pub interrupted: bool,
@@ -41,8 +42,27 @@ pub struct RenderOutput {
 
 /// Renders without writing images: scene build, integrator set-up, the sample range in passes
 /// (resuming `opts.resume`, writing `opts.checkpoint` periodically and at the end, stopping
-/// early on `opts.stop` or when `opts.time_budget` is spent).
+/// early on `opts.stop` or when `opts.time_budget` is spent). A render that ends with no sample
+/// is an error ([`SessionError::NoSamples`]) and writes nothing.
 pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
+    let out = render_passes(opts)?;
+    write_checkpoint(&out)?;
+    Ok(out)
+}
+
+/// Writes the final checkpoint of `out` (its [`RenderOutput::checkpoint`], if any).
+pub(super) fn write_checkpoint(out: &RenderOutput) -> Result<(), SessionError> {
+    if let Some(p) = &out.checkpoint {
+        checkpoint::write(p, &out.header, &out.film)?;
+    }
+    Ok(())
+}
+
+/// [`render_to_film`] without the final checkpoint (the caller writes the images first, then it:
+/// a checkpoint that cannot be written never costs the finished images). Periodic checkpoints
+/// are written here; one that fails is reported and tried again a period later, the previous
+/// one staying in place.
+pub(super) fn render_passes(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
     let (scene, mut integrator) = prepare(opts)?;
     if let Some(b) = opts.time_budget {
         if !(b > 0.0 && b.is_finite()) {
@@ -68,7 +88,7 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
     let mut film = Film::new(scene.desc.width, scene.desc.height);
     if let Some(path) = &opts.resume {
         let (h, f) = checkpoint::read(path)?;
-        if let Some(why) = h.mismatch(&header, "this render") {
+        if let Some(why) = h.mismatch_allowing(&header, "this render", opts.allow_other_build) {
             return Err(SessionError::ResumeMismatch { path: path.clone(), why });
         }
         let have = f.samples();
@@ -129,22 +149,30 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
         pass = if want >= render::SAMPLE_BATCH { want / render::SAMPLE_BATCH * render::SAMPLE_BATCH } else { want };
         if let Some(p) = &ckpt_path {
             if s < target.end && last_ckpt.elapsed().as_secs_f64() >= every {
-                checkpoint::write(p, &header, &film)?;
+                if let Err(e) = checkpoint::write(p, &header, &film) {
+                    progress.warn(&format!(
+                        "strata: warning: {e}; the previous checkpoint stays, trying again in {every} s (rendering goes on)"
+                    ));
+                }
                 last_ckpt = Instant::now();
             }
         }
     }
     drop(profiling);
     progress.finish();
+    if film.samples().is_empty() {
+        return Err(SessionError::NoSamples(match opts.time_budget {
+            _ if interrupted => "interrupted before the first pass".to_string(),
+            Some(b) => format!("--time-budget {b} s was spent before the first pass"),
+            None => "no pass ran".to_string(),
+        }));
+    }
     let stem = output_stem(opts, &scene.desc);
     let final_ckpt = match ckpt_path {
         Some(p) => Some(p),
         None if interrupted || opts.samples.is_some() => Some(with_ext(&stem, "ckpt")),
         None => None,
     };
-    if let Some(p) = &final_ckpt {
-        checkpoint::write(p, &header, &film)?;
-    }
     header = checkpoint::header_for(header, &film);
     Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted })
 }

@@ -131,6 +131,14 @@ impl Progress {
         }
     }
 
+    /// Prints a message on stderr above the bar (plainly when there is none).
+    pub fn warn(&self, msg: &str) {
+        match &self.bar {
+            Some(bar) => bar.suspend(|| eprintln!("{msg}")),
+            None => eprintln!("{msg}"),
+        }
+    }
+
     /// Ends the bar (leaving its last state on the terminal).
     pub fn finish(&self) {
         if let Some(bar) = &self.bar {

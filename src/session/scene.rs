@@ -87,7 +87,13 @@ pub fn parse_camera(s: &str) -> Result<CameraDesc, SessionError> {
 /// Parses, checks and builds the scene and the integrator of `opts`.
 pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError> {
     super::checks::check_command_line(opts)?;
+    for (flag, v) in [("spp", opts.spp), ("light-samples", opts.light_samples)] {
+        if v == Some(0) {
+            return Err(SessionError::Zero { flag });
+        }
+    }
     let desc = load_scene(opts)?;
+    super::checks::check_outputs(opts, &super::output_stem(opts, &desc))?;
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {
         return Err(over("spp", spp.to_string(), opts.limits.max_spp.into(), "", "max_spp"));
@@ -102,13 +108,22 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         ));
     }
     super::checks::check_sampler_periods(opts, &desc, spp)?;
+    super::memory::check(opts, &desc, spp)?;
     let scene = Scene::build(desc)?;
-    if scene.degenerate_dropped > 0 {
-        let n = scene.degenerate_dropped;
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    let (zero, huge) = (scene.degenerate_dropped - scene.overflow_dropped, scene.overflow_dropped);
+    if zero > 0 {
         eprintln!(
-            "strata: warning: {}: dropped {n} degenerate (zero-area) triangle{}",
+            "strata: warning: {}: dropped {zero} degenerate (zero-area) triangle{}",
             scene.desc.source.display(),
-            if n == 1 { "" } else { "s" }
+            plural(zero)
+        );
+    }
+    if huge > 0 {
+        eprintln!(
+            "strata: warning: {}: dropped {huge} triangle{} whose area overflows f32 (edges of about 1e19 or more; scale the scene down)",
+            scene.desc.source.display(),
+            plural(huge)
         );
     }
     let samplers = crate::integrator::SamplerChoice {

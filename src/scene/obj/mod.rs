@@ -53,8 +53,8 @@ pub use mtl::locate_mtl_error;
 pub use place::{
     frame_camera, normal_matrix, place, scene_from_obj, scene_from_obj_with_warnings, whole_scene_material,
 };
-pub use procedural::{procedural_mesh, write_obj};
-pub use read::{load, load_with_warnings};
+pub use procedural::{procedural_mesh, procedural_mesh_bytes, write_obj};
+pub use read::{load, load_bounded, load_with_warnings, load_with_warnings_bounded};
 
 use crate::scene::desc::Material;
 use crate::scene::error::SceneError;

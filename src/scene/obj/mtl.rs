@@ -8,8 +8,8 @@ use glam::Vec3;
 use std::path::Path;
 
 /// Loads one MTL library, checking every value strata uses (finite; colours and `Ns` >= 0).
-pub(super) fn load_mtl(path: &Path, warnings: &mut Vec<ObjWarning>) -> Result<Vec<MtlMaterial>, SceneError> {
-    let (text, _) = read_text(path, "material library", warnings)?;
+pub(super) fn load_mtl(path: &Path, max: u64, warnings: &mut Vec<ObjWarning>) -> Result<Vec<MtlMaterial>, SceneError> {
+    let (text, _) = read_text(path, "material library", max, warnings)?;
     if let Some((line, msg)) = locate_mtl_error(&text) {
         return Err(err(path, line, msg));
     }

@@ -1,7 +1,7 @@
 //! OBJ meshes in a scene: a whole-scene OBJ (camera, settings, interned materials) and the
 //! placement of a mesh's faces, emitters and vertex normals into a `SceneDesc`.
 
-use super::read::load_with_warnings;
+use super::read::load_with_warnings_bounded;
 use super::{err, print_warnings, MtlMaterial, ObjMesh, ObjWarning};
 use crate::scene::desc::{CameraDesc, ImportanceSampling, IntegratorKind, Material, Nee, SceneDesc};
 use crate::scene::error::{LineError, SceneError};
@@ -38,7 +38,7 @@ pub fn scene_from_obj(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneEr
 
 /// [`scene_from_obj`], returning the loader's warnings instead of printing them.
 pub fn scene_from_obj_with_warnings(path: &Path, limits: &Limits) -> Result<(SceneDesc, Vec<ObjWarning>), SceneError> {
-    let (mesh, warnings) = load_with_warnings(path)?;
+    let (mesh, warnings) = load_with_warnings_bounded(path, limits.max_file_bytes)?;
     let mut desc = SceneDesc {
         source: path.to_path_buf(),
         spp: 16,

@@ -5,16 +5,31 @@ use glam::Vec3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The torus of [`procedural_mesh`] is 2n x n quads.
+fn torus_side(min_triangles: usize) -> usize {
+    ((min_triangles as f64 / 4.0).sqrt().ceil() as usize).max(3)
+}
+
+/// Bytes [`procedural_mesh`] holds for `min_triangles` (positions 12 and face 12 + material 4 bytes
+/// per triangle, reserved up front), so that `gen-mesh` can refuse a mesh that does not fit.
+pub fn procedural_mesh_bytes(min_triangles: usize) -> u64 {
+    let n = torus_side(min_triangles) as u64;
+    let (verts, tris) = (2 * n * n + 12, 4 * n * n + 6);
+    12 * verts + 16 * tris
+}
+
 /// A procedural test mesh of at least `min_triangles` triangles: a bumpy torus (2 n x n quads, no
 /// degenerate triangles) tilted towards +z, on a floor before a wall, under an emissive patch
 /// (2 x 2 n^2 + 6 triangles); material names
 /// `torus`, `floor`, `light` (see [`write_obj`]).
 pub fn procedural_mesh(min_triangles: usize) -> ObjMesh {
-    let n = ((min_triangles as f64 / 4.0).sqrt().ceil() as usize).max(3);
+    let n = torus_side(min_triangles);
     let (nu, nv) = (2 * n, n);
     let (big_r, small_r) = (1.0f32, 0.35f32);
     let tilt = glam::Mat3::from_rotation_x(1.0);
     let mut mesh = ObjMesh::default();
+    mesh.positions.reserve_exact(nu * nv + 12);
+    mesh.faces.reserve_exact(2 * nu * nv + 6);
     for i in 0..nu {
         let u = i as f32 / nu as f32 * std::f32::consts::TAU;
         for j in 0..nv {

@@ -5,6 +5,7 @@ use super::faces::parse_obj;
 use super::mtl::load_mtl;
 use super::{err, print_warnings, short, warn, MtlMaterial, ObjMesh, ObjWarning, ParsedObj, NO_NORMAL};
 use crate::scene::error::SceneError;
+use crate::scene::limits::read_bounded;
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -29,9 +30,15 @@ fn decode(bytes: &[u8]) -> Result<(Cow<'_, str>, Option<usize>), (usize, String)
 
 const LATIN1: &str = "the file is not valid UTF-8 text; read as Latin-1";
 
-/// Reads and decodes `path`; `what` names the file kind in the "cannot read" error.
-pub(super) fn read_text(path: &Path, what: &str, warnings: &mut Vec<ObjWarning>) -> Result<(String, bool), SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| err(path, 0, format!("cannot read {what}: {e}")))?;
+/// Reads and decodes `path` (at most `max` bytes, [`read_bounded`]); `what` names the file kind in
+/// the "cannot read" error.
+pub(super) fn read_text(
+    path: &Path,
+    what: &str,
+    max: u64,
+    warnings: &mut Vec<ObjWarning>,
+) -> Result<(String, bool), SceneError> {
+    let bytes = read_bounded(path, what, max).map_err(|(line, m)| err(path, line, m))?;
     let (text, latin1) = decode(&bytes).map_err(|(line, m)| err(path, line, m))?;
     if let Some(line) = latin1 {
         warnings.push(warn(path, line, format!("{LATIN1} (ISO 8859-1)")));
@@ -39,18 +46,30 @@ pub(super) fn read_text(path: &Path, what: &str, warnings: &mut Vec<ObjWarning>)
     Ok((text.into_owned(), latin1.is_some()))
 }
 
-/// Loads `path` and its material libraries, printing the warnings to stderr.
+/// Loads `path` and its material libraries, printing the warnings to stderr (files up to the
+/// default `max_file_bytes`).
 pub fn load(path: &Path) -> Result<ObjMesh, SceneError> {
-    let (mesh, warnings) = load_with_warnings(path)?;
+    load_bounded(path, crate::scene::parse::Limits::default().max_file_bytes)
+}
+
+/// [`load`] reading each file up to `max_file_bytes` (`--limit max_file_bytes`).
+pub fn load_bounded(path: &Path, max_file_bytes: u64) -> Result<ObjMesh, SceneError> {
+    let (mesh, warnings) = load_with_warnings_bounded(path, max_file_bytes)?;
     print_warnings(&warnings);
     Ok(mesh)
 }
 
 /// Loads `path` and its material libraries (relative to its directory): the mesh and what was
-/// repaired or ignored, in file order (the OBJ's warnings, then each library's).
+/// repaired or ignored, in file order (the OBJ's warnings, then each library's). Files are read up
+/// to the default `max_file_bytes`.
 pub fn load_with_warnings(path: &Path) -> Result<(ObjMesh, Vec<ObjWarning>), SceneError> {
+    load_with_warnings_bounded(path, crate::scene::parse::Limits::default().max_file_bytes)
+}
+
+/// [`load_with_warnings`] reading each file up to `max` bytes (`--limit max_file_bytes`).
+pub fn load_with_warnings_bounded(path: &Path, max: u64) -> Result<(ObjMesh, Vec<ObjWarning>), SceneError> {
     let mut warnings = Vec::new();
-    let (text, latin1) = read_text(path, "OBJ file", &mut warnings)?;
+    let (text, latin1) = read_text(path, "OBJ file", max, &mut warnings)?;
     let parsed = parse_obj(&text).map_err(|(line, mut msg)| {
         if latin1 && text.split('\n').nth(line.wrapping_sub(1)).is_some_and(|l| !l.is_ascii()) {
             msg.push_str(&format!(" ({LATIN1})"));
@@ -58,7 +77,7 @@ pub fn load_with_warnings(path: &Path) -> Result<(ObjMesh, Vec<ObjWarning>), Sce
         err(path, line, msg)
     })?;
     warnings.extend(parsed.warnings.iter().map(|(line, m)| warn(path, *line, m.clone())));
-    let (materials, by_name) = load_libraries(path, &parsed, &mut warnings)?;
+    let (materials, by_name) = load_libraries(path, &parsed, max, &mut warnings)?;
     // usemtl slots -> material indices
     let any_library = !materials.is_empty() || !parsed.mtllibs.is_empty();
     let mut slot_material = Vec::with_capacity(parsed.usemtl.len());
@@ -118,6 +137,7 @@ pub fn load_with_warnings(path: &Path) -> Result<(ObjMesh, Vec<ObjWarning>), Sce
 fn load_libraries(
     path: &Path,
     parsed: &ParsedObj,
+    max: u64,
     warnings: &mut Vec<ObjWarning>,
 ) -> Result<(Vec<MtlMaterial>, HashMap<String, u32>), SceneError> {
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -126,7 +146,7 @@ fn load_libraries(
     let mut materials = Vec::new();
     let mut by_name = HashMap::new();
     let mut load_one = |lib: &Path, materials: &mut Vec<MtlMaterial>, warnings: &mut Vec<ObjWarning>| {
-        for m in load_mtl(lib, warnings)? {
+        for m in load_mtl(lib, max, warnings)? {
             by_name.insert(m.name.clone(), materials.len() as u32);
             materials.push(m);
         }
@@ -155,6 +175,9 @@ fn load_libraries(
             }
             if let Some(m) = how {
                 warnings.push(warn(path, *line, m));
+            }
+            if let Some(m) = outside(&lib, &dir) {
+                warnings.push(warn(path, *line, format!("mtllib '{}': {m}", short(&name))));
             }
             load_one(&lib, &mut materials, warnings)?;
             loaded.push(lib);
@@ -207,4 +230,12 @@ fn mtllib_names(rest: &str, dir: &Path) -> Vec<String> {
         names.push(cur);
     }
     names
+}
+
+/// A warning if the library `lib` lies outside the OBJ's directory `dir` (after resolving links):
+/// an OBJ from elsewhere naming `/etc/passwd` or `../../x` should not be read silently.
+fn outside(lib: &Path, dir: &Path) -> Option<String> {
+    let here = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+    let (l, d) = (std::fs::canonicalize(lib).ok()?, std::fs::canonicalize(here).ok()?);
+    (!l.starts_with(&d)).then(|| format!("{} is outside the OBJ's directory; read anyway", l.display()))
 }

@@ -91,7 +91,7 @@ impl Parser<'_> {
             a: Vec3::new(ax, ay, az),
             ab: Vec3::new(bx, by, bz),
             ac: Vec3::new(cx, cy, cz),
-            radiance: Vec3::new(r, g, b),
+            radiance: radiance("quadLight radiance", r, g, b)?,
         };
         let area = light.ab.cross(light.ac).length();
         if !(area > 0.0 && area.is_finite()) {
@@ -107,7 +107,8 @@ impl Parser<'_> {
     /// material elsewhere; faces with `Ke` become emissive triangles).
     pub(super) fn obj(&mut self, name: &str) -> Result<(), LineError> {
         let path = self.desc.source.parent().unwrap_or(Path::new("")).join(name);
-        let mesh = obj::load(&path).map_err(|e| format!("obj '{}': {e}", show(name)))?;
+        let mesh =
+            obj::load_bounded(&path, self.limits.max_file_bytes).map_err(|e| format!("obj '{}': {e}", show(name)))?;
         let d = &self.desc;
         let n = d.triangles.len() + d.emissive_triangles.len() + d.spheres.len() + d.quad_lights.len();
         if n + mesh.faces.len() > self.limits.max_primitives {
@@ -204,6 +205,15 @@ fn intern_material(lookup: &mut HashMap<[u32; 15], u32>, desc: &mut SceneDesc, m
             i
         }
     })
+}
+
+/// A light's radiance or colour (`what` names it): every channel >= 0 (a negative emitter would
+/// make negative pixels; NaN is refused by the number parser).
+pub(super) fn radiance(what: &str, r: f32, g: f32, b: f32) -> Result<Vec3, LineError> {
+    if r < 0.0 || g < 0.0 || b < 0.0 {
+        return Err(format!("{what} must be >= 0 in every channel, got {r} {g} {b}").into());
+    }
+    Ok(Vec3::new(r, g, b))
 }
 
 /// One number that must be >= 0.

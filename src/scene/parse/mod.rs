@@ -19,7 +19,7 @@ pub use crate::scene::limits::{limit_hint, LimitError, Limits};
 
 use crate::scene::desc::*;
 use args::{hint, show, Args};
-use commands::non_negative;
+use commands::{non_negative, radiance};
 use glam::{DMat4, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
@@ -27,7 +27,8 @@ use std::path::Path;
 /// Reads and parses a `.test` file. An unreadable file is an error on line 0.
 pub fn parse_file(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneError> {
     let error = |line, message: String| SceneError::new(path, line, message);
-    let bytes = std::fs::read(path).map_err(|e| error(0, format!("cannot read scene file: {e}")))?;
+    let bytes = crate::scene::limits::read_bounded(path, "scene file", limits.max_file_bytes)
+        .map_err(|(line, m)| error(line, m))?;
     let text = std::str::from_utf8(&bytes).map_err(|e| {
         let before = bytes.get(..e.valid_up_to()).unwrap_or_default();
         let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
@@ -164,7 +165,10 @@ impl<'l> Parser<'l> {
             }
             "diffuse" => self.set_material(Material { diffuse: Vec3::from_array(a.floats()?), ..self.material }),
             "specular" => self.set_material(Material { specular: Vec3::from_array(a.floats()?), ..self.material }),
-            "emission" => self.set_material(Material { emission: Vec3::from_array(a.floats()?), ..self.material }),
+            "emission" => {
+                let [r, g, b] = a.floats()?;
+                self.set_material(Material { emission: radiance("emission", r, g, b)?, ..self.material })
+            }
             "ambient" => self.set_material(Material { ambient: Vec3::from_array(a.floats()?), ..self.material }),
             "shininess" => self.set_material(Material { shininess: non_negative(a)?, ..self.material }),
             "roughness" => self.set_material(Material { roughness: non_negative(a)?, ..self.material }),
@@ -177,7 +181,8 @@ impl<'l> Parser<'l> {
                 let [x, y, z, r, g, b] = a.floats()?;
                 self.count_primitive()?;
                 let position = self.to_world(Vec3::new(x, y, z))?;
-                let light = PointLightDesc { position, color: Vec3::new(r, g, b), attenuation: self.attenuation };
+                let color = radiance("point light colour", r, g, b)?;
+                let light = PointLightDesc { position, color, attenuation: self.attenuation };
                 self.desc.point_lights.push(light);
             }
             "directional" => {
@@ -185,7 +190,8 @@ impl<'l> Parser<'l> {
                 self.count_primitive()?;
                 let direction = self.matrix.transform_vector3(Vec3::new(x, y, z).as_dvec3());
                 let direction = direction.try_normalize().ok_or("directional light direction must be non-zero")?;
-                let light = DirectionalLightDesc { direction: direction.as_vec3(), color: Vec3::new(r, g, b) };
+                let color = radiance("directional light colour", r, g, b)?;
+                let light = DirectionalLightDesc { direction: direction.as_vec3(), color };
                 self.desc.directional_lights.push(light);
             }
             "attenuation" => {
