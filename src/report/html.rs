@@ -303,7 +303,7 @@ const SCRIPT: &str = r#"
     else if (e.key === 'ArrowLeft') { show(active, (active.index + n - 1) % n); }
     else if (e.key === 'r') { show(active, 0); }
   });
-  if (location.hash === '#selftest') {
+  function selftest() {
     var lines = [];
     books.forEach(function (b, bi) {
       active = b;
@@ -319,6 +319,9 @@ const SCRIPT: &str = r#"
     pre.id = 'selftest';
     pre.textContent = lines.join('\n');
     document.body.appendChild(pre);
+  }
+  if (location.hash === '#selftest') {
+    if (document.readyState === 'complete') { selftest(); } else { window.addEventListener('load', selftest); }
   }
 })();
 "#;
