@@ -98,7 +98,8 @@ pub(crate) enum Cmd {
         triangles: usize,
     },
     /// Regenerate the seed experiments (direct lighting light samplers; path tracing pixel
-    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, contact sheets, plots.
+    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, report.html (flip-books,
+    /// error maps, tables, plots), SVG plots.
     Experiments {
         /// Output folder.
         #[arg(long, default_value = "docs/experiments")]
@@ -121,7 +122,7 @@ pub(crate) enum Cmd {
         /// Worker threads (0 = all cores).
         #[arg(long, default_value_t = 0)]
         threads: usize,
-        /// Contact-sheet tiles are the images box-downsampled by this factor.
+        /// report.html shows the images box-downsampled by this factor (keeps it small).
         #[arg(long, default_value_t = 2)]
         sheet_factor: u32,
     },

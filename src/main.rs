@@ -153,7 +153,7 @@ fn main() -> ExitCode {
             };
             strata::lab::experiments::run(&cfg).map_err(|e| e.to_string()).map(|md| {
                 println!("{md}");
-                println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
+                println!("written to {}/ (report.html, results.md, results.json, *.svg)", out.display());
             })
         }
         Cmd::Rays { args, json } => {

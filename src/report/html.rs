@@ -76,10 +76,33 @@ pub fn png_data_uri(width: u32, height: u32, rgb8: &[u8]) -> String {
     format!("data:image/png;base64,{}", base64::engine::general_purpose::STANDARD.encode(bytes))
 }
 
-/// Little-endian f32 values, base64: the linear pixels the page shows on hover.
+/// Little-endian IEEE half floats (`half`; 3 significant digits, values to 65504), base64: the
+/// linear pixels the page shows on hover, at half the size of f32.
 fn values_b64(rgb: &[[f32; 3]]) -> String {
-    let bytes: Vec<u8> = rgb.iter().flat_map(|p| p.iter().flat_map(|v| v.to_le_bytes())).collect();
+    let bytes: Vec<u8> =
+        rgb.iter().flat_map(|p| p.iter().flat_map(|&v| half::f16::from_f32(v).to_le_bytes())).collect();
     base64::engine::general_purpose::STANDARD.encode(bytes)
+}
+
+/// Box-filters linear RGB `rgb` (`width x height`) by an integer `factor` (at least 1): each output
+/// pixel is the mean of a `factor x factor` block; a partial block at the right or bottom edge is
+/// dropped. Returns the new width, height and pixels.
+pub fn box_downsample(width: u32, height: u32, rgb: &[[f32; 3]], factor: u32) -> (u32, u32, Vec<[f32; 3]>) {
+    let f = factor.max(1);
+    let (w, h) = (width / f, height / f);
+    let norm = 1.0 / (f * f) as f32;
+    let out = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let mut acc = [0.0f32; 3];
+            for (dx, dy) in (0..f).flat_map(|dy| (0..f).map(move |dx| (dx, dy))) {
+                let p = rgb[((y * f + dy) * width + x * f + dx) as usize];
+                (0..3).for_each(|c| acc[c] += p[c]);
+            }
+            acc.map(|v| v * norm)
+        })
+        .collect();
+    (w, h, out)
 }
 
 /// The `q` quantile (0..1) of `v` (NaN-free), 0 when empty.
@@ -264,13 +287,21 @@ const SCRIPT: &str = r#"
     b.legend.textContent = b.shots[i].dataset.label + ': ' + b.shots[i].dataset.legend;
     b.box.dataset.shown = b.shots[i].dataset.label;
   }
+  function half(b) {
+    var s = b & 0x8000 ? -1 : 1, e = (b >> 10) & 31, m = b & 1023;
+    if (e === 0) { return s * m * Math.pow(2, -24); }
+    if (e === 31) { return m ? NaN : s * Infinity; }
+    return s * (1 + m / 1024) * Math.pow(2, e - 15);
+  }
   var decoded = new WeakMap();
   function values(img) {
     if (!img.dataset.values) { return null; }
     if (!decoded.has(img)) {
       var s = atob(img.dataset.values), u = new Uint8Array(s.length);
       for (var i = 0; i < s.length; i++) { u[i] = s.charCodeAt(i); }
-      decoded.set(img, new Float32Array(u.buffer));
+      var h = new Uint16Array(u.buffer), f = new Float32Array(h.length);
+      for (var j = 0; j < h.length; j++) { f[j] = half(h[j]); }
+      decoded.set(img, f);
     }
     return decoded.get(img);
   }
@@ -286,7 +317,7 @@ const SCRIPT: &str = r#"
         var v = values(img);
         if (!v || (img !== bk.shots[bk.index] && img.dataset.label !== 'reference')) { return; }
         var k = 3 * (y * b.w + x);
-        text += '   ' + img.dataset.label + ': ' + [v[k], v[k + 1], v[k + 2]].map(function (c) { return c.toPrecision(4); }).join(' ');
+        text += '   ' + img.dataset.label + ': ' + [v[k], v[k + 1], v[k + 2]].map(function (c) { return c.toPrecision(3); }).join(' ');
       });
     });
     out.textContent = text;
@@ -310,8 +341,10 @@ const SCRIPT: &str = r#"
       for (var i = 0; i < Math.min(b.shots.length, 10); i++) {
         document.dispatchEvent(new KeyboardEvent('keydown', { key: String((i + 1) % 10) }));
         var on = b.shots.filter(function (img) { return img.classList.contains('on'); });
+        var v = on.length === 1 ? values(on[0]) : null, k = 3 * ((b.h >> 1) * b.w + (b.w >> 1));
         lines.push('section ' + b.sec.id + ' book ' + bi + ' key ' + ((i + 1) % 10) + ' shows ' + b.box.dataset.shown +
-          ' visible ' + on.length + ' loaded ' + (on.length === 1 && on[0].complete && on[0].naturalWidth === b.w));
+          ' visible ' + on.length + ' loaded ' + (on.length === 1 && on[0].complete && on[0].naturalWidth === b.w) +
+          (v ? ' centre ' + [v[k], v[k + 1], v[k + 2]].join(' ') : ''));
       }
     });
     lines.push('errors ' + errors.length + (errors.length ? ': ' + errors.join(' | ') : ''));
@@ -345,4 +378,61 @@ pub fn page_html(p: &Page) -> String {
         intro = p.intro,
         blocks = p.blocks.join("\n"),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_downsample_averages_blocks_and_drops_partial_ones() {
+        let rgb: Vec<[f32; 3]> = (0..15).map(|i| [i as f32, 2.0 * i as f32, 1.0]).collect();
+        let (w, h, d) = box_downsample(5, 3, &rgb, 2);
+        assert_eq!((w, h), (2, 1));
+        // block (0,0): pixels 0, 1, 5, 6 -> mean 3; block (1,0): 2, 3, 7, 8 -> mean 5
+        assert_eq!(d, vec![[3.0, 6.0, 1.0], [5.0, 10.0, 1.0]]);
+        assert_eq!(box_downsample(5, 3, &rgb, 1), (5, 3, rgb.clone()));
+    }
+
+    #[test]
+    fn page_is_self_contained_and_escapes_text() {
+        let shot = |l: &str, v: f32| Shot { label: l.into(), rgb: vec![[v; 3]; 6] };
+        let page = Page {
+            title: "a <b> & c".into(),
+            intro: String::new(),
+            sections: vec![Section {
+                title: "s".into(),
+                width: 3,
+                height: 2,
+                reference: Some(shot("reference", 0.5)),
+                shots: vec![shot("x\"y", 0.25)],
+                blocks: vec![],
+            }],
+            blocks: vec![],
+            commands: vec!["strata compare --variant 'a=--spp 1'".into()],
+        };
+        let html = page_html(&page);
+        assert!(html.contains("<title>a &lt;b&gt; &amp; c</title>") && html.contains("data-label=\"x&quot;y\""));
+        // One image entry per shot and reference, three error maps per shot, PNG data URIs only.
+        assert_eq!(html.matches("<img class=\"shot\"").count(), 2 + 3);
+        assert_eq!(html.matches("src=\"data:image/png;base64,").count(), 5);
+        assert!(
+            html.contains("strata compare --variant &#x27;a=--spp 1&#x27;") || html.contains("--variant 'a=--spp 1'")
+        );
+    }
+
+    #[test]
+    fn error_maps_are_black_where_equal_and_signed_by_colour() {
+        let r = vec![[0.5f32; 3]; 4];
+        let mut t = r.clone();
+        t[1] = [0.7; 3];
+        t[2] = [0.3; 3];
+        let maps = error_maps(&t, &r, 2, 2);
+        assert_eq!(maps.iter().map(|m| m.0.as_str()).collect::<Vec<_>>(), ["relMSE", "signed", "FLIP"]);
+        let signed = &maps[1].2;
+        assert_eq!(&signed[0..3], &[255, 255, 255], "no error: white");
+        assert_eq!(&signed[3..6], &[255, 0, 0], "positive: red");
+        assert_eq!(&signed[6..9], &[0, 0, 255], "negative: blue");
+        assert_eq!(&maps[0].2[0..3], &magma(0.0), "no relative error: the bottom of the scale");
+    }
 }

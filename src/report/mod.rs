@@ -16,7 +16,6 @@
 //! - [`slope`]: fitted log-log convergence slopes with a Student-t interval.
 
 pub mod bars;
-pub mod contact;
 pub mod flip;
 pub mod html;
 pub mod metrics;
