@@ -205,6 +205,7 @@ fn csv_columns_spell_the_header_and_g3_reads_well() {
 fn sampler_columns_show_the_profile_or_say_not_profiled() {
     let mut plain = rows()[0].clone();
     (plain.sampler_ns_per_sample, plain.sampler_share) = (f64::NAN, f64::NAN);
+    (plain.flip, plain.eff_vs_baseline) = (0.05, 1.0);
     let md = to_markdown(&[rows()[0].clone(), plain.clone()]);
     let lines: Vec<&str> = md.lines().collect();
     assert!(lines[0].contains("sampler ns/sample") && lines[0].contains("% of render in sampler"));
