@@ -260,3 +260,40 @@ fn defaults_are_unbiased_and_independent_samples_converge_at_slope_minus_one_hal
     assert_eq!(std::fs::read_to_string(d.join("out/runs.csv")).unwrap().lines().count(), 1 + 24);
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// A noisy reference (few spp): its variance layer enters the bias test and the noise-corrected
+/// MSE. Without it the bias interval of an unbiased variant, from the runs' spread alone, would
+/// exclude 0 here (the reference's own error dominates); with it the interval covers 0.
+#[test]
+fn the_references_variance_layer_enters_the_bias_test_and_the_corrected_mse() {
+    let (c, d) = (corpus(), common::tmpdir("cmp-noisyref"));
+    let direct9 = c.join("hw2/direct9.test");
+    reference(&direct9, "32x24", 2, &[], &d.join("ref"));
+    let img = strata::film::read_exr(&d.join("ref.exr")).unwrap();
+    let var = img.variance.expect("a reference has a variance layer");
+    let ref_var = var.iter().flatten().map(|&v| f64::from(v)).sum::<f64>() / (3 * var.len()) as f64;
+    let o = compare(
+        &direct9,
+        &d.join("ref.exr"),
+        "32x24",
+        &["--runs", "8", "--spp-ladder", "64", "--variant", "independent=--light-sampler independent"],
+        &d.join("out"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let row = &rows(&d.join("out"))[0];
+    let (mse, corrected) = (row["mse"].as_f64().unwrap(), row["mse_corrected"].as_f64().unwrap());
+    assert!((mse - corrected - ref_var).abs() <= 1e-9 * mse.max(1e-30) + 1e-12, "{mse} - {corrected} vs {ref_var}");
+    let ci = row["bias_ci"].as_array().unwrap();
+    let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+    assert!(lo <= 0.0 && 0.0 <= hi, "with the reference's noise the interval covers 0: [{lo}, {hi}]");
+    // From the runs' spread alone (runs.json), the interval would exclude 0.
+    let runs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("out/runs.json")).unwrap()).unwrap();
+    let e: Vec<f64> = runs.as_array().unwrap().iter().map(|r| r["mean_error"].as_f64().unwrap()).collect();
+    let k = e.len() as f64;
+    let mean = e.iter().sum::<f64>() / k;
+    let se = (e.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0) / k).sqrt();
+    let t = strata::report::student_t_quantile(0.975, k - 1.0);
+    assert!(mean.abs() > t * se, "this case must need the reference's noise: {mean} +- {}", t * se);
+    std::fs::remove_dir_all(&d).ok();
+}

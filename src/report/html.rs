@@ -209,7 +209,7 @@ h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.5em; }
 .bar button.on { background: #246; color: white; }
 .legend, .hover { font-size: 0.85em; color: #444; min-height: 1.2em; }
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.8em 0; }
-td, th { border: 1px solid #bbb; padding: 0.2em 0.5em; text-align: right; }
+td, th { border: 1px solid #bbb; padding: 0.2em 0.5em; text-align: right; white-space: nowrap; }
 td:first-child, th:first-child { text-align: left; }
 pre { background: #f4f4f4; padding: 0.6em; overflow-x: auto; }
 .notes li { color: #842; }
