@@ -201,7 +201,7 @@ fn section_html(i: usize, s: &Section) -> String {
 const STYLE: &str = r#"
 body { font-family: sans-serif; margin: 1.5em; color: #222; }
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.5em; }
-.books { display: flex; flex-wrap: wrap; gap: 1.5em; }
+.books { display: flex; flex-wrap: wrap; gap: 1.5em; align-items: flex-start; }
 .view { position: relative; overflow: hidden; border: 1px solid #888; background: #333; cursor: crosshair; }
 .view img.shot { position: absolute; left: 0; top: 0; transform-origin: 0 0; image-rendering: pixelated; display: none; }
 .view img.shot.on { display: block; }
@@ -235,6 +235,7 @@ const SCRIPT: &str = r#"
       view.scale = fit;
       box.style.width = (w * fit) + 'px';
       box.style.height = (h * fit) + 'px';
+      book.style.maxWidth = (w * fit + 2) + 'px';
       var bar = book.querySelector('.bar');
       var b = { sec: sec, shots: shots, index: 0, buttons: [], box: box, legend: book.querySelector('.legend'), w: w, h: h };
       shots.forEach(function (img, i) {
