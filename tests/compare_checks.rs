@@ -18,14 +18,6 @@ fn strata() -> Command {
     Command::new(std::env::var_os("STRATA_BIN").unwrap_or_else(|| env!("CARGO_BIN_EXE_strata").into()))
 }
 
-fn corpus() -> PathBuf {
-    let p = std::env::var_os("STRATA_CSE168")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168")));
-    assert!(p.join("hw2").is_dir(), "CSE168 corpus missing at {} (CI has ../shared; set STRATA_CSE168)", p.display());
-    p
-}
-
 /// Runs `cmd`, killing it after `limit` (a test must not hang on an uncapped render).
 fn run(cmd: &mut Command, limit: Duration) -> Output {
     let mut child =
@@ -86,7 +78,7 @@ fn rows(dir: &Path) -> Vec<serde_json::Value> {
 
 #[test]
 fn a_reference_of_another_scene_or_camera_is_refused_naming_both_unless_forced() {
-    let (c, d) = (corpus(), common::tmpdir("cmp-ref"));
+    let (c, d) = (common::corpus_required(), common::tmpdir("cmp-ref"));
     let (sphere, direct9) = (c.join("hw2/sphere.test"), c.join("hw2/direct9.test"));
     reference(&direct9, "32x24", 8, &[], &d.join("d9"));
     let v = ["--runs", "2", "--spp-ladder", "1", "--variant", "a=--light-sampler independent"];
@@ -123,7 +115,7 @@ fn a_reference_of_another_scene_or_camera_is_refused_naming_both_unless_forced()
 
 #[test]
 fn owned_flags_duplicate_names_and_uncapped_ladders_are_refused_with_the_reason() {
-    let (c, d) = (corpus(), common::tmpdir("cmp-flags"));
+    let (c, d) = (common::corpus_required(), common::tmpdir("cmp-flags"));
     let sphere = c.join("hw2/sphere.test");
     reference(&sphere, "24x18", 4, &[], &d.join("ref"));
     let r = d.join("ref.exr");
@@ -164,7 +156,7 @@ fn owned_flags_duplicate_names_and_uncapped_ladders_are_refused_with_the_reason(
 
 #[test]
 fn variants_that_render_the_same_image_are_named_and_not_ranked() {
-    let (c, d) = (corpus(), common::tmpdir("cmp-same"));
+    let (c, d) = (common::corpus_required(), common::tmpdir("cmp-same"));
     let sphere = c.join("hw2/sphere.test");
     reference(&sphere, "24x18", 8, &[], &d.join("ref"));
     let o = compare(
@@ -214,7 +206,7 @@ fn variants_that_render_the_same_image_are_named_and_not_ranked() {
 /// jitter independent too, so every sample is i.i.d.) is -1/2 within its interval.
 #[test]
 fn defaults_are_unbiased_and_independent_samples_converge_at_slope_minus_one_half() {
-    let (c, d) = (corpus(), common::tmpdir("cmp-d9"));
+    let (c, d) = (common::corpus_required(), common::tmpdir("cmp-d9"));
     let direct9 = c.join("hw2/direct9.test");
     reference(&direct9, "64x48", 512, &[], &d.join("ref"));
     let meta = strata::film::read_exr(&d.join("ref.exr")).unwrap().meta;
@@ -266,7 +258,7 @@ fn defaults_are_unbiased_and_independent_samples_converge_at_slope_minus_one_hal
 /// exclude 0 here (the reference's own error dominates); with it the interval covers 0.
 #[test]
 fn the_references_variance_layer_enters_the_bias_test_and_the_corrected_mse() {
-    let (c, d) = (corpus(), common::tmpdir("cmp-noisyref"));
+    let (c, d) = (common::corpus_required(), common::tmpdir("cmp-noisyref"));
     let direct9 = c.join("hw2/direct9.test");
     reference(&direct9, "32x24", 2, &[], &d.join("ref"));
     let img = strata::film::read_exr(&d.join("ref.exr")).unwrap();

@@ -10,14 +10,6 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn corpus() -> PathBuf {
-    let p = std::env::var_os("STRATA_CSE168")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168")));
-    assert!(p.join("hw2").is_dir(), "CSE168 corpus missing at {} (CI has ../shared; set STRATA_CSE168)", p.display());
-    p
-}
-
 /// Headless Chromium on `url` with `extra` flags: (stdout, stderr).
 fn chromium(url: &str, extra: &[&str]) -> (String, String) {
     let profile = common::tmpdir(&format!("chromium-{}", extra.len()));
@@ -48,7 +40,7 @@ fn console_errors(log: &str) -> Vec<&str> {
 }
 
 fn compare_report(dir: &Path) -> PathBuf {
-    let sphere = corpus().join("hw2/sphere.test");
+    let sphere = common::corpus_required().join("hw2/sphere.test");
     let st = common::strata()
         .arg("reference")
         .arg(&sphere)
