@@ -197,6 +197,10 @@ fn variants_that_render_the_same_image_are_named_and_not_ranked() {
         }
     }
     assert!(md.contains("same image as a"), "{md}");
+    // Progress: stderr is not a terminal here, so a plain line per run (3 variants x 2 steps x 2 runs).
+    let lines: Vec<String> = stderr(&o).lines().filter(|l| l.starts_with("compare: run ")).map(String::from).collect();
+    assert_eq!(lines.len(), 12, "{}", stderr(&o));
+    assert!(lines[0].starts_with("compare: run 1/12 (a at 1 spp)") && lines[11].contains("ETA"), "{lines:?}");
     std::fs::remove_dir_all(&d).ok();
 }
 

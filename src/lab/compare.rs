@@ -394,7 +394,10 @@ fn convergence(variant: &str, runs: &[RunRow]) -> Convergence {
     let rmse = |r: &RunRow| r.mse_corrected.max(0.0).sqrt();
     let spp: Vec<(f64, f64)> = mine.iter().filter(|r| r.step > 0).map(|r| (f64::from(r.spp), rmse(r))).collect();
     let secs: Vec<(f64, f64)> = mine.iter().map(|r| (r.seconds, rmse(r))).collect();
-    Convergence { variant: variant.into(), vs_spp: loglog_slope(&spp), vs_seconds: loglog_slope(&secs) }
+    // Equal-time runs all spend about the budget: no range of seconds to fit a slope over.
+    let (lo, hi) = secs.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    let vs_seconds = if hi > 1.5 * lo { loglog_slope(&secs) } else { None };
+    Convergence { variant: variant.into(), vs_spp: loglog_slope(&spp), vs_seconds }
 }
 
 /// Writes `rows.csv`, `rows.json`, `runs.csv`, `runs.json`, `table.md`, `error.svg` (RMSE against
