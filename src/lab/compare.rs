@@ -218,6 +218,10 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                 notes.push(note);
             }
         }
+        if matches!(opts.mode, Mode::Budget(_)) {
+            // A layout that needs its count in advance cannot run at equal time: refuse it now.
+            integ.equal_time().map_err(session::SessionError::from)?;
+        }
         prepared.push((o, scene, integ));
     }
     let ref_info = ReferenceInfo { variance: img.variance.as_deref(), gamma: None };
@@ -233,9 +237,17 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         let (mut per_step, mut last) = (Vec::new(), Vec::new());
         for &step in &steps {
             let (mut runs_img, mut secs, mut spps, mut hashes) = (Vec::new(), 0.0, 0.0, Vec::new());
+            // The samplers the runs of this step used (equal time may replace a default).
+            let mut ran = String::new();
             let mut step_stats = RenderStats { threads: all.threads, ..Default::default() };
             for run in 0..opts.runs {
-                let mut it = integ.resampled(if step > 0 { Some(step) } else { None });
+                // Equal time: progressive layouts continue their sequences pass after pass; one that
+                // needs its count in advance is refused.
+                let mut it = if step > 0 {
+                    integ.resampled(step)
+                } else {
+                    integ.equal_time().map_err(session::SessionError::from)?
+                };
                 it.seed = run_seed(o.seed, run);
                 let mut film = Film::new(img.width, img.height);
                 let (seconds, spp) = if step > 0 {
@@ -246,6 +258,7 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                     let Mode::Budget(b) = opts.mode else { unreachable!("step 0 is the budget") };
                     budget_run(scene, &it, &mut film, &pool, b, o.limits.max_spp, &mut step_stats, &mut notes, &v.name)
                 };
+                ran = samplers_ran(&it);
                 secs += seconds;
                 spps += f64::from(spp);
                 let mean = film.mean();
@@ -284,6 +297,7 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                 .with_sampler(step_profile.sampler_ns_per_sample(), step_profile.sampler_share());
             row.first_sample = integ.first_sample.name().into();
             row.flip = flips;
+            row.setting = ran;
             rows.push(row);
             per_step.push(hashes);
             last = runs_img.swap_remove(0);
@@ -437,4 +451,11 @@ pub fn write_outputs(c: &Comparison, dir: &Path, title: &str, commands: &[String
         film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
     }
     Ok(md)
+}
+
+/// The samplers an integrator runs, for the `samplers` column: pixel, light and the others, and
+/// the light choice.
+fn samplers_ran(it: &crate::integrator::Integrator) -> String {
+    let [pixel, light, path] = it.kinds().map(|k| k.name());
+    format!("pixel {pixel}, light {light}, other {path}, choice {}", it.light_choice.name())
 }

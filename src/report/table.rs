@@ -271,6 +271,7 @@ fn vs_baseline(r: &Row) -> String {
 /// The columns of `table.md` of `strata compare` ([`to_markdown`]).
 pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "variant", cell: |r, _| r.variant.replace('|', "\\|") },
+    Column { header: "samplers", cell: |r, _| r.setting.replace('|', "\\|") },
     Column { header: "first sample", cell: |r, _| r.first_sample.clone() },
     Column { header: "spp", cell: |r, _| spp_cell(r.spp) },
     Column { header: "CPU s/run", cell: |r, _| g3(r.seconds) },
@@ -328,6 +329,8 @@ pub fn to_markdown(rows: &[Row]) -> String {
 #[derive(Serialize)]
 struct FlatRow<'a> {
     variant: &'a str,
+    /// the samplers that ran (`strata compare` puts them in the row's `setting`)
+    samplers: &'a str,
     seconds: f64,
     spp: f64,
     mse: f64,
@@ -355,6 +358,7 @@ pub fn to_json(rows: &[Row]) -> serde_json::Value {
         .iter()
         .map(|r| FlatRow {
             variant: &r.variant,
+            samplers: &r.setting,
             seconds: r.seconds,
             spp: r.spp,
             mse: r.stats.mse,

@@ -89,6 +89,7 @@ fn json_has_the_compare_keys_and_round_trips_the_numbers() {
     let keys: Vec<&str> = value[0].as_object().unwrap().keys().map(String::as_str).collect();
     let mut want = [
         "variant",
+        "samplers",
         "seconds",
         "spp",
         "mse",
@@ -158,7 +159,7 @@ fn markdown_is_aligned_with_integer_spp_units_and_the_baseline_ratio() {
     assert!(lines[0].contains("CPU s/run") && lines[0].contains("first sample"), "units in headers: {}", lines[0]);
     let cell = |l: &str, i: usize| l.split('|').nth(i + 1).unwrap().trim().to_string();
     // spp is an integer, not 6.40e1; the first-sample column says which layout each row used.
-    assert_eq!((cell(lines[2], 2), cell(lines[2], 1)), ("64".to_string(), "jittered".to_string()));
+    assert_eq!((cell(lines[2], 3), cell(lines[2], 2)), ("64".to_string(), "jittered".to_string()));
     let last = |l: &str| l.trim_end_matches('|').rsplit('|').next().unwrap().trim().to_string();
     assert_eq!(last(lines[2]), "1.00x");
     assert_eq!(last(lines[3]), "3.20x");
