@@ -3,6 +3,9 @@
 #   - libclang (bindgen in embree4-sys needs the full -dev package for stddef.h), pkg-config
 #   - Embree 4.4 + TBB into ./.embree/lib, from the PyPI wheel embreex==4.4.0.post1
 #     (skipped when EMBREE_DIR is set or pkg-config finds embree4)
+#   - Debian's chromium (headless: the browser test of report.html, tests/report_html.rs)
+#   - NVIDIA's flip-evaluator (FLIP's reference implementation, with numpy) into target/py, for
+#     tests/flip.rs (pip --target: no system packages touched)
 #   - a Rust toolchain is assumed (cargo on PATH); rustup is used to install it if missing.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -12,11 +15,18 @@ dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
 command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
 command -v python3 >/dev/null 2>&1 || need_apt+=(python3)
 python3 -m pip --version >/dev/null 2>&1 || need_apt+=(python3-pip)
+command -v chromium >/dev/null 2>&1 || need_apt+=(chromium)
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "setup: installing ${need_apt[*]}" >&2
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
+fi
+
+if ! PYTHONPATH="$root/target/py" python3 -c "import flip_evaluator, numpy" >/dev/null 2>&1; then
+  echo "setup: installing flip-evaluator (FLIP's reference) into target/py" >&2
+  python3 -m pip install -q --upgrade --disable-pip-version-check --root-user-action=ignore --target "$root/target/py" \
+    flip-evaluator==1.7 numpy
 fi
 
 if ! command -v cargo >/dev/null 2>&1; then

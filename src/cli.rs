@@ -19,10 +19,13 @@ pub(crate) enum Cmd {
     /// Render a CSE168 .test scene (or the built-in Cornell box) to OUT.exr and OUT.png.
     Render(RenderArgs),
     /// Render a high-spp reference: linear EXR with a per-pixel variance layer (and a PNG), with
-    /// progress and ETA. Same flags as `render`; give --spp and -o.
+    /// progress and ETA. Same flags as `render`; give --spp and -o. Unbiased by default:
+    /// --first-sample jittered unless given.
     Reference(RenderArgs),
     /// Compare sampling techniques against a reference: K independent runs per variant at equal spp
-    /// (--spp-ladder) or equal time (--budget); writes rows.csv, rows.json, table.md, error.svg.
+    /// (--spp-ladder) or equal time (--budget); writes rows.csv/json, runs.csv/json (one row per
+    /// run), table.md, error.svg and report.html (flip-book, error maps, plots). The reference must
+    /// be of the same scene, size and camera. Variants default to --first-sample jittered.
     /// Seconds are the worker threads' CPU seconds; the sampler's ns/sample and share of the render
     /// come from the phase profiler, which every run has on.
     Compare {
@@ -31,10 +34,20 @@ pub(crate) enum Cmd {
         /// Reference EXR (from `strata reference`), same size as the renders.
         #[arg(long)]
         reference: PathBuf,
-        /// NAME=OPTIONS, OPTIONS being render flags, e.g. strat=--light-sampler=stratified
-        /// (several flags separated by spaces). Repeat for each variant.
+        /// NAME=OPTIONS, OPTIONS being render flags with shell quoting, e.g.
+        /// strat='--light-sampler stratified --camera "0 0 5 0 0 0 0 1 0 45"'. Repeat for each
+        /// variant; names are unique. compare owns --spp, --size, -o, --threads (refused here).
         #[arg(long = "variant", required = true)]
         variants: Vec<String>,
+        /// The variant the efficiency ratios are against, at each spp step (default: the first).
+        #[arg(long, value_name = "NAME")]
+        baseline: Option<String>,
+        /// Compare against a reference of another scene or camera anyway (the report says so).
+        #[arg(long)]
+        force: bool,
+        /// No progress lines on stderr.
+        #[arg(long, short = 'q')]
+        quiet: bool,
         /// Independent runs per variant (seeds differ), at least 2.
         #[arg(long, default_value_t = 4)]
         runs: usize,
@@ -89,7 +102,8 @@ pub(crate) enum Cmd {
         triangles: usize,
     },
     /// Regenerate the seed experiments (direct lighting light samplers; path tracing pixel
-    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, contact sheets, plots.
+    /// stratification, cosine, BRDF sampling) into DIR: results.md/json, report.html (flip-books,
+    /// error maps, tables, plots), SVG plots.
     Experiments {
         /// Output folder.
         #[arg(long, default_value = "docs/experiments")]
@@ -112,7 +126,7 @@ pub(crate) enum Cmd {
         /// Worker threads (0 = all cores).
         #[arg(long, default_value_t = 0)]
         threads: usize,
-        /// Contact-sheet tiles are the images box-downsampled by this factor.
+        /// report.html shows the images box-downsampled by this factor (keeps it small).
         #[arg(long, default_value_t = 2)]
         sheet_factor: u32,
     },

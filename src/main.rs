@@ -39,10 +39,15 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let cli = Cli::parse();
+    let is_reference = matches!(cli.cmd, Cmd::Reference(_));
     let result = match cli.cmd {
         Cmd::Render(args) | Cmd::Reference(args) => {
             let quiet = args.quiet;
             let mut opts = args.options();
+            if is_reference {
+                // A reference is unbiased by default, whatever the scene's course conventions.
+                opts.first_sample.get_or_insert(strata::integrator::FirstSample::Jittered);
+            }
             match session::stop_on_signals() {
                 Ok(flag) => {
                     let rendering = Arc::new(AtomicBool::new(false));
@@ -98,6 +103,9 @@ fn main() -> ExitCode {
             scene,
             reference,
             variants,
+            baseline,
+            force,
+            quiet,
             runs,
             budget,
             spp_ladder,
@@ -108,7 +116,13 @@ fn main() -> ExitCode {
             profile_svg,
         } => {
             let profile_out = ProfileOut { json: profile, svg: profile_svg };
-            run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out, &profile_out)
+            let mode = match (budget, spp_ladder) {
+                (Some(b), _) => strata::lab::Mode::Budget(b),
+                (None, Some(l)) => strata::lab::Mode::Ladder(l),
+                (None, None) => strata::lab::Mode::Ladder(Vec::new()),
+            };
+            let opts = strata::lab::Options { runs, mode, baseline, force, size, threads, progress: !quiet };
+            run_compare(scene, &reference, &variants, &opts, &out, &profile_out)
         }
         Cmd::GenMesh { out, triangles } => gen_mesh(&out, triangles),
         Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
@@ -126,7 +140,7 @@ fn main() -> ExitCode {
             };
             strata::lab::experiments::run(&cfg).map_err(|e| e.to_string()).map(|md| {
                 println!("{md}");
-                println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
+                println!("written to {}/ (report.html, results.md, results.json, *.svg)", out.display());
             })
         }
         Cmd::Rays { args, json } => {
@@ -219,54 +233,54 @@ struct ProfileOut {
     svg: Option<PathBuf>,
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Splits `--variant NAME=FLAGS` into the name and its flags (shell quoting, `shlex`).
+fn variant_flags(spec: &str) -> Result<(&str, Vec<String>), String> {
+    let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
+    let words = shlex::split(flags).ok_or_else(|| format!("--variant {name}: unbalanced quotes in `{flags}`"))?;
+    Ok((name, words))
+}
+
+/// The command line of this process, shell-quoted (`shlex`), for the report.
+fn command_line() -> String {
+    let args: Vec<String> = std::env::args().collect();
+    shlex::try_join(args.iter().map(String::as_str)).unwrap_or_else(|_| args.join(" "))
+}
+
 fn run_compare(
     scene: Option<PathBuf>,
     reference: &std::path::Path,
     specs: &[String],
-    runs: usize,
-    budget: Option<f64>,
-    ladder: Option<Vec<u32>>,
-    size: Option<(u32, u32)>,
-    threads: usize,
+    opts: &strata::lab::Options,
     out: &std::path::Path,
     profile_out: &ProfileOut,
 ) -> Result<(), String> {
+    if matches!(&opts.mode, strata::lab::Mode::Ladder(l) if l.is_empty()) {
+        return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into());
+    }
     let mut variants = Vec::new();
     for spec in specs {
-        let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
+        let (name, flags) = variant_flags(spec)?;
         let mut argv = vec!["strata".to_string(), "render".to_string()];
         argv.extend(scene.iter().map(|p| p.display().to_string()));
-        argv.extend(flags.split_whitespace().map(str::to_string));
+        argv.extend(flags.iter().cloned());
         let cli = Cli::try_parse_from(&argv)
             .map_err(|e| format!("--variant {name}: {}", e.to_string().lines().next().unwrap_or("")))?;
         let Cmd::Render(args) = cli.cmd else { unreachable!("parsed as render") };
-        let mut opts = args.options();
-        opts.size = size.or(opts.size);
-        opts.threads = threads;
-        opts.progress = false;
-        variants.push(strata::lab::Variant { name: name.to_string(), opts });
+        variants.push(strata::lab::Variant { name: name.to_string(), opts: args.options(), flags });
     }
-    let mode = match (budget, ladder) {
-        (Some(b), _) if b > 0.0 && b.is_finite() => strata::lab::Mode::Budget(b),
-        (Some(b), _) => return Err(format!("--budget {b}: expected a positive number of seconds")),
-        (None, Some(l)) if !l.is_empty() && l.iter().all(|&s| s > 0) => strata::lab::Mode::Ladder(l),
-        (None, Some(_)) => return Err("--spp-ladder: expected positive spp values".into()),
-        (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
-    };
     for f in [&profile_out.json, &profile_out.svg].into_iter().flatten() {
         session::checks::check_output_file(f).map_err(|e| e.to_string())?;
     }
-    let (rows, profiles) =
-        strata::lab::compare_profiled(&variants, reference, runs, &mode).map_err(|e| e.to_string())?;
+    let c = strata::lab::run(&variants, reference, opts).map_err(|e| e.to_string())?;
     let title = format!(
         "{} vs {}",
         scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
         reference.display()
     );
-    let md = strata::lab::write_outputs(&rows, out, &title).map_err(|e| e.to_string())?;
+    let md = strata::lab::write_outputs(&c, out, &title, &[command_line()]).map_err(|e| e.to_string())?;
+    let profiles = &c.profiles;
     if let Some(f) = &profile_out.json {
-        let text = serde_json::to_string_pretty(&profiles).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string_pretty(profiles).map_err(|e| e.to_string())?;
         session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
     }
     if let Some(f) = &profile_out.svg {
@@ -276,6 +290,9 @@ fn run_compare(
         session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
     }
     println!("{md}");
-    println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", out.display());
+    println!(
+        "written to {}/ (report.html, rows.csv, rows.json, runs.csv, runs.json, table.md, error.svg)",
+        out.display()
+    );
     Ok(())
 }

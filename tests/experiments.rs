@@ -6,7 +6,7 @@
 mod common;
 
 #[test]
-fn tiny_experiments_write_tables_sheets_and_plots() {
+fn tiny_experiments_write_tables_report_and_plots() {
     let Some(corpus) = common::corpus() else { return };
     let out = std::env::temp_dir().join(format!("strata-experiments-{}", std::process::id()));
     let cfg = strata::lab::experiments::Config {
@@ -21,14 +21,17 @@ fn tiny_experiments_write_tables_sheets_and_plots() {
         sheet_factor: 1,
     };
     let md = strata::lab::experiments::run(&cfg).expect("experiments run");
-    for f in
-        ["results.md", "results.json", "direct.svg", "direct-sphere.png", "direct-cornell.png", "direct-dragon.png"]
-    {
+    for f in ["results.md", "results.json", "direct.svg", "report.html"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     for k in ["pixel4", "pixel5", "cosine", "brdf"] {
-        assert!(out.join(format!("path-{k}.png")).is_file() && out.join(format!("path-{k}.svg")).is_file(), "{k}");
+        assert!(out.join(format!("path-{k}.svg")).is_file(), "{k}");
     }
+    // One report page through compare's page code: a flip-book per scene and case, no bitmap sheets.
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert_eq!(page.matches("<section id=").count(), 3 + 4, "3 direct scenes and 4 path cases");
+    assert!(page.contains("data-label=\"halton 25\"") && page.contains("data-label=\"brdf 10 spp\""));
+    assert!(!out.join("direct-sphere.png").exists());
     assert!(md.contains("## Direct lighting, hw2 dragon, 25 light samples"));
     let rows: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();

@@ -1,24 +1,37 @@
 //! `strata compare`: sampling techniques against a reference, K independent runs per variant, at
-//! equal spp (a ladder) or equal time (a budget); writes CSV, JSON, a Markdown table and a
-//! log-log plot of RMSE against seconds. Seconds are the worker threads' CPU seconds, and every
-//! row carries the sampler's cost from the phase profiler.
+//! equal spp (a ladder) or equal time (a budget). Inputs are checked first ([`super::checks`]):
+//! the reference must be of the variants' scene, size and camera. Writes per-step and per-run rows
+//! (CSV, JSON), a Markdown table, log-log plots with error bars and `report.html`. Seconds are the
+//! worker threads' CPU seconds, and every row carries the sampler's cost from the phase profiler.
 
-use super::{io_err, LabError};
+use super::progress::Progress;
+use super::{checks, io_err, LabError};
+use crate::camera::FirstSample;
 use crate::film::{self, Film};
 use crate::render::{self, RenderStats};
-use crate::report::{self, Row, RunStats, Series};
+use crate::report::{self, flip, loglog_slope, ReferenceInfo, Row, RunStats, Slope};
 use crate::session::profile::Profile;
 use crate::session::{self, RenderOptions};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// One technique: a name and the render options that define it.
+/// One technique: a name, the render options that define it and the flags they came from.
 #[derive(Clone, Debug)]
 pub struct Variant {
     /// label in tables and plots
     pub name: String,
-    /// render options (scene, samplers, ...); seed and spp are set per run
+    /// render options (scene, samplers, ...); seed and spp are set per run, size and threads by
+    /// [`Options`]
     pub opts: RenderOptions,
+    /// the command-line flags that gave `opts` (said back when two variants render the same image)
+    pub flags: Vec<String>,
+}
+
+impl Variant {
+    /// A variant from its options alone (no flags to quote).
+    pub fn new(name: impl Into<String>, opts: RenderOptions) -> Self {
+        Variant { name: name.into(), opts, flags: Vec::new() }
+    }
 }
 
 /// Equal-spp ladder or equal-time budget.
@@ -28,6 +41,33 @@ pub enum Mode {
     Ladder(Vec<u32>),
     /// render each run in passes until this many CPU seconds of the worker threads are spent
     Budget(f64),
+}
+
+/// How a comparison runs.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// independent runs per variant (K >= 2)
+    pub runs: usize,
+    /// equal spp or equal time
+    pub mode: Mode,
+    /// the variant the efficiency ratios are against (default: the first)
+    pub baseline: Option<String>,
+    /// compare against a reference of another scene, size or camera anyway (the notes say so)
+    pub force: bool,
+    /// image size of every variant (default: the scene's)
+    pub size: Option<(u32, u32)>,
+    /// worker threads (0 = all cores)
+    pub threads: usize,
+    /// print a progress line per run on stderr
+    pub progress: bool,
+}
+
+impl Options {
+    /// K runs under `mode`, the rest default (first variant as baseline, no force, scene size,
+    /// all cores, no progress).
+    pub fn new(runs: usize, mode: Mode) -> Self {
+        Options { runs, mode, baseline: None, force: false, size: None, threads: 0, progress: false }
+    }
 }
 
 /// One variant's phase profile over all its runs and steps (`compare --profile`).
@@ -40,117 +80,374 @@ pub struct VariantProfile {
     pub profile: Profile,
 }
 
-/// Runs every variant `runs` times (seeds 1..=runs, independent streams) under `mode`, compares
-/// with the reference image and returns one row per (variant, ladder step). Times are the worker
-/// threads' CPU seconds (a budget too); every render is profiled, so each row carries the
-/// sampler's ns per sample and share of the render.
-pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, LabError> {
-    compare_profiled(variants, reference, runs, mode).map(|(rows, _)| rows)
+/// One render of one variant at one step: a line of `runs.csv` / `runs.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunRow {
+    /// the variant
+    pub variant: String,
+    /// the ladder step's spp (0 for an equal-time budget)
+    pub step: u32,
+    /// run index 0..K
+    pub run: usize,
+    /// the seed of this run's sample streams
+    pub seed: u64,
+    /// CPU seconds of the worker threads
+    pub seconds: f64,
+    /// samples per pixel rendered
+    pub spp: u32,
+    /// MSE against the reference
+    pub mse: f64,
+    /// relative MSE against the reference
+    pub rel_mse: f64,
+    /// MSE less the reference's mean variance (its own noise)
+    pub mse_corrected: f64,
+    /// mean signed error
+    pub mean_error: f64,
+    /// mean FLIP against the reference
+    pub flip: f64,
 }
 
-/// [`compare`] with the phase profiler on (it never changes an image): also returns each
-/// variant's profile over all its renders.
+/// A variant's fitted convergence: log RMSE (noise-corrected) against log spp over the ladder and
+/// against log CPU seconds, one point per run (see [`report::slope`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct Convergence {
+    /// the variant
+    pub variant: String,
+    /// slope against spp (None with fewer than two ladder steps)
+    pub vs_spp: Option<Slope>,
+    /// slope against CPU seconds
+    pub vs_seconds: Option<Slope>,
+}
+
+/// What a comparison measured: the tables' rows, per-run rows, profiles, slopes, notes, and one
+/// image per variant for the report.
+pub struct Comparison {
+    /// one row per (variant, step)
+    pub rows: Vec<Row>,
+    /// one row per (variant, step, run)
+    pub runs: Vec<RunRow>,
+    /// each variant's phase profile
+    pub profiles: Vec<VariantProfile>,
+    /// each variant's convergence slopes
+    pub convergence: Vec<Convergence>,
+    /// what the reader must know: forced mismatches, variants that render the same image, caps
+    pub notes: Vec<String>,
+    /// the reference image (linear RGB) and its size
+    pub reference: film::ExrImage,
+    /// each variant's image of run 1 at the last step
+    pub images: Vec<(String, Vec<[f32; 3]>)>,
+    /// the baseline variant
+    pub baseline: String,
+}
+
+/// [`run`] with default options (first variant as baseline, no progress): the rows.
+pub fn compare(variants: &[Variant], reference: &Path, runs: usize, mode: &Mode) -> Result<Vec<Row>, LabError> {
+    run(variants, reference, &Options::new(runs, mode.clone())).map(|c| c.rows)
+}
+
+/// [`compare`] with each variant's profile over all its renders.
 pub fn compare_profiled(
     variants: &[Variant],
     reference: &Path,
     runs: usize,
     mode: &Mode,
 ) -> Result<(Vec<Row>, Vec<VariantProfile>), LabError> {
-    let img = film::read_exr(reference).map_err(io_err(reference))?;
-    if runs < 2 {
+    run(variants, reference, &Options::new(runs, mode.clone())).map(|c| (c.rows, c.profiles))
+}
+
+/// The seed of run `run` of a variant with base seed `base` (independent streams per run).
+pub fn run_seed(base: u64, run: usize) -> u64 {
+    base.wrapping_add(1 + run as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+}
+
+/// Runs every variant `opts.runs` times (seeds 1..=K, independent streams) under `opts.mode`,
+/// compares each with the reference (its variance layer enters the bias test and the
+/// noise-corrected MSE) and returns what was measured. Variants and the reference are checked
+/// first; every cap of a render (`--limit`) applies to each ladder step and to the budget's passes.
+pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Comparison, LabError> {
+    checks::check_variants(variants)?;
+    if opts.runs < 2 {
         return Err(LabError::TooFewRuns { why: " (bias and variance need independent runs)" });
     }
-    let mut rows = Vec::new();
-    let mut profiles = Vec::new();
-    let _profiling = crate::profile::enable();
-    for v in variants {
-        let (scene, integ) = session::prepare(&v.opts)?;
-        if (scene.desc.width, scene.desc.height) != (img.width, img.height) {
-            return Err(LabError::SizeMismatch {
-                variant: v.name.clone(),
-                w: scene.desc.width,
-                h: scene.desc.height,
-                rw: img.width,
-                rh: img.height,
-            });
+    let baseline = match &opts.baseline {
+        Some(b) if variants.iter().any(|v| &v.name == b) => b.clone(),
+        Some(b) => {
+            let names: Vec<&str> = variants.iter().map(|v| v.name.as_str()).collect();
+            return Err(LabError::UnknownBaseline { name: b.clone(), names: names.join(", ") });
         }
-        let pool = render::thread_pool(v.opts.threads)?;
+        None => variants[0].name.clone(),
+    };
+    let img = film::read_exr(reference).map_err(io_err(reference))?;
+    let steps: Vec<u32> = match &opts.mode {
+        Mode::Ladder(l) if l.is_empty() || l.contains(&0) => return Err(LabError::BadLadder),
+        Mode::Ladder(l) => l.clone(),
+        Mode::Budget(b) if !(b.is_finite() && *b > 0.0) => return Err(LabError::BadBudget(*b)),
+        Mode::Budget(_) => vec![0],
+    };
+    // Prepare every variant first: a refused variant or reference fails before anything renders.
+    let mut prepared = Vec::new();
+    let mut notes = Vec::new();
+    for v in variants {
+        let mut o = v.opts.clone();
+        o.size = opts.size;
+        o.threads = opts.threads;
+        o.progress = false;
+        // Unbiased by default: the course's centre sample only when a variant asks for it.
+        o.first_sample = Some(o.first_sample.unwrap_or(FirstSample::Jittered));
+        // Every cap of a render applies to the largest step (or the scene's spp for a budget).
+        o.spp = steps.iter().copied().max().filter(|&s| s > 0);
+        let (scene, integ) = session::prepare(&o)?;
+        let size = (scene.desc.width, scene.desc.height);
+        let camera = session::output::camera_text(scene.desc.camera.as_ref());
+        let hash = session::scene_hash(&o)?;
+        let (diffs, mut n) = checks::reference_mismatch(&img, &v.name, &hash, size, &camera);
+        if !diffs.is_empty() {
+            if !opts.force || size != (img.width, img.height) {
+                return Err(LabError::ReferenceMismatch {
+                    reference: reference.to_path_buf(),
+                    diffs: diffs.join("; "),
+                    hint: if size != (img.width, img.height) { "" } else { " (--force compares anyway)" },
+                });
+            }
+            n.extend(
+                diffs.into_iter().map(|d| format!("--force: compared anyway although the reference differs: {d}")),
+            );
+        }
+        for note in n {
+            if !notes.contains(&note) {
+                notes.push(note);
+            }
+        }
+        if matches!(opts.mode, Mode::Budget(_)) {
+            // A layout that needs its count in advance cannot run at equal time: refuse it now.
+            integ.equal_time().map_err(session::SessionError::from)?;
+        }
+        prepared.push((o, scene, integ));
+    }
+    let ref_info = ReferenceInfo { variance: img.variance.as_deref(), gamma: None };
+    let ref_srgb = flip::to_srgb8(&img.rgb);
+    let mut progress = Progress::new("compare", variants.len() * steps.len() * opts.runs, opts.progress);
+    let (mut rows, mut run_rows, mut profiles, mut images) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    // Per variant, step and run: a hash of the image's bits, to find variants that render the same.
+    let mut renders: Vec<Vec<Vec<u64>>> = Vec::new();
+    let _profiling = crate::profile::enable();
+    for (v, (o, scene, integ)) in variants.iter().zip(&prepared) {
+        let pool = render::thread_pool(o.threads)?;
         let mut all = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
-        let steps: Vec<Option<u32>> = match mode {
-            Mode::Ladder(l) => l.iter().map(|&s| Some(s)).collect(),
-            Mode::Budget(_) => vec![None],
-        };
-        for step in steps {
-            let (mut images, mut secs, mut spps) = (Vec::new(), 0.0, 0.0);
+        let (mut per_step, mut last) = (Vec::new(), Vec::new());
+        for &step in &steps {
+            let (mut runs_img, mut secs, mut spps, mut hashes) = (Vec::new(), 0.0, 0.0, Vec::new());
             // The samplers the runs of this step used (equal time may replace a default).
             let mut ran = String::new();
             let mut step_stats = RenderStats { threads: all.threads, ..Default::default() };
-            for run in 0..runs {
-                let mut it = integ.clone();
-                it.seed = v.opts.seed.wrapping_add(1 + run as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            for run in 0..opts.runs {
+                // Equal time: progressive layouts continue their sequences pass after pass; one that
+                // needs its count in advance is refused.
+                let mut it = if step > 0 {
+                    integ.resampled(step)
+                } else {
+                    integ.equal_time().map_err(session::SessionError::from)?
+                };
+                it.seed = run_seed(o.seed, run);
                 let mut film = Film::new(img.width, img.height);
-                let (seconds, spp) = match (step, mode) {
-                    (Some(spp), _) => {
-                        it = it.resampled(spp);
-                        let st = render::render(&scene, &it, &mut film, 0..spp, &pool);
-                        step_stats.merge(&st);
-                        (st.cpu_seconds, spp)
-                    }
-                    (None, Mode::Budget(b)) => {
-                        // Equal time: whole passes of one sample until the budget (the workers' CPU
-                        // seconds) is spent. Progressive layouts continue their sequences pass
-                        // after pass; one that needs its count in advance is refused.
-                        it = it.equal_time().map_err(session::SessionError::from)?;
-                        let (mut t, mut s) = (0.0, 0u32);
-                        while t < *b {
-                            let st = render::render(&scene, &it, &mut film, s..s + 1, &pool);
-                            step_stats.merge(&st);
-                            t += st.cpu_seconds;
-                            s += 1;
-                        }
-                        (t, s)
-                    }
-                    (None, Mode::Ladder(_)) => unreachable!("ladder steps are Some"),
+                let (seconds, spp) = if step > 0 {
+                    let st = render::render(scene, &it, &mut film, 0..step, &pool);
+                    step_stats.merge(&st);
+                    (st.cpu_seconds, step)
+                } else {
+                    let Mode::Budget(b) = opts.mode else { unreachable!("step 0 is the budget") };
+                    budget_run(scene, &it, &mut film, &pool, b, o.limits.max_spp, &mut step_stats, &mut notes, &v.name)
                 };
                 ran = samplers_ran(&it);
                 secs += seconds;
                 spps += f64::from(spp);
-                images.push(film.mean());
+                let mean = film.mean();
+                let flip_map = flip::flip_map_srgb8(&ref_srgb, &flip::to_srgb8(&mean), img.width, img.height);
+                let one = report::metrics::image_error(&mean, &img.rgb)
+                    .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
+                let ref_var = ref_mean_variance(&img);
+                run_rows.push(RunRow {
+                    variant: v.name.clone(),
+                    step,
+                    run,
+                    seed: it.seed,
+                    seconds,
+                    spp,
+                    mse: one.mse,
+                    rel_mse: one.rel_mse,
+                    mse_corrected: one.mse - ref_var,
+                    mean_error: one.mean,
+                    flip: flip::mean(&flip_map),
+                });
+                hashes.push(image_hash(&mean));
+                runs_img.push(mean);
+                progress.run_done(&format!(
+                    "{} at {}",
+                    v.name,
+                    if step > 0 { format!("{step} spp") } else { "budget".into() }
+                ));
             }
-            let stats = RunStats::from_runs(&images, &img.rgb)
+            let stats = RunStats::against(&runs_img, &img.rgb, ref_info)
                 .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
             let step_profile = Profile::from_stats("", &step_stats);
             all.merge(&step_stats);
-            let mut row = Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?
+            let k = opts.runs as f64;
+            let flips = run_rows[run_rows.len() - opts.runs..].iter().map(|r| r.flip).sum::<f64>() / k;
+            let mut row = Row::new(v.name.clone(), secs / k, spps / k, &stats)?
                 .with_sampler(step_profile.sampler_ns_per_sample(), step_profile.sampler_share());
+            row.first_sample = integ.first_sample.name().into();
+            row.flip = flips;
             row.setting = ran;
             rows.push(row);
+            per_step.push(hashes);
+            last = runs_img.swap_remove(0);
         }
+        images.push((v.name.clone(), last));
+        renders.push(per_step);
         let profile = Profile::from_stats(&scene.desc.source.display().to_string(), &all);
         profiles.push(VariantProfile { variant: v.name.clone(), profile });
     }
-    Ok((rows, profiles))
+    mark_identical(variants, &renders, steps.len(), &mut rows, &mut notes);
+    rank_against_baseline(&mut rows, &baseline, steps.len());
+    let convergence = variants.iter().map(|v| convergence(&v.name, &run_rows)).collect();
+    Ok(Comparison { rows, runs: run_rows, profiles, convergence, notes, reference: img, images, baseline })
 }
 
-/// Writes rows.csv, rows.json, table.md and error.svg (RMSE against seconds, slope -1/2 guide)
-/// into `dir`; returns the Markdown table.
-pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, LabError> {
-    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
-    let md = report::to_markdown(rows);
-    let json = serde_json::to_string_pretty(&report::to_json(rows))?;
-    let mut series: Vec<Series> = Vec::new();
-    for r in rows {
-        let p = (r.seconds, r.stats.mse.sqrt());
-        match series.iter_mut().find(|s| s.name == r.variant) {
-            Some(s) => s.points.push(p),
-            None => series.push(Series { name: r.variant.clone(), points: vec![p] }),
+/// The mean over values of the reference's own variance (0 without a variance layer).
+fn ref_mean_variance(img: &film::ExrImage) -> f64 {
+    img.variance.as_ref().map_or(0.0, |v| {
+        v.iter().flat_map(|p| p.iter().map(|&x| f64::from(x))).sum::<f64>() / (3 * v.len().max(1)) as f64
+    })
+}
+
+/// A 64-bit hash of an image's exact bits (FNV-1a): equal images, equal hashes.
+fn image_hash(img: &[[f32; 3]]) -> u64 {
+    let bytes: Vec<u8> = img.iter().flat_map(|p| p.iter().flat_map(|v| v.to_bits().to_le_bytes())).collect();
+    crate::checkpoint::fnv1a(0xcbf2_9ce4_8422_2325, &bytes)
+}
+
+/// One equal-time run: whole passes of one sample until `budget` CPU seconds of the workers are
+/// spent or the `max_spp` cap is reached (said in `notes`). The pixel layout is independent (the
+/// spp is not known in advance). Returns the seconds and spp.
+#[allow(clippy::too_many_arguments)]
+fn budget_run(
+    scene: &crate::scene::build::Scene,
+    it: &crate::integrator::Integrator,
+    film: &mut Film,
+    pool: &rayon::ThreadPool,
+    budget: f64,
+    max_spp: u32,
+    stats: &mut RenderStats,
+    notes: &mut Vec<String>,
+    variant: &str,
+) -> (f64, u32) {
+    let (mut t, mut s) = (0.0, 0u32);
+    while t < budget && s < max_spp {
+        let st = render::render(scene, it, film, s..s + 1, pool);
+        stats.merge(&st);
+        t += st.cpu_seconds;
+        s += 1;
+    }
+    if t < budget {
+        let note = format!(
+            "variant {variant}: the budget stopped at the max_spp cap ({max_spp} spp, {t:.3} of {budget} s); raise it with --limit max_spp=N"
+        );
+        if !notes.contains(&note) {
+            notes.push(note);
         }
     }
-    let svg = report::loglog_svg(&series, title, "CPU seconds (worker threads)", "RMSE", report::plot::RMSE_SLOPE);
-    for (name, text) in
-        [("rows.csv", report::to_csv(rows)), ("rows.json", json), ("table.md", md.clone()), ("error.svg", svg)]
-    {
-        let p: PathBuf = dir.join(name);
+    (t, s)
+}
+
+/// Marks variants whose every run at every step is bit-identical to an earlier variant's: they are
+/// not ranked (`same_as`), and a note names the flags that made no difference.
+fn mark_identical(
+    variants: &[Variant],
+    renders: &[Vec<Vec<u64>>],
+    steps: usize,
+    rows: &mut [Row],
+    notes: &mut Vec<String>,
+) {
+    for b in 1..variants.len() {
+        let Some(a) = (0..b).find(|&a| renders[a] == renders[b]) else { continue };
+        let (va, vb) = (&variants[a], &variants[b]);
+        for s in 0..steps {
+            rows[b * steps + s].same_as = Some(va.name.clone());
+        }
+        let only = |x: &Variant, y: &Variant| -> Vec<String> {
+            x.flags.iter().filter(|f| !y.flags.contains(f)).cloned().collect()
+        };
+        let diff: Vec<String> = only(vb, va).into_iter().chain(only(va, vb)).collect();
+        let what = if diff.is_empty() {
+            "their options have the same effect".to_string()
+        } else {
+            format!(
+                "flag {} has no effect on this integrator",
+                shlex::try_join(diff.iter().map(String::as_str)).unwrap_or_else(|_| diff.join(" "))
+            )
+        };
+        notes.push(format!("variants {} and {} render the same image: {what}; they are not ranked", va.name, vb.name));
+    }
+}
+
+/// Sets each row's efficiency ratio to the baseline's row at the same step (rows are grouped by
+/// variant, `steps` per variant); rows that render the baseline's image keep NaN and `same_as`.
+fn rank_against_baseline(rows: &mut [Row], baseline: &str, steps: usize) {
+    let Some(bi) = rows.iter().position(|r| r.variant == baseline) else { return };
+    let base: Vec<f64> = rows[bi..bi + steps].iter().map(|r| r.efficiency).collect();
+    for (i, r) in rows.iter_mut().enumerate() {
+        if r.same_as.is_none() {
+            r.eff_vs_baseline = r.efficiency / base[i % steps];
+        }
+    }
+}
+
+/// The fitted slopes of one variant from its per-run rows: RMSE with the reference's noise removed.
+fn convergence(variant: &str, runs: &[RunRow]) -> Convergence {
+    let mine: Vec<&RunRow> = runs.iter().filter(|r| r.variant == variant).collect();
+    let rmse = |r: &RunRow| r.mse_corrected.max(0.0).sqrt();
+    let spp: Vec<(f64, f64)> = mine.iter().filter(|r| r.step > 0).map(|r| (f64::from(r.spp), rmse(r))).collect();
+    let secs: Vec<(f64, f64)> = mine.iter().map(|r| (r.seconds, rmse(r))).collect();
+    // Equal-time runs all spend about the budget: no range of seconds to fit a slope over.
+    let (lo, hi) = secs.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    let vs_seconds = if hi > 1.5 * lo { loglog_slope(&secs) } else { None };
+    Convergence { variant: variant.into(), vs_spp: loglog_slope(&spp), vs_seconds }
+}
+
+/// Writes `rows.csv`, `rows.json`, `runs.csv`, `runs.json`, `table.md`, `error.svg` (RMSE against
+/// seconds with 95% error bars), `error-spp.svg` (RMSE against spp, ladders) and `report.html`
+/// into `dir`; `commands` are the command lines that reproduce it, said back in the report.
+/// Returns the Markdown table with the notes and slopes under it.
+pub fn write_outputs(c: &Comparison, dir: &Path, title: &str, commands: &[String]) -> Result<String, LabError> {
+    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
+    let mut md = report::to_markdown(&c.rows);
+    md += &super::report_page::slopes_markdown(&c.convergence);
+    for n in &c.notes {
+        md += &format!("\nNote: {n}\n");
+    }
+    let json = serde_json::to_string_pretty(&report::to_json(&c.rows))?;
+    let runs_json = serde_json::to_string_pretty(&c.runs)?;
+    let mut runs_csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(Vec::new());
+    for r in &c.runs {
+        runs_csv.serialize(r).map_err(|e| LabError::Io { path: dir.join("runs.csv"), source: e.into() })?;
+    }
+    let runs_csv = String::from_utf8(runs_csv.into_inner().unwrap_or_default()).unwrap_or_default();
+    let (svg_s, svg_spp) = super::report_page::compare_plots(c, title);
+    let html = super::report_page::compare_html(c, title, commands, &svg_s, &svg_spp);
+    let mut files = vec![
+        ("rows.csv", report::to_csv(&c.rows)),
+        ("rows.json", json),
+        ("runs.csv", runs_csv),
+        ("runs.json", runs_json),
+        ("table.md", md.clone()),
+        ("error.svg", svg_s),
+    ];
+    if let Some(s) = svg_spp {
+        files.push(("error-spp.svg", s));
+    }
+    files.push(("report.html", html));
+    for (name, text) in files {
+        let p = dir.join(name);
         film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
     }
     Ok(md)

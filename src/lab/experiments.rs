@@ -1,5 +1,6 @@
 //! `strata experiments`: the two seed experiments of the course report, regenerated into one folder
-//! (Markdown tables, JSON, PNG contact sheets, log-log SVG plots).
+//! (Markdown tables, JSON, log-log SVG plots, and `report.html`: flip-books of the images with
+//! error maps, through the page code of `strata compare`).
 //!
 //! - Direct lighting (hw2 sphere, cornell, dragon; 9 and 25 light samples; random, stratified,
 //!   grid-centre, Halton). The pixel position is fixed at the pixel centre (`--pixel-sampler
@@ -14,10 +15,12 @@
 //! sampler's cost (`sampler ns/sample`, `% in sampler`). Every number except these timings (and
 //! the equal-time spp derived from them) is a pure function of the configuration: seeds are fixed and renders are bit-identical whatever the thread count.
 
+use super::progress::Progress;
 use super::{io_err, LabError};
 use crate::film::{self, Film};
 use crate::render;
-use crate::report::{self, contact, g3, markdown_table, ReferenceInfo, ReportError, Row, RunStats, Series, Style};
+use crate::report::html::{self, box_downsample, Page, Section, Shot};
+use crate::report::{self, markdown_table, ReferenceInfo, ReportError, Row, RunStats, Series, Style};
 use crate::sampler::SamplerKind;
 use crate::scene::desc::ImportanceSampling;
 use crate::session::{self, RenderOptions};
@@ -43,7 +46,7 @@ pub struct Config {
     pub threads: usize,
     /// print progress on stderr
     pub verbose: bool,
-    /// contact-sheet tiles are the images box-downsampled by this factor (keeps the PNGs small)
+    /// the report's images are box-downsampled by this factor (keeps report.html small)
     pub sheet_factor: u32,
 }
 
@@ -88,6 +91,11 @@ pub struct Runs {
 
 /// [`runs`] with the phase profiler on (it never changes an image): also the sampler's cost.
 pub fn runs_profiled(opts: &RenderOptions, spp: u32, k: usize) -> Result<Runs, LabError> {
+    runs_counted(opts, spp, k, &mut |_| {})
+}
+
+/// [`runs_profiled`], calling `done(run)` after each run (progress).
+pub fn runs_counted(opts: &RenderOptions, spp: u32, k: usize, done: &mut dyn FnMut(usize)) -> Result<Runs, LabError> {
     let (scene, integ) = session::prepare(opts)?;
     let pool = render::thread_pool(opts.threads)?;
     let integ = integ.resampled(spp);
@@ -100,6 +108,7 @@ pub fn runs_profiled(opts: &RenderOptions, spp: u32, k: usize) -> Result<Runs, L
         let mut f = Film::new(scene.desc.width, scene.desc.height);
         all.merge(&render::render(&scene, &it, &mut f, 0..spp, &pool));
         images.push(f.mean());
+        done(run);
     }
     let p = session::profile::Profile::from_stats("", &all);
     Ok(Runs {
@@ -168,11 +177,6 @@ fn measure(variant: &str, r: &Runs, reference: &Reference, spp: u32) -> Result<R
     Ok(Row::new(variant, r.seconds, f64::from(spp), &stats)?.with_sampler(r.sampler_ns_per_sample, r.sampler_share))
 }
 
-/// The variance of the 8-bit values of a row (computed for every row of the experiments).
-fn variance_8bit(row: &Row) -> f64 {
-    row.stats.eight_bit.map_or(f64::NAN, |e| e.variance)
-}
-
 fn scene_opts(cfg: &Config, rel: &str, aspect: f64) -> RenderOptions {
     let h = ((f64::from(cfg.width) / aspect).round() as u32).max(1);
     RenderOptions {
@@ -191,8 +195,25 @@ fn log(cfg: &Config, msg: &str) {
     }
 }
 
-/// The direct-lighting experiment: returns its rows and writes `direct-*.png` and `direct.svg`.
-pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
+/// An image of the report, box-downsampled by the configured factor.
+fn shot(cfg: &Config, label: String, (w, h): (u32, u32), rgb: &[[f32; 3]]) -> (Shot, (u32, u32)) {
+    let (w, h, rgb) = box_downsample(w, h, rgb, cfg.sheet_factor);
+    (Shot { label, rgb }, (w, h))
+}
+
+/// One section of the report: its images and the rows it shows (`table`, and `scene` for the
+/// direct-lighting tables).
+pub struct ReportSection {
+    /// the images
+    pub section: Section,
+    /// the rows' `table`
+    pub table: String,
+    /// the rows' `scene` (direct lighting), empty for a path case
+    pub scene: String,
+}
+
+/// The direct-lighting experiment: returns its rows and report sections and writes `direct.svg`.
+pub fn direct(cfg: &Config, progress: &mut Progress) -> Result<(Vec<Row>, Vec<ReportSection>), LabError> {
     let kinds = [
         ("random", SamplerKind::INDEPENDENT),
         ("stratified", SamplerKind::STRATIFIED),
@@ -200,6 +221,7 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
         ("halton", SamplerKind::HALTON),
     ];
     let mut rows = Vec::new();
+    let mut sections = Vec::new();
     let mut series: Vec<Series> = Vec::new();
     for (name, rel, aspect) in [
         ("sphere", "hw2/sphere.test", 4.0 / 3.0),
@@ -217,35 +239,16 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
             light_samples: Some(cfg.ref_light_samples),
             ..base.clone()
         })?;
-        let (w, h) = reference.size;
-        let mut tiles = Vec::new();
+        let (refshot, (w, h)) =
+            shot(cfg, format!("reference (2x{} stratified)", cfg.ref_light_samples), reference.size, &reference.rgb);
+        let mut shots = Vec::new();
         for n in [9u32, 25] {
-            tiles.push(contact::tile_from_linear(
-                w,
-                h,
-                &reference.rgb,
-                cfg.sheet_factor,
-                reference.gamma,
-                vec!["reference".into(), format!("2x{} str", cfg.ref_light_samples)],
-            ));
             for (label, kind) in kinds {
-                log(cfg, &format!("direct {name}: {label} x{n}, {} runs", cfg.runs));
                 let o = RenderOptions { light_sampler: Some(kind), light_samples: Some(n), ..base.clone() };
-                let r = runs_profiled(&o, 1, cfg.runs)?;
+                let what = format!("direct {name} {label} x{n}");
+                let r = runs_counted(&o, 1, cfg.runs, &mut |_| progress.run_done(&what))?;
                 let st = measure(label, &r, &reference, 1)?.grouped("direct", name, format!("{n}"));
-                let imgs = r.images;
-                tiles.push(contact::tile_from_linear(
-                    w,
-                    h,
-                    &imgs[0],
-                    cfg.sheet_factor,
-                    reference.gamma,
-                    vec![
-                        format!("{} {n}", label.replace("grid-center", "grid-ctr")),
-                        format!("v8 {}", g3(variance_8bit(&st))),
-                        format!("rb {}", g3(st.stats.rms_bias)),
-                    ],
-                ));
+                shots.push(shot(cfg, format!("{label} {n}"), reference.size, &r.images[0]).0);
                 let sname = format!("{name} {label}");
                 let p = (f64::from(n), st.stats.mse.sqrt());
                 match series.iter_mut().find(|s| s.name == sname) {
@@ -255,10 +258,18 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
                 rows.push(st);
             }
         }
-        let sheet =
-            contact::layout(&tiles, 5, Some(&format!("hw2 {name}: direct lighting, pixel centre, K={}", cfg.runs)));
-        let p = cfg.out.join(format!("direct-{name}.png"));
-        contact::write_sheet(&p, &sheet).map_err(io_err(&p))?;
+        sections.push(ReportSection {
+            section: Section {
+                title: format!("hw2 {name}: direct lighting, pixel centre, K={}", cfg.runs),
+                width: w,
+                height: h,
+                reference: Some(refshot),
+                shots,
+                blocks: Vec::new(),
+            },
+            table: "direct".into(),
+            scene: name.into(),
+        });
     }
     let svg = report::loglog_svg(
         &series,
@@ -269,7 +280,12 @@ pub fn direct(cfg: &Config) -> Result<Vec<Row>, LabError> {
     );
     let p = cfg.out.join("direct.svg");
     film::write_atomic(&p, svg.as_bytes()).map_err(io_err(&p))?;
-    Ok(rows)
+    if let Some(last) = sections.last_mut() {
+        last.section
+            .blocks
+            .push(format!("<h3>All scenes: RMSE against light samples</h3>\n{}", html::inline_svg(&svg)));
+    }
+    Ok((rows, sections))
 }
 
 /// One path-tracing comparison: a baseline and a candidate at `spp` (and a ladder for the plot).
@@ -283,8 +299,21 @@ struct PathCase {
     ladder: &'static [u32],
 }
 
-/// The path-tracing experiment: returns its rows and writes `path-*.png` and `path-*.svg`.
-pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
+/// The number of runs the path-tracing experiment renders before its equal-time steps (progress).
+fn path_runs(cases: &[PathCase], k: usize) -> usize {
+    cases
+        .iter()
+        .map(|c| {
+            let mut l: Vec<u32> = c.ladder.iter().copied().chain([c.spp]).collect();
+            l.sort_unstable();
+            l.dedup();
+            2 * l.len() * k
+        })
+        .sum()
+}
+
+/// The path-tracing experiment: returns its rows and report sections and writes `path-*.svg`.
+pub fn path(cfg: &Config, progress: &mut Progress) -> Result<(Vec<Row>, Vec<ReportSection>), LabError> {
     let nee = scene_opts(cfg, "hw3/cornellNEE.test", 1.0);
     let brdf = scene_opts(cfg, "hw4/cornellBRDF.test", 1.0);
     let is = |o: &RenderOptions, s| RenderOptions { importance_sampling: Some(s), ..o.clone() };
@@ -339,7 +368,9 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             ladder: &[2, 5, 10, 20],
         },
     ];
+    progress.add(path_runs(&cases, cfg.runs));
     let mut rows = Vec::new();
+    let mut sections = Vec::new();
     let mut refs: Vec<(RenderOptions, Reference)> = Vec::new();
     for case in &cases {
         let ro = RenderOptions { spp: Some(cfg.ref_spp), ..case.reference.clone() };
@@ -354,15 +385,8 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             }
         };
         let reference = &refs[ri].1;
-        let (w, h) = reference.size;
-        let mut tiles = vec![contact::tile_from_linear(
-            w,
-            h,
-            &reference.rgb,
-            cfg.sheet_factor,
-            reference.gamma,
-            vec!["reference".into(), format!("{} spp", cfg.ref_spp)],
-        )];
+        let (refshot, (w, h)) = shot(cfg, format!("reference ({} spp)", cfg.ref_spp), reference.size, &reference.rgb);
+        let mut shots = Vec::new();
         let mut series = Vec::new();
         let mut main: Vec<Row> = Vec::new();
         for (label, o) in &case.variants {
@@ -372,24 +396,12 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
             ladder.dedup();
             let mut points = Vec::new();
             for s in ladder {
-                log(cfg, &format!("path {}: {label} {s} spp, {} runs", case.key, cfg.runs));
-                let r = runs_profiled(o, s, cfg.runs)?;
+                let what = format!("path {} {label} {s} spp", case.key);
+                let r = runs_counted(o, s, cfg.runs, &mut |_| progress.run_done(&what))?;
                 let st = measure(label, &r, reference, s)?;
                 points.push((r.seconds, st.stats.mse.sqrt()));
-                let imgs = r.images;
                 if s == spp {
-                    tiles.push(contact::tile_from_linear(
-                        w,
-                        h,
-                        &imgs[0],
-                        cfg.sheet_factor,
-                        reference.gamma,
-                        vec![
-                            format!("{label} {s}"),
-                            format!("var {}", g3(st.stats.variance)),
-                            format!("z {:.2}", st.stats.z),
-                        ],
-                    ));
+                    shots.push(shot(cfg, format!("{label} {s} spp"), reference.size, &r.images[0]).0);
                     main.push(st);
                 }
             }
@@ -405,29 +417,22 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
         let per_spp = main[fast].seconds / main[fast].spp;
         let eq_spp = ((budget / per_spp).round() as u32).max(1);
         let (label, o) = &case.variants[fast];
-        log(cfg, &format!("path {}: equal time, {label} at {eq_spp} spp", case.key));
-        let eq = if f64::from(eq_spp) == main[fast].spp { None } else { Some(runs_profiled(o, eq_spp, cfg.runs)?) };
+        let eq = if f64::from(eq_spp) == main[fast].spp {
+            None
+        } else {
+            progress.add(cfg.runs);
+            let what = format!("path {} equal time: {label} {eq_spp} spp", case.key);
+            Some(runs_counted(o, eq_spp, cfg.runs, &mut |_| progress.run_done(&what))?)
+        };
         let st = match &eq {
             None => main[fast].clone(),
             Some(r) => measure(label, r, reference, eq_spp)?,
         };
-        let imgs = eq.map(|r| r.images).unwrap_or_default();
-        if !imgs.is_empty() {
-            tiles.push(contact::tile_from_linear(
-                w,
-                h,
-                &imgs[0],
-                cfg.sheet_factor,
-                reference.gamma,
-                vec![format!("{label} {eq_spp}"), "equal time".into(), format!("var {}", g3(st.stats.variance))],
-            ));
+        if let Some(r) = &eq {
+            shots.push(shot(cfg, format!("{label} {eq_spp} spp (equal time)"), reference.size, &r.images[0]).0);
         }
         rows.push(main[slow].clone().grouped(case.key, case.scene, "equal time"));
         rows.push(st.grouped(case.key, case.scene, "equal time"));
-        let sheet =
-            contact::layout(&tiles, tiles.len(), Some(&format!("{}: {}, K={}", case.scene, case.title, cfg.runs)));
-        let p = cfg.out.join(format!("path-{}.png", case.key));
-        contact::write_sheet(&p, &sheet).map_err(io_err(&p))?;
         let svg = report::loglog_svg(
             &series,
             &format!("{}: {}", case.scene, case.title),
@@ -437,11 +442,23 @@ pub fn path(cfg: &Config) -> Result<Vec<Row>, LabError> {
         );
         let p = cfg.out.join(format!("path-{}.svg", case.key));
         film::write_atomic(&p, svg.as_bytes()).map_err(io_err(&p))?;
+        sections.push(ReportSection {
+            section: Section {
+                title: format!("{}: {} (`{}`), K={}", case.scene, case.title, case.key, cfg.runs),
+                width: w,
+                height: h,
+                reference: Some(refshot),
+                shots,
+                blocks: vec![format!("<h3>RMSE against CPU seconds</h3>\n{}", html::inline_svg(&svg))],
+            },
+            table: case.key.into(),
+            scene: String::new(),
+        });
     }
-    Ok(rows)
+    Ok((rows, sections))
 }
 
-/// Runs both experiments and writes `results.md`, `results.json`, the contact sheets and plots into
+/// Runs both experiments and writes `results.md`, `results.json`, `report.html` and the plots into
 /// `cfg.out`.
 pub fn run(cfg: &Config) -> Result<String, LabError> {
     if cfg.runs < 2 {
@@ -451,15 +468,79 @@ pub fn run(cfg: &Config) -> Result<String, LabError> {
         return Err(LabError::NoCorpus(cfg.corpus.clone()));
     }
     std::fs::create_dir_all(&cfg.out).map_err(io_err(&cfg.out))?;
-    let mut rows = direct(cfg)?;
-    rows.extend(path(cfg)?);
+    let mut progress = Progress::new("experiments", 3 * 2 * 4 * cfg.runs, cfg.verbose);
+    let (mut rows, mut sections) = direct(cfg, &mut progress)?;
+    let (path_rows, path_sections) = path(cfg, &mut progress)?;
+    rows.extend(path_rows);
+    sections.extend(path_sections);
     let md = markdown(&rows, cfg.runs, cfg.width, cfg.sheet_factor);
     let json = serde_json::to_string_pretty(&report::to_grouped_json(&rows))?;
-    for (name, text) in [("results.md", &md), ("results.json", &json)] {
+    let page = report_page(cfg, &rows, sections);
+    for (name, text) in [("results.md", &md), ("results.json", &json), ("report.html", &page)] {
         let p: PathBuf = cfg.out.join(name);
         film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
     }
     Ok(md)
+}
+
+/// The (table, scene, setting) blocks of `rows`, in order: the rows of one Markdown/HTML table each.
+fn groups(rows: &[Row]) -> Vec<&[Row]> {
+    let key = |r: &Row| (r.table.clone(), r.scene.clone(), r.setting.clone());
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < rows.len() {
+        let j = (i..rows.len()).find(|&j| key(&rows[j]) != key(&rows[i])).unwrap_or(rows.len());
+        out.push(&rows[i..j]);
+        i = j;
+    }
+    out
+}
+
+/// The heading of a table of rows.
+fn heading(r0: &Row) -> String {
+    if r0.table == "direct" {
+        format!("Direct lighting, hw2 {}, {} light samples", r0.scene, r0.setting)
+    } else {
+        format!("{} `{}`, {}", r0.scene, r0.table, r0.setting)
+    }
+}
+
+/// `report.html` of the experiments: one section per scene or case, its tables under its images.
+fn report_page(cfg: &Config, rows: &[Row], sections: Vec<ReportSection>) -> String {
+    let mut out = Vec::new();
+    for mut rs in sections {
+        for g in groups(rows)
+            .into_iter()
+            .filter(|g| g[0].table == rs.table && (rs.scene.is_empty() || g[0].scene == rs.scene))
+        {
+            let table = report::html_table(report::table::EXPERIMENT_COLUMNS, g);
+            rs.section
+                .blocks
+                .insert(rs.section.blocks.len().min(2), format!("<h3>{}</h3>\n{table}", html::escape(&heading(&g[0]))));
+        }
+        out.push(rs.section);
+    }
+    let command = format!(
+        "strata experiments --out {} --corpus {} --runs {} --width {} --ref-light-samples {} --ref-spp {} --sheet-factor {}",
+        cfg.out.display(),
+        cfg.corpus.display(),
+        cfg.runs,
+        cfg.width,
+        cfg.ref_light_samples,
+        cfg.ref_spp,
+        cfg.sheet_factor
+    );
+    html::page_html(&Page {
+        title: "strata experiments: the seed experiments".into(),
+        intro: format!(
+            "<p>K = {} runs per variant, images {} pixels wide (shown box-downsampled by {}). Images are run 1 of each \
+             variant; error maps compare it with the reference. Column meanings: see results.md.</p>",
+            cfg.runs, cfg.width, cfg.sheet_factor
+        ),
+        sections: out,
+        blocks: Vec::new(),
+        commands: vec![command],
+    })
 }
 
 /// `results.md`: the Markdown tables of `rows` (K = `runs`, images `width` wide, sheets
@@ -480,41 +561,15 @@ pub fn markdown(rows: &[Row], runs: usize, width: u32, sheet_factor: u32) -> Str
          per camera sample and as a share of the profiled render time.\n",
         runs, width
     );
-    let (mut i, mut shown) = (0, Vec::<String>::new());
-    while i < rows.len() {
-        let r0 = &rows[i];
-        let group = |r: &Row| (r.table.clone(), r.scene.clone(), r.setting.clone());
-        let g0 = group(r0);
-        let mut j = i;
-        while j < rows.len() && group(&rows[j]) == g0 {
-            j += 1;
-        }
-        let (head, sheet) = if r0.table == "direct" {
-            (
-                format!("## Direct lighting, hw2 {}, {} light samples", r0.scene, r0.setting),
-                format!("direct-{}.png", r0.scene),
-            )
-        } else {
-            (format!("## {} `{}`, {}", r0.scene, r0.table, r0.setting), format!("path-{}.png", r0.table))
-        };
-        let _ = writeln!(md, "{head}\n");
-        if !shown.contains(&sheet) {
-            let caption = if r0.table == "direct" {
-                "Tiles: the reference, then run 1 of random, stratified, grid-center, halton; top row 9, bottom row 25 light \
-                 samples (`v8` = var8, `rb` = rms bias)."
-            } else {
-                "Tiles: the reference, then run 1 of each technique at equal spp, then the faster one at equal time."
-            };
-            let _ = writeln!(
-                md,
-                "![{sheet}]({sheet})\n\n{caption} Images box-downsampled by {} for the sheet.\n",
-                sheet_factor
-            );
-            shown.push(sheet);
-        }
-        md += &markdown_table(report::table::EXPERIMENT_COLUMNS, &rows[i..j], Style::Plain);
+    let _ = writeln!(
+        md,
+        "Images, error maps (relative squared error, signed error, FLIP) and these tables side by side: \
+         [report.html](report.html) (one self-contained page; images box-downsampled by {sheet_factor}).\n"
+    );
+    for g in groups(rows) {
+        let _ = writeln!(md, "## {}\n", heading(&g[0]));
+        md += &markdown_table(report::table::EXPERIMENT_COLUMNS, g, Style::Plain);
         md.push('\n');
-        i = j;
     }
     md
 }

@@ -3,10 +3,16 @@
 //! - [`compare`] — `strata compare` (variants against a reference, equal spp or equal time);
 //! - [`experiments`] — `strata experiments` (the seed experiments of the course report).
 
+pub mod checks;
 pub mod compare;
 pub mod experiments;
+pub mod progress;
+pub mod report_page;
 
-pub use compare::{compare, compare_profiled, write_outputs, Mode, Variant, VariantProfile};
+pub use compare::{
+    compare, compare_profiled, run, write_outputs, Comparison, Convergence, Mode, Options, RunRow, Variant,
+    VariantProfile,
+};
 
 use crate::report::ReportError;
 use crate::session::SessionError;
@@ -24,20 +30,41 @@ pub enum LabError {
         /// the reason given after the message, if any
         why: &'static str,
     },
-    /// A variant's image size differs from the reference's.
-    #[error("variant {variant}: image {w}x{h} but the reference is {rw}x{rh} (use --size)")]
-    SizeMismatch {
-        /// the variant
-        variant: String,
-        /// its width
-        w: u32,
-        /// its height
-        h: u32,
-        /// the reference's width
-        rw: u32,
-        /// the reference's height
-        rh: u32,
+    /// The reference is not of the variants' scene, size or camera.
+    #[error("{}: not a reference for this comparison: {diffs}{hint}", reference.display())]
+    ReferenceMismatch {
+        /// the reference file
+        reference: PathBuf,
+        /// what differs, naming both sides
+        diffs: String,
+        /// how to override, when that is possible
+        hint: &'static str,
     },
+    /// A variant is refused (its name, or a flag `compare` owns).
+    #[error("--variant {variant}: {why}")]
+    BadVariant {
+        /// the variant's name
+        variant: String,
+        /// why
+        why: String,
+    },
+    /// No variant was given.
+    #[error("give at least one --variant NAME=FLAGS")]
+    NoVariants,
+    /// `--baseline` names no variant.
+    #[error("--baseline {name}: no such variant (variants: {names})")]
+    UnknownBaseline {
+        /// the name given
+        name: String,
+        /// the variants' names
+        names: String,
+    },
+    /// An empty ladder or a zero step.
+    #[error("--spp-ladder: expected positive spp values")]
+    BadLadder,
+    /// A budget that is not a positive number of seconds.
+    #[error("--budget {0}: expected a positive number of seconds")]
+    BadBudget(f64),
     /// A variant's statistics could not be computed.
     #[error("variant {variant}: {source}")]
     VariantStats {

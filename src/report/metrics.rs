@@ -31,6 +31,25 @@ pub fn rel_mse(img: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, ReportEr
     Ok(error_means(img, reference).rel)
 }
 
+/// The errors of one image against a reference: mean signed error, MSE and relative MSE.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ImageError {
+    /// mean over values of `v - r`
+    pub mean: f64,
+    /// mean over values of `(v - r)^2`
+    pub mse: f64,
+    /// mean over values of `(v - r)^2 / (r + 0.01)^2` ([`rel_mse`])
+    pub rel_mse: f64,
+}
+
+/// [`ImageError`] of `img` against `reference` (validated as [`mse`] does), in one pass.
+pub fn image_error(img: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<ImageError, ReportError> {
+    check_reference(reference)?;
+    check_image(img, "image", reference.len())?;
+    let e = error_means(img, reference);
+    Ok(ImageError { mean: e.err, mse: e.sq, rel_mse: e.rel })
+}
+
 /// Monte Carlo efficiency `1 / (mse * seconds)`. A zero product (zero error or zero time) gives
 /// `f64::INFINITY`; a NaN, infinite or negative argument is an error, so the result is never NaN.
 pub fn efficiency(mse: f64, seconds: f64) -> Result<f64, ReportError> {
@@ -80,7 +99,9 @@ pub struct EightBit {
 /// - `rms_bias = sqrt(max(0, mean_i (m[i] - r[i])^2 - variance / K - mean_i v[i]))`, the root mean
 ///   squared per-value bias with the noise of the runs and of the reference removed,
 /// - `bias_ratio = mean_i (m[i] - r[i])^2 / (variance / K + mean_i v[i])`: about 1 for an
-///   unbiased technique (infinite when the denominator is 0).
+///   unbiased technique (infinite when the denominator is 0),
+/// - `ref_variance = mean_i v[i]`, and the noise-corrected MSE `mse - ref_variance`
+///   ([`RunStats::mse_corrected`]).
 ///
 /// Algebraically `mse = bias_sq + variance` exactly (per value,
 /// `mean_k (x - r)^2 = (m - r)^2 + (K - 1)/K * s^2`); [`RunStats::decomposition_residual`]
@@ -111,6 +132,8 @@ pub struct RunStats {
     pub rel_mse: f64,
     /// the variance and MSE of the 8-bit gamma-encoded values, when a gamma was given
     pub eight_bit: Option<EightBit>,
+    /// mean over values of the reference's own variance (0 for an exact reference)
+    pub ref_variance: f64,
 }
 
 impl RunStats {
@@ -182,6 +205,7 @@ impl RunStats {
             mse: over_runs(|e| e.sq),
             rel_mse: over_runs(|e| e.rel),
             eight_bit: info.gamma.map(|_| EightBit { variance: var8_sum / (kf - 1.0) / m, mse: sq8_sum / kf / m }),
+            ref_variance: ref_var / m,
         };
         stats.bias_ci = stats.bias_ci_at(0.95);
         Ok(stats)
@@ -194,6 +218,12 @@ impl RunStats {
     pub fn bias_ci_at(&self, level: f64) -> (f64, f64) {
         let half = student_t_quantile(0.5 + 0.5 * level, (self.runs - 1) as f64) * self.bias_se;
         (self.bias - half, self.bias + half)
+    }
+
+    /// The MSE with the reference's own noise removed: `mse - ref_variance`. A noisy reference adds
+    /// its variance to every run's expected squared error; this is the MSE against the exact image.
+    pub fn mse_corrected(&self) -> f64 {
+        self.mse - self.ref_variance
     }
 
     /// `mse - (bias_sq + variance)`: zero up to rounding, since the identity is exact.
@@ -246,93 +276,13 @@ fn check_image(img: &[[f32; 3]], name: &str, pixels: usize) -> Result<(), Report
 }
 
 /// Quantile of Student's t distribution: the `t` with `P(T <= t) = p` for `dof` degrees of freedom
-/// (`dof` need not be an integer; values above [`MAX_DOF`] are evaluated at `MAX_DOF`). Found by
-/// bisection on the exact CDF `P(|T| > t) = I(dof / (dof + t^2); dof/2, 1/2)` (regularized
-/// incomplete beta), accurate to about 1e-9 relative.
+/// (`dof` need not be an integer; values above [`MAX_DOF`] are evaluated at `MAX_DOF`), from
+/// `statrs` (its inverse CDF over the regularized incomplete beta function).
 ///
 /// # Panics
 /// If `p` is not strictly between 0 and 1 or `dof` is not positive.
 pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
-    assert!(p > 0.0 && p < 1.0 && dof > 0.0, "student_t_quantile: need 0 < p < 1 and dof > 0, got p={p}, dof={dof}");
-    if p < 0.5 {
-        return -student_t_quantile(1.0 - p, dof);
-    }
-    let dof = dof.min(MAX_DOF);
-    let tail = 2.0 * (1.0 - p); // target P(|T| > t), decreasing in t
-    let two_tail = |t: f64| inc_beta(0.5 * dof, 0.5, dof / (dof + t * t));
-    let (mut lo, mut hi) = (0.0, 1.0);
-    while two_tail(hi) > tail {
-        (lo, hi) = (hi, 2.0 * hi);
-    }
-    while hi - lo > 1e-12 * hi {
-        let mid = 0.5 * (lo + hi);
-        if two_tail(mid) > tail {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
-/// Regularized incomplete beta function `I_x(a, b)` for `a, b > 0`, by its continued fraction,
-/// evaluated on the side of the symmetry `I_x(a, b) = 1 - I_{1-x}(b, a)` where it converges fast.
-fn inc_beta(a: f64, b: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    let front = (a * x.ln() + b * (1.0 - x).ln() - ln_gamma(a) - ln_gamma(b) + ln_gamma(a + b)).exp();
-    if x < (a + 1.0) / (a + b + 2.0) {
-        front * beta_fraction(a, b, x) / a
-    } else {
-        1.0 - front * beta_fraction(b, a, 1.0 - x) / b
-    }
-}
-
-/// The continued fraction `1 / (1 + d1 / (1 + d2 / (1 + ...)))` of the incomplete beta function,
-/// with `d(2m+1) = -(a+m)(a+b+m)x / ((a+2m)(a+2m+1))` and `d(2m) = m(b-m)x / ((a+2m-1)(a+2m))`,
-/// evaluated front to back with the modified Lentz method.
-fn beta_fraction(a: f64, b: f64, x: f64) -> f64 {
-    const TINY: f64 = 1e-300;
-    let guard = |v: f64| if v.abs() < TINY { TINY } else { v };
-    // Lentz on f = 0 + 1/(1 + d1/(1 + d2/(...))): partial numerators 1, d1, d2, ...
-    let (mut f, mut c, mut d) = (TINY, TINY, 0.0);
-    for j in 0..100_000u32 {
-        let numerator = if j == 0 {
-            1.0
-        } else {
-            let m = (j / 2) as f64;
-            if j % 2 == 1 {
-                -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
-            } else {
-                m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m))
-            }
-        };
-        d = 1.0 / guard(1.0 + numerator * d);
-        c = guard(1.0 + numerator / c);
-        f *= c * d;
-        if (c * d - 1.0).abs() < 1e-15 {
-            break;
-        }
-    }
-    f
-}
-
-/// `ln Γ(x)` for `x > 0`: Stirling's series at `x >= 10`, shifted there by `Γ(x+1) = x Γ(x)`
-/// (absolute error below 1e-12).
-fn ln_gamma(x: f64) -> f64 {
-    let (mut x, mut shift) = (x, 0.0);
-    while x < 10.0 {
-        shift += x.ln();
-        x += 1.0;
-    }
-    let inv = 1.0 / x;
-    let inv2 = inv * inv;
-    let series = inv * (1.0 / 12.0 - inv2 * (1.0 / 360.0 - inv2 * (1.0 / 1260.0 - inv2 / 1680.0)));
-    (x - 0.5) * x.ln() - x + 0.5 * (2.0 * std::f64::consts::PI).ln() + series - shift
+    super::slope::t_quantile(p, dof)
 }
 
 #[cfg(test)]

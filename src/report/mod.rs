@@ -11,17 +11,23 @@
 //!   CSV, JSON) over column lists, for both commands.
 //! - [`plot`]: a self-contained log-log SVG of error against time with a convergence-rate guide.
 //! - [`bars`]: a stacked bar chart SVG (the phases of `strata profile`, one bar per variant).
+//! - [`flip`]: FLIP error maps and means (LDR, through `nv-flip`).
+//! - [`html`]: the self-contained `report.html` (flip-books, error maps, tables, plots).
+//! - [`slope`]: fitted log-log convergence slopes with a Student-t interval.
 
 pub mod bars;
-pub mod contact;
+pub mod flip;
+pub mod html;
 pub mod metrics;
 pub mod plot;
+pub mod slope;
 pub mod table;
 
 pub use bars::{stacked_bars_svg, Bar};
 pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, EightBit, ReferenceInfo, RunStats};
-pub use plot::{loglog_svg, LogScale, Series};
-pub use table::{g3, markdown_table, to_csv, to_grouped_json, to_json, to_markdown, Column, Row, Style};
+pub use plot::{loglog_svg, loglog_svg_annotated, Annotation, LogScale, Series};
+pub use slope::{loglog_slope, Slope};
+pub use table::{g3, html_table, markdown_table, to_csv, to_grouped_json, to_json, to_markdown, Column, Row, Style};
 
 use std::fmt;
 

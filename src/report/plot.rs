@@ -71,6 +71,27 @@ const LEGEND_X: f64 = 580.0;
 /// left out (with a comment) when the first series has no plottable point or the slope is not
 /// finite. Axes span whole decades covering all plottable points.
 pub fn loglog_svg(series: &[Series], title: &str, x_label: &str, y_label: &str, guide_slope: f64) -> String {
+    loglog_svg_annotated(series, &[], title, x_label, y_label, guide_slope)
+}
+
+/// What is drawn at each point of a series besides its marker, index-aligned with its points.
+#[derive(Clone, Debug, Default)]
+pub struct Annotation {
+    /// a vertical error bar from `lo` to `hi` per point (a non-positive `lo` is drawn to the axis)
+    pub y_range: Vec<(f64, f64)>,
+    /// a text label per point (e.g. its spp)
+    pub labels: Vec<String>,
+}
+
+/// [`loglog_svg`] with error bars and point labels: `annotations[i]` belongs to `series[i]`.
+pub fn loglog_svg_annotated(
+    series: &[Series],
+    annotations: &[Annotation],
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    guide_slope: f64,
+) -> String {
     let plottable = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0;
     let kept: Vec<Vec<(f64, f64)>> =
         series.iter().map(|s| s.points.iter().copied().filter(plottable).collect()).collect();
@@ -148,12 +169,35 @@ pub fn loglog_svg(series: &[Series], title: &str, x_label: &str, y_label: &str, 
         put("<!-- no guide line: the first series has no plottable point or the slope is not finite -->\n".into());
     }
 
-    for (i, (s, points)) in series.iter().zip(&kept).enumerate() {
+    for (i, s) in series.iter().enumerate() {
         let colour = colour(i);
         let mut coords = String::new();
         let mut markers = String::new();
-        for &(x, y) in points {
+        let ann = annotations.get(i);
+        for (j, &(x, y)) in s.points.iter().enumerate().filter(|(_, p)| plottable(p)) {
             let (px, py) = (xs.map(x), ys.map(y));
+            if let Some(&(lo, hi)) = ann.and_then(|a| a.y_range.get(j)) {
+                let clamp = |v: f64| if v > 0.0 && v.is_finite() { ys.map(v).clamp(TOP, BOTTOM) } else { BOTTOM };
+                let (a, b) = (clamp(lo), clamp(hi));
+                let _ = writeln!(
+                    markers,
+                    "<line class=\"error-bar\" x1=\"{px:.2}\" y1=\"{a:.2}\" x2=\"{px:.2}\" y2=\"{b:.2}\" stroke=\"{colour}\" stroke-width=\"1.5\"/>\n\
+                     <line x1=\"{:.2}\" y1=\"{a:.2}\" x2=\"{:.2}\" y2=\"{a:.2}\" stroke=\"{colour}\"/><line x1=\"{:.2}\" y1=\"{b:.2}\" x2=\"{:.2}\" y2=\"{b:.2}\" stroke=\"{colour}\"/>",
+                    px - 4.0,
+                    px + 4.0,
+                    px - 4.0,
+                    px + 4.0
+                );
+            }
+            if let Some(label) = ann.and_then(|a| a.labels.get(j)) {
+                let _ = writeln!(
+                    markers,
+                    "<text class=\"point-label\" x=\"{:.2}\" y=\"{:.2}\" font-size=\"10\" fill=\"{colour}\">{}</text>",
+                    px + 5.0,
+                    py - 5.0,
+                    escape(label)
+                );
+            }
             let sep = if coords.is_empty() { "" } else { " " };
             let _ = write!(coords, "{sep}{px:.2},{py:.2}");
             let _ = writeln!(markers, "<circle cx=\"{px:.2}\" cy=\"{py:.2}\" r=\"3.5\" fill=\"{colour}\"/>");

@@ -32,6 +32,15 @@ pub struct Row {
     pub sampler_ns_per_sample: f64,
     /// fraction of the profiled render time spent in sample generation; NaN when not profiled
     pub sampler_share: f64,
+    /// where pixel sample 0 went (`centre` or `jittered`); empty when not recorded
+    pub first_sample: String,
+    /// mean over runs of the mean FLIP error against the reference (LDR, sRGB); NaN when not computed
+    pub flip: f64,
+    /// efficiency over the baseline variant's at the same spp step (`strata compare --baseline`);
+    /// NaN when not compared or when the two render the same image ([`Row::same_as`])
+    pub eff_vs_baseline: f64,
+    /// the variant that rendered bit-identical images (then the two are not ranked)
+    pub same_as: Option<String>,
 }
 
 impl Row {
@@ -48,6 +57,10 @@ impl Row {
             efficiency: efficiency(stats.mse, seconds)?,
             sampler_ns_per_sample: f64::NAN,
             sampler_share: f64::NAN,
+            first_sample: String::new(),
+            flip: f64::NAN,
+            eff_vs_baseline: f64::NAN,
+            same_as: None,
         })
     }
 
@@ -132,25 +145,35 @@ pub fn markdown_table(columns: &[Column], rows: &[Row], style: Style) -> String 
     out
 }
 
-/// CSV (RFC 4180) of `rows` under `columns`: the headers, then one line per row; a cell with a
-/// comma, quote or line break is quoted.
-pub fn csv_table(columns: &[Column], rows: &[Row]) -> String {
-    let header: Vec<&str> = columns.iter().map(|c| c.header).collect();
-    let mut out = format!("{}\n", header.join(","));
-    for row in cells(columns, rows) {
-        let row: Vec<String> = row.iter().map(|c| csv_field(c)).collect();
-        out += &row.join(",");
-        out.push('\n');
+/// An HTML `<table>` of `rows` under `columns` (ratio columns against the first row), escaped.
+pub fn html_table(columns: &[Column], rows: &[Row]) -> String {
+    let esc = |s: &str| super::html::escape(&s.replace("\\|", "|"));
+    let mut out = String::from("<table>\n<tr>");
+    for c in columns {
+        out += &format!("<th>{}</th>", esc(c.header));
     }
-    out
+    out += "</tr>\n";
+    for row in cells(columns, rows) {
+        out += "<tr>";
+        for c in row {
+            out += &format!("<td>{}</td>", esc(&c));
+        }
+        out += "</tr>\n";
+    }
+    out + "</table>\n"
 }
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
+/// CSV (RFC 4180, the `csv` crate) of `rows` under `columns`: the headers, then one line per
+/// row; a cell with a comma, quote or line break is quoted.
+pub fn csv_table(columns: &[Column], rows: &[Row]) -> String {
+    let mut w = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(Vec::new());
+    let header: Vec<&str> = columns.iter().map(|c| c.header).collect();
+    // Writing into a Vec cannot fail.
+    let _ = w.write_record(&header);
+    for row in cells(columns, rows) {
+        let _ = w.write_record(&row);
     }
+    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
 }
 
 /// A number in the shortest form that parses back to the same f64 (`1.5e-3`; `inf`/`NaN`).
@@ -211,37 +234,58 @@ pub const CSV_COLUMNS: &[Column] = &[
     Column { header: "efficiency", cell: |r, _| exact(r.efficiency) },
     Column { header: "sampler_ns_per_sample", cell: |r, _| exact(r.sampler_ns_per_sample) },
     Column { header: "sampler_share", cell: |r, _| exact(r.sampler_share) },
+    Column { header: "first_sample", cell: |r, _| r.first_sample.clone() },
+    Column { header: "mse_corrected", cell: |r, _| exact(r.stats.mse_corrected()) },
+    Column { header: "flip", cell: |r, _| exact(r.flip) },
+    Column { header: "eff_vs_baseline", cell: |r, _| exact(r.eff_vs_baseline) },
+    Column { header: "same_as", cell: |r, _| r.same_as.clone().unwrap_or_default() },
 ];
 
 /// The CSV header written by [`to_csv`]; `bias_ci` is split into two columns. `seconds` is the
 /// workers' CPU seconds of one run; `sampler_share` a fraction (0..1), NaN when not profiled.
-pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share";
+/// `mse_corrected` is the MSE less the reference's own variance, `flip` the mean FLIP,
+/// `eff_vs_baseline` the efficiency over the baseline's at the same spp step, `same_as` the
+/// variant that rendered the same images.
+pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share,first_sample,mse_corrected,flip,eff_vs_baseline,same_as";
+
+/// Samples per pixel as an integer when it is one (ladders), else with one decimal (the mean over
+/// the runs of an equal-time budget).
+fn spp_cell(spp: f64) -> String {
+    if spp.fract() == 0.0 {
+        format!("{spp:.0}")
+    } else {
+        format!("{spp:.1}")
+    }
+}
+
+/// The efficiency ratio to the baseline: `=NAME` for a variant that renders the baseline's (or
+/// another variant's) image, `n/a` when undefined.
+fn vs_baseline(r: &Row) -> String {
+    match (&r.same_as, r.eff_vs_baseline) {
+        (Some(other), _) => format!("same image as {other}"),
+        (None, x) if x.is_finite() => format!("{x:.2}x"),
+        _ => "n/a".into(),
+    }
+}
 
 /// The columns of `table.md` of `strata compare` ([`to_markdown`]).
 pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "variant", cell: |r, _| r.variant.replace('|', "\\|") },
     Column { header: "samplers", cell: |r, _| r.setting.replace('|', "\\|") },
-    Column { header: "seconds", cell: |r, _| sci(r.seconds) },
-    Column { header: "spp", cell: |r, _| sci(r.spp) },
+    Column { header: "first sample", cell: |r, _| r.first_sample.clone() },
+    Column { header: "spp", cell: |r, _| spp_cell(r.spp) },
+    Column { header: "CPU s/run", cell: |r, _| g3(r.seconds) },
     Column { header: "sampler ns/sample", cell: |r, _| ns1(r.sampler_ns_per_sample) },
     Column { header: "% of render in sampler", cell: |r, _| pct1(r.sampler_share) },
     Column { header: "MSE", cell: |r, _| sci(r.stats.mse) },
+    Column { header: "MSE - ref. var.", cell: |r, _| sci(r.stats.mse_corrected()) },
     Column { header: "relMSE", cell: |r, _| sci(r.stats.rel_mse) },
+    Column { header: "FLIP", cell: |r, _| if r.flip.is_finite() { format!("{:.4}", r.flip) } else { "n/a".into() } },
     Column { header: "bias", cell: |r, _| sci(r.stats.bias) },
     Column { header: "bias 95% CI", cell: |r, _| format!("[{}, {}]", sci(r.stats.bias_ci.0), sci(r.stats.bias_ci.1)) },
     Column { header: "variance", cell: |r, _| sci(r.stats.variance) },
-    Column { header: "efficiency", cell: |r, _| sci(r.efficiency) },
-    Column {
-        header: "eff. vs first",
-        cell: |r, first| {
-            let ratio = r.efficiency / first.efficiency;
-            if ratio.is_nan() {
-                "n/a".into()
-            } else {
-                sci(ratio)
-            }
-        },
-    },
+    Column { header: "efficiency 1/(MSE s)", cell: |r, _| sci(r.efficiency) },
+    Column { header: "eff. vs baseline, same spp", cell: |r, _| vs_baseline(r) },
 ];
 
 /// The columns of each table of `results.md` of `strata experiments`; ratios are to the first row
@@ -273,9 +317,10 @@ pub fn to_csv(rows: &[Row]) -> String {
     csv_table(CSV_COLUMNS, rows)
 }
 
-/// The aligned Markdown table of `strata compare` ([`COMPARE_COLUMNS`]). Numbers are in
-/// scientific notation with 3 significant digits; the last column is each row's efficiency divided
-/// by the first row's (`n/a` where that ratio is undefined, e.g. inf/inf).
+/// The aligned Markdown table of `strata compare` ([`COMPARE_COLUMNS`]). Errors are in scientific
+/// notation with 3 significant digits; the last column is each row's efficiency divided by the
+/// baseline variant's at the same spp step ([`Row::eff_vs_baseline`]), or the variant it renders
+/// the same image as.
 pub fn to_markdown(rows: &[Row]) -> String {
     markdown_table(COMPARE_COLUMNS, rows, Style::Aligned)
 }
@@ -296,11 +341,17 @@ struct FlatRow<'a> {
     efficiency: f64,
     sampler_ns_per_sample: f64,
     sampler_share: f64,
+    first_sample: &'a str,
+    mse_corrected: f64,
+    flip: f64,
+    eff_vs_baseline: f64,
+    same_as: Option<&'a str>,
 }
 
 /// The JSON of `strata compare`: an array of objects with the keys `variant`, `seconds` (the
 /// workers' CPU seconds of one run), `spp`, `mse`, `rel_mse`, `bias`, `bias_ci` (`[lo, hi]`),
-/// `variance`, `efficiency`, `sampler_ns_per_sample` and `sampler_share` (a fraction). JSON has no
+/// `variance`, `efficiency`, `sampler_ns_per_sample`, `sampler_share` (a fraction),
+/// `first_sample`, `mse_corrected`, `flip`, `eff_vs_baseline` and `same_as`. JSON has no
 /// infinity or NaN: such values (e.g. an infinite efficiency) become `null`.
 pub fn to_json(rows: &[Row]) -> serde_json::Value {
     let flat: Vec<FlatRow> = rows
@@ -318,6 +369,11 @@ pub fn to_json(rows: &[Row]) -> serde_json::Value {
             efficiency: r.efficiency,
             sampler_ns_per_sample: r.sampler_ns_per_sample,
             sampler_share: r.sampler_share,
+            first_sample: &r.first_sample,
+            mse_corrected: r.stats.mse_corrected(),
+            flip: r.flip,
+            eff_vs_baseline: r.eff_vs_baseline,
+            same_as: r.same_as.as_deref(),
         })
         .collect();
     serde_json::to_value(flat).expect("rows serialize to JSON")

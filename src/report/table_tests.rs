@@ -17,6 +17,7 @@ fn row(variant: &str, seconds: f64, mse: f64) -> Row {
         mse,
         rel_mse: 3.0 * mse,
         eight_bit: Some(EightBit { variance: 2.5, mse: 3.5 }),
+        ref_variance: 0.0,
     };
     Row::new(variant, seconds, 64.0, &stats).unwrap().with_sampler(12.5, 0.25)
 }
@@ -52,8 +53,8 @@ fn csv_has_header_one_line_per_row_and_parses_back() {
     assert_eq!(lines[0], CSV_HEADER);
     for (line, row) in lines[1..].iter().zip(&rows) {
         let f = parse_csv_line(line);
-        assert_eq!(f.len(), 12, "{line}");
-        let x: Vec<f64> = f[1..].iter().map(|s| s.parse().unwrap()).collect();
+        assert_eq!(f.len(), 17, "{line}");
+        let x: Vec<f64> = f[1..12].iter().map(|s| s.parse().unwrap()).collect();
         assert_eq!(f[0], row.variant);
         let s = &row.stats;
         let want = [
@@ -99,6 +100,11 @@ fn json_has_the_compare_keys_and_round_trips_the_numbers() {
         "efficiency",
         "sampler_ns_per_sample",
         "sampler_share",
+        "first_sample",
+        "mse_corrected",
+        "flip",
+        "eff_vs_baseline",
+        "same_as",
     ];
     want.sort_unstable();
     let mut keys = keys;
@@ -139,19 +145,25 @@ fn grouped_json_has_the_experiment_keys_in_order() {
 }
 
 #[test]
-fn markdown_is_aligned_with_efficiency_ratio() {
-    let rows = rows();
+fn markdown_is_aligned_with_integer_spp_units_and_the_baseline_ratio() {
+    let mut rows = rows();
+    (rows[0].eff_vs_baseline, rows[1].eff_vs_baseline) = (1.0, 3.2);
+    rows[2].same_as = Some("independent".into());
+    rows[0].first_sample = "jittered".into();
     let md = to_markdown(&rows);
     let lines: Vec<&str> = md.lines().collect();
     assert_eq!(lines.len(), rows.len() + 2);
     let width = lines[0].chars().count();
     assert!(lines.iter().all(|l| l.chars().count() == width), "{md}");
-    assert!(lines[0].contains("eff. vs first") && lines[1].starts_with("|:-"));
-    // Ratios: 1, (1/0.0025)/(1/0.008) = 3.2, (1/0.0123456)/(1/0.008) = 0.648.
+    assert!(lines[0].contains("eff. vs baseline, same spp") && lines[1].starts_with("|:-"));
+    assert!(lines[0].contains("CPU s/run") && lines[0].contains("first sample"), "units in headers: {}", lines[0]);
+    let cell = |l: &str, i: usize| l.split('|').nth(i + 1).unwrap().trim().to_string();
+    // spp is an integer, not 6.40e1; the first-sample column says which layout each row used.
+    assert_eq!((cell(lines[2], 3), cell(lines[2], 2)), ("64".to_string(), "jittered".to_string()));
     let last = |l: &str| l.trim_end_matches('|').rsplit('|').next().unwrap().trim().to_string();
-    assert_eq!(last(lines[2]), "1.00e0");
-    assert_eq!(last(lines[3]), "3.20e0");
-    assert_eq!(last(lines[4]), "6.48e-1");
+    assert_eq!(last(lines[2]), "1.00x");
+    assert_eq!(last(lines[3]), "3.20x");
+    assert_eq!(last(lines[4]), "same image as independent");
     assert!(lines[2].contains("4.00e-3") && lines[2].contains("[-3.50e-4, 1.00e-4]"));
     assert!(lines[4].contains("say \"halton\" \\| x"));
     assert_eq!(to_markdown(&[]).lines().count(), 2);
@@ -194,12 +206,13 @@ fn csv_columns_spell_the_header_and_g3_reads_well() {
 fn sampler_columns_show_the_profile_or_say_not_profiled() {
     let mut plain = rows()[0].clone();
     (plain.sampler_ns_per_sample, plain.sampler_share) = (f64::NAN, f64::NAN);
+    (plain.flip, plain.eff_vs_baseline) = (0.05, 1.0);
     let md = to_markdown(&[rows()[0].clone(), plain.clone()]);
     let lines: Vec<&str> = md.lines().collect();
     assert!(lines[0].contains("sampler ns/sample") && lines[0].contains("% of render in sampler"));
     assert!(lines[2].contains(" 12.5 |") && lines[2].contains(" 25.0% |"), "{}", lines[2]);
     assert_eq!(lines[3].matches(" n/a |").count(), 2, "{}", lines[3]);
-    assert!(to_csv(&[plain.clone()]).lines().nth(1).unwrap().ends_with(",NaN,NaN"));
+    assert!(to_csv(&[plain.clone()]).lines().nth(1).unwrap().contains(",NaN,NaN,"));
     assert!(to_json(&[plain])[0]["sampler_share"].is_null());
 }
 

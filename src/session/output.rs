@@ -22,10 +22,29 @@ pub fn output_stem(opts: &RenderOptions, desc: &SceneDesc) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("strata"))
 }
 
+/// The camera as `--camera` spells it, "ex ey ez cx cy cz ux uy uz fovy" (shortest round-trip
+/// decimals), or `default` when the scene has none: the EXR attribute `strata.camera`.
+pub fn camera_text(c: Option<&crate::scene::desc::CameraDesc>) -> String {
+    c.map_or_else(
+        || "default".into(),
+        |c| {
+            let v: Vec<String> = [c.eye.to_array(), c.center.to_array(), c.up.to_array()]
+                .concat()
+                .into_iter()
+                .chain([c.fovy_deg])
+                .map(|x| x.to_string())
+                .collect();
+            v.join(" ")
+        },
+    )
+}
+
 /// Metadata written into the EXR header of a render ([`header_metadata`] and the thread count).
 pub fn metadata(out: &RenderOutput) -> Metadata {
     let mut m = header_metadata(&out.header);
     m.push(("strata.threads".into(), out.stats.threads.to_string()));
+    // The camera, so that `compare` can refuse a reference of another view.
+    m.push(("strata.camera".into(), camera_text(out.scene.desc.camera.as_ref())));
     m
 }
 

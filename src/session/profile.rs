@@ -135,7 +135,7 @@ pub fn profile_svg(entries: &[(&str, &Profile)], title: &str) -> String {
             }
         })
         .collect();
-    crate::report::stacked_bars_svg(&bars, &names, title)
+    crate::report::stacked_bars_svg(&bars, &names, title, "ns per camera sample (worker threads)")
 }
 
 /// Writes `text` to `path` atomically (a profile's JSON or SVG).

@@ -18,6 +18,11 @@ pub fn corpus() -> Option<PathBuf> {
     }
 }
 
+/// The CSE168 corpus, which CI always has: a missing corpus fails the test (with how to point at it).
+pub fn corpus_required() -> PathBuf {
+    corpus().unwrap_or_else(|| panic!("CSE168 corpus missing (CI has ../shared/cse168; set STRATA_CSE168)"))
+}
+
 /// Render options for `scene` at a small size.
 pub fn opts(scene: PathBuf, w: u32, h: u32, spp: u32) -> RenderOptions {
     RenderOptions { scene: Some(scene), size: Some((w, h)), spp: Some(spp), threads: 2, ..Default::default() }

@@ -1,0 +1,181 @@
+//! The pages and plots of `strata compare` (and the pieces `strata experiments` shares): the
+//! convergence plots with 95% error bars and spp labels, the slopes table, and `report.html`
+//! through [`crate::report::html`].
+
+use super::compare::{Comparison, Convergence, RunRow};
+use crate::report::html::{self, Page, Section, Shot};
+use crate::report::{self, slope::t_quantile, Annotation, Series};
+use crate::session::profile::{profile_svg, Profile};
+use std::fmt::Write as _;
+
+/// Mean of the runs' RMSE at one (variant, step) and its two-sided 95% Student-t interval.
+pub fn rmse_interval(runs: &[&RunRow]) -> (f64, f64, f64) {
+    let k = runs.len() as f64;
+    let rmse: Vec<f64> = runs.iter().map(|r| r.mse.sqrt()).collect();
+    let mean = rmse.iter().sum::<f64>() / k;
+    if runs.len() < 2 {
+        return (mean, mean, mean);
+    }
+    let sd = (rmse.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0)).sqrt();
+    let half = t_quantile(0.975, k - 1.0) * sd / k.sqrt();
+    (mean, mean - half, mean + half)
+}
+
+/// Series of mean RMSE per (variant, step) against `x` (seconds or spp), with error bars and spp
+/// labels.
+fn series_of(c: &Comparison, x_of: fn(&[&RunRow]) -> f64) -> (Vec<Series>, Vec<Annotation>) {
+    let (mut series, mut ann): (Vec<Series>, Vec<Annotation>) = (Vec::new(), Vec::new());
+    for row in &c.rows {
+        let step = if row.spp.fract() == 0.0 && c.runs.iter().any(|r| r.step > 0) { row.spp as u32 } else { 0 };
+        let runs: Vec<&RunRow> = c.runs.iter().filter(|r| r.variant == row.variant && r.step == step).collect();
+        if runs.is_empty() {
+            continue;
+        }
+        let (mean, lo, hi) = rmse_interval(&runs);
+        let label = if step > 0 { format!("{step} spp") } else { format!("{:.1} spp", row.spp) };
+        let i = match series.iter().position(|s| s.name == row.variant) {
+            Some(i) => i,
+            None => {
+                series.push(Series { name: row.variant.clone(), points: Vec::new() });
+                ann.push(Annotation::default());
+                series.len() - 1
+            }
+        };
+        series[i].points.push((x_of(&runs), mean));
+        ann[i].y_range.push((lo, hi));
+        ann[i].labels.push(label);
+    }
+    (series, ann)
+}
+
+/// `error.svg` (mean RMSE of a run against its CPU seconds) and, for a ladder of two or more
+/// steps, `error-spp.svg` (against spp), both with 95% error bars over the runs and a slope -1/2
+/// guide.
+pub fn compare_plots(c: &Comparison, title: &str) -> (String, Option<String>) {
+    let secs = |runs: &[&RunRow]| runs.iter().map(|r| r.seconds).sum::<f64>() / runs.len() as f64;
+    let (s, a) = series_of(c, secs);
+    let by_time = report::loglog_svg_annotated(
+        &s,
+        &a,
+        title,
+        "CPU seconds per run (worker threads)",
+        "RMSE (mean over runs, 95% CI)",
+        report::plot::RMSE_SLOPE,
+    );
+    let steps: std::collections::BTreeSet<u32> = c.runs.iter().map(|r| r.step).filter(|&s| s > 0).collect();
+    let by_spp = (steps.len() >= 2).then(|| {
+        let (s, a) = series_of(c, |runs| f64::from(runs[0].spp));
+        report::loglog_svg_annotated(
+            &s,
+            &a,
+            title,
+            "samples per pixel",
+            "RMSE (mean over runs, 95% CI)",
+            report::plot::RMSE_SLOPE,
+        )
+    });
+    (by_time, by_spp)
+}
+
+/// A slope with its interval, `n/a` when there is none.
+fn slope_text(s: Option<report::Slope>) -> String {
+    s.map_or("n/a".into(), |s| format!("{:.3} [{:.3}, {:.3}]", s.slope, s.lo, s.hi))
+}
+
+/// The Markdown table of fitted convergence slopes (log RMSE, the reference's noise removed, one
+/// point per run) with 95% intervals.
+pub fn slopes_markdown(conv: &[Convergence]) -> String {
+    let mut md = String::from(
+        "\nConvergence (least squares over runs of ln RMSE, the reference's variance removed; 95% interval; \
+         -0.5 is the Monte Carlo rate):\n\n| variant | slope vs spp | slope vs CPU seconds |\n|:--|--:|--:|\n",
+    );
+    for c in conv {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} |",
+            c.variant.replace('|', "\\|"),
+            slope_text(c.vs_spp),
+            slope_text(c.vs_seconds)
+        );
+    }
+    md
+}
+
+/// The slopes as an HTML table.
+fn slopes_html(conv: &[Convergence]) -> String {
+    let mut out = String::from(
+        "<h3>Convergence slopes</h3>\n<p>Least squares over the runs of ln RMSE (the reference's variance removed) \
+         against ln spp and ln CPU seconds, with 95% intervals; -0.5 is the Monte Carlo rate.</p>\n\
+         <table><tr><th>variant</th><th>slope vs spp</th><th>slope vs CPU seconds</th></tr>\n",
+    );
+    for c in conv {
+        let _ = writeln!(
+            out,
+            "<tr><td>{}</td><td>{}</td><td>{}</td></tr>",
+            html::escape(&c.variant),
+            slope_text(c.vs_spp),
+            slope_text(c.vs_seconds)
+        );
+    }
+    out + "</table>\n"
+}
+
+/// The sampler-cost bars of the variants' profiles, as an inline SVG block.
+pub fn profile_block(entries: &[(&str, &Profile)], title: &str) -> String {
+    format!("<h3>Where the time goes (phase profiler)</h3>\n{}\n", html::inline_svg(&profile_svg(entries, title)))
+}
+
+/// Notes as an HTML list (empty when there are none).
+pub fn notes_block(notes: &[String]) -> String {
+    if notes.is_empty() {
+        return String::new();
+    }
+    let items: String = notes.iter().map(|n| format!("<li>{}</li>", html::escape(n))).collect();
+    format!("<ul class=\"notes\">{items}</ul>\n")
+}
+
+/// `report.html` of a comparison.
+pub fn compare_html(
+    c: &Comparison,
+    title: &str,
+    commands: &[String],
+    by_time: &str,
+    by_spp: &Option<String>,
+) -> String {
+    let reference = Shot { label: "reference".into(), rgb: c.reference.rgb.clone() };
+    let shots = c.images.iter().map(|(name, rgb)| Shot { label: name.clone(), rgb: rgb.clone() }).collect();
+    let mut blocks = vec![
+        notes_block(&c.notes),
+        format!(
+            "<h3>Results (K = {} runs per row; efficiency against {})</h3>\n{}",
+            c.runs.iter().map(|r| r.run).max().map_or(0, |m| m + 1),
+            html::escape(&c.baseline),
+            report::html_table(report::table::COMPARE_COLUMNS, &c.rows)
+        ),
+        slopes_html(&c.convergence),
+        format!("<h3>Convergence</h3>\n{}", html::inline_svg(by_time)),
+    ];
+    if let Some(s) = by_spp {
+        blocks.push(html::inline_svg(s));
+    }
+    let entries: Vec<(&str, &Profile)> = c.profiles.iter().map(|p| (p.variant.as_str(), &p.profile)).collect();
+    blocks.push(profile_block(&entries, "phases per variant"));
+    let page = Page {
+        title: format!("strata compare: {title}"),
+        intro:
+            "<p>Images: each variant's run 1 at the last step, sRGB (clamped), against the reference. Error maps of \
+                that image against the reference.</p>"
+                .into(),
+        sections: vec![Section {
+            title: title.into(),
+            width: c.reference.width,
+            height: c.reference.height,
+            reference: Some(reference),
+            shots,
+            blocks,
+        }],
+        blocks: Vec::new(),
+        commands: commands.to_vec(),
+    };
+    html::page_html(&page)
+}

@@ -1,0 +1,109 @@
+//! `report.html` of `strata compare` in a real browser: Debian's Chromium, headless (installed by
+//! scripts/setup.sh). The page loads without console errors; its self-test mode (`#selftest`)
+//! presses every flip-book key and writes what each showed into the DOM, read back with
+//! `--dump-dom`; a screenshot is kept as a test artifact in `target/test-artifacts/report.png`.
+//!
+//! Needs `../shared/cse168` (CI always has it: a missing corpus fails this test).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Headless Chromium on `url` with `extra` flags: (stdout, stderr).
+fn chromium(url: &str, extra: &[&str]) -> (String, String) {
+    let profile = common::tmpdir(&format!("chromium-{}", extra.len()));
+    let out = Command::new("chromium")
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--no-first-run",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(extra)
+        .arg(url)
+        .output()
+        .expect("chromium runs (scripts/setup.sh installs Debian's chromium)");
+    std::fs::remove_dir_all(&profile).ok();
+    (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Console messages of the page in Chromium's log (`CONSOLE` lines), and uncaught errors.
+fn console_errors(log: &str) -> Vec<&str> {
+    log.lines().filter(|l| l.contains("CONSOLE") || l.contains("Uncaught")).collect()
+}
+
+fn compare_report(dir: &Path) -> PathBuf {
+    let sphere = common::corpus_required().join("hw2/sphere.test");
+    let st = common::strata()
+        .arg("reference")
+        .arg(&sphere)
+        .args(["--size", "40x30", "--spp", "16", "-q", "-o"])
+        .arg(dir.join("ref"))
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let out = common::strata()
+        .arg("compare")
+        .arg(&sphere)
+        .arg("--reference")
+        .arg(dir.join("ref.exr"))
+        .args(["--size", "40x30", "--runs", "2", "--spp-ladder", "1,4", "--threads", "2", "-q"])
+        .args(["--variant", "independent=--light-sampler independent"])
+        .args(["--variant", "stratified=--light-sampler stratified"])
+        .args(["--variant", "halton=--light-sampler halton"])
+        .arg("--out")
+        .arg(dir.join("cmp"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    dir.join("cmp/report.html")
+}
+
+#[test]
+fn report_html_flip_book_shows_every_variant_in_headless_chromium() {
+    let d = common::tmpdir("report-html");
+    let page = compare_report(&d);
+    let html = std::fs::read_to_string(&page).unwrap();
+    // Self-contained: no network resource.
+    for bad in ["src=\"http", "href=\"http", "url(http", "@import", "<link", "src=\"/"] {
+        assert!(!html.contains(bad), "report.html refers to {bad}");
+    }
+    let url = format!("file://{}", page.display());
+    let (dom, log) = chromium(&format!("{url}#selftest"), &["--dump-dom"]);
+    assert!(console_errors(&log).is_empty(), "console errors: {:?}", console_errors(&log));
+    let start = dom.find("<pre id=\"selftest\">").unwrap_or_else(|| panic!("no self-test output in the DOM:\n{log}"));
+    let text = &dom[start..dom[start..].find("</pre>").map_or(dom.len(), |e| start + e)];
+    // The image flip-book: reference then the three variants, each shown alone and decoded.
+    let want = ["reference", "independent", "stratified", "halton"];
+    for (i, label) in want.iter().enumerate() {
+        let line = format!("book 0 key {} shows {label} visible 1 loaded true", i + 1);
+        assert!(text.contains(&line), "missing `{line}` in:\n{text}");
+    }
+    // The error-map flip-book: relMSE, signed and FLIP of each variant.
+    for (i, label) in
+        ["independent: relMSE", "independent: signed", "independent: FLIP", "stratified: relMSE"].iter().enumerate()
+    {
+        let line = format!("book 1 key {} shows {label} visible 1 loaded true", i + 1);
+        assert!(text.contains(&line), "missing `{line}` in:\n{text}");
+    }
+    assert!(text.contains("errors 0"), "page errors: {text}");
+    // The page carries the table, the plots with error bars, the profile bars and the command line.
+    for part in ["<table>", "class=\"error-bar\"", "class=\"bar\"", "compare", "Convergence slopes", "FLIP"] {
+        assert!(html.contains(part), "report.html lacks {part}");
+    }
+    // A screenshot, kept as a test artifact.
+    let shot = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/target/test-artifacts/report.png"));
+    std::fs::create_dir_all(shot.parent().unwrap()).unwrap();
+    std::fs::remove_file(&shot).ok();
+    let (_, log) = chromium(&url, &[&format!("--screenshot={}", shot.display()), "--window-size=1280,1600"]);
+    let png = std::fs::read(&shot).unwrap_or_else(|e| panic!("no screenshot {}: {e}\n{log}", shot.display()));
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "screenshot of {} bytes", png.len());
+    std::fs::remove_dir_all(&d).ok();
+}
