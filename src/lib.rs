@@ -8,6 +8,7 @@ pub mod integrator;
 pub mod lab;
 pub mod light;
 pub mod measure;
+pub mod pointset;
 pub mod profile;
 pub mod render;
 pub mod report;
