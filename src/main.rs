@@ -142,6 +142,9 @@ fn main() -> ExitCode {
                 println!("written to {}/ (results.md, results.json, *.png, *.svg)", out.display());
             })
         }
+        Cmd::Pointset { target, out, export, sets, points, seed, dim, width, trials, max_freq, options } => {
+            run_pointset(target, out, export, [sets, points, dim, width, trials], seed, max_freq, &options)
+        }
         Cmd::Rays { args, json } => {
             session::run_rays(&args.options()).map_err(|e| e.to_string()).map(|(rates, name)| {
                 if json {
@@ -197,6 +200,43 @@ fn exit_on_signal_outside_render(stop: Arc<AtomicBool>, rendering: Arc<AtomicBoo
         }
         std::thread::sleep(std::time::Duration::from_millis(20));
     });
+}
+
+/// `strata pointset`: `counts` are sets, points, dim, width, trials.
+fn run_pointset(
+    target: String,
+    out: Option<PathBuf>,
+    export: Option<PathBuf>,
+    counts: [u32; 5],
+    seed: u64,
+    max_freq: usize,
+    options: &[String],
+) -> Result<(), String> {
+    let [sets, points, dim, width, trials] = counts;
+    let mut opts = strata::pointset::spec::Options::default();
+    options.iter().try_for_each(|kv| opts.set(kv)).map_err(|e| e.to_string())?;
+    let args = strata::pointset::command::Args {
+        target,
+        out: out.clone(),
+        export: export.clone(),
+        sets,
+        points,
+        seed,
+        dim,
+        width,
+        trials,
+        max_freq,
+        options: opts,
+    };
+    let (_, table) = strata::pointset::command::run(&args).map_err(|e| e.to_string())?;
+    println!("{table}");
+    if let Some(d) = out {
+        println!("written to {}/ (spectrum.csv/svg, integration.csv/svg, pointset.json)", d.display());
+    }
+    if let Some(e) = export {
+        println!("sets written to {}", e.display());
+    }
+    Ok(())
 }
 
 /// Where `compare` writes its variants' profiles (`--profile`, `--profile-svg`).
