@@ -107,8 +107,23 @@ fn main() -> ExitCode {
             profile,
             profile_svg,
         } => {
-            let profile_out = ProfileOut { json: profile, svg: profile_svg };
-            run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out, &profile_out)
+            let profile = strata::frontend::ProfileOut { json: profile, svg: profile_svg };
+            let args = strata::frontend::CompareArgs {
+                scene,
+                reference,
+                variants,
+                runs,
+                budget,
+                spp_ladder,
+                size,
+                threads,
+                out,
+                profile,
+            };
+            strata::frontend::run_compare(&args).map(|o| {
+                println!("{}", o.markdown);
+                println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", args.out.display());
+            })
         }
         Cmd::GenMesh { out, triangles } => {
             let mesh = strata::scene::obj::procedural_mesh(triangles);
@@ -236,72 +251,5 @@ fn run_pointset(
     if let Some(e) = export {
         println!("sets written to {}", e.display());
     }
-    Ok(())
-}
-
-/// Where `compare` writes its variants' profiles (`--profile`, `--profile-svg`).
-struct ProfileOut {
-    json: Option<PathBuf>,
-    svg: Option<PathBuf>,
-}
-
-#[allow(clippy::too_many_arguments)]
-fn run_compare(
-    scene: Option<PathBuf>,
-    reference: &std::path::Path,
-    specs: &[String],
-    runs: usize,
-    budget: Option<f64>,
-    ladder: Option<Vec<u32>>,
-    size: Option<(u32, u32)>,
-    threads: usize,
-    out: &std::path::Path,
-    profile_out: &ProfileOut,
-) -> Result<(), String> {
-    let mut variants = Vec::new();
-    for spec in specs {
-        let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
-        let mut argv = vec!["strata".to_string(), "render".to_string()];
-        argv.extend(scene.iter().map(|p| p.display().to_string()));
-        argv.extend(flags.split_whitespace().map(str::to_string));
-        let cli = Cli::try_parse_from(&argv)
-            .map_err(|e| format!("--variant {name}: {}", e.to_string().lines().next().unwrap_or("")))?;
-        let Cmd::Render(args) = cli.cmd else { unreachable!("parsed as render") };
-        let mut opts = args.options();
-        opts.size = size.or(opts.size);
-        opts.threads = threads;
-        opts.progress = false;
-        variants.push(strata::lab::Variant { name: name.to_string(), opts });
-    }
-    let mode = match (budget, ladder) {
-        (Some(b), _) if b > 0.0 && b.is_finite() => strata::lab::Mode::Budget(b),
-        (Some(b), _) => return Err(format!("--budget {b}: expected a positive number of seconds")),
-        (None, Some(l)) if !l.is_empty() && l.iter().all(|&s| s > 0) => strata::lab::Mode::Ladder(l),
-        (None, Some(_)) => return Err("--spp-ladder: expected positive spp values".into()),
-        (None, None) => return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
-    };
-    for f in [&profile_out.json, &profile_out.svg].into_iter().flatten() {
-        session::checks::check_output_file(f).map_err(|e| e.to_string())?;
-    }
-    let (rows, profiles) =
-        strata::lab::compare_profiled(&variants, reference, runs, &mode).map_err(|e| e.to_string())?;
-    let title = format!(
-        "{} vs {}",
-        scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
-        reference.display()
-    );
-    let md = strata::lab::write_outputs(&rows, out, &title).map_err(|e| e.to_string())?;
-    if let Some(f) = &profile_out.json {
-        let text = serde_json::to_string_pretty(&profiles).map_err(|e| e.to_string())?;
-        session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
-    }
-    if let Some(f) = &profile_out.svg {
-        let entries: Vec<(&str, &session::Profile)> =
-            profiles.iter().map(|v| (v.variant.as_str(), &v.profile)).collect();
-        let svg = session::profile::profile_svg(&entries, &format!("phases per variant: {title}"));
-        session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
-    }
-    println!("{md}");
-    println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", out.display());
     Ok(())
 }

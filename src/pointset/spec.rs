@@ -103,6 +103,9 @@ impl SamplerSpec {
 /// A sampler name of the registry or a `file:PATH?options` spec, resolved to its kind (a file is
 /// loaded and checked); the error lists the registry's names for an unknown one.
 pub fn resolve_sampler(s: &str) -> Result<SamplerKind, PointSetError> {
+    if let Some(kind) = file::loaded_named(s.trim()) {
+        return Ok(kind); // a point array registered by name (the Python module's `array:DIGEST`)
+    }
     match SamplerSpec::parse(s) {
         Some(spec) => spec?.load(),
         None => SamplerKind::parse(s).ok_or_else(|| {
