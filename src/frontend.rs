@@ -134,8 +134,14 @@ pub fn compare_mode(budget: Option<f64>, ladder: Option<Vec<u32>>) -> Result<Mod
 /// Runs `strata compare` and writes its outputs (rows.csv, rows.json, table.md, error.svg in
 /// `out`, and the profiles asked for).
 pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, String> {
-    let variants = compare_variants(a.scene.as_deref(), &a.variants, a.size, a.threads)?;
+    let mut variants = compare_variants(a.scene.as_deref(), &a.variants, a.size, a.threads)?;
     let mode = compare_mode(a.budget, a.spp_ladder.clone())?;
+    if let Mode::Ladder(l) = &mode {
+        // Checks made before rendering (a point set's size, a sampler's period) are against the
+        // largest spp the variant renders, not the scene's.
+        let top = l.iter().copied().max();
+        variants.iter_mut().filter(|v| v.opts.spp.is_none()).for_each(|v| v.opts.spp = top);
+    }
     for f in [&a.profile.json, &a.profile.svg].into_iter().flatten() {
         session::checks::check_output_file(f).map_err(|e| e.to_string())?;
     }

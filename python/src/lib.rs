@@ -42,13 +42,13 @@ fn rgb_bytes(v: &[[f32; 3]]) -> Vec<u8> {
 
 /// Checks an array of points (float64 bytes, shape `[sets, points, dims]`) as a file's points are
 /// checked (messages name `<array NAME>`), and registers it as a sampler; returns the sampler's
-/// name (`array:DIGEST?options`), which render flags then accept like a registry name.
+/// name (`array:NAME:DIGEST?options`), which render flags then accept like a registry name.
 fn array_sampler(name: &str, data: &[u8], shape: [usize; 3], options: &str) -> Result<strata::sampler::SamplerKind, String> {
     let source = format!("<array {name}>");
     let ps = PointSets::new(&source, shape[0], shape[1], shape[2], f64s(data)).map_err(|e| e.to_string())?;
     let mut opts = Options::default();
     options.split('&').filter(|kv| !kv.is_empty()).try_for_each(|kv| opts.set(kv)).map_err(|e| e.to_string())?;
-    sampler_from_sets(&ps, &format!("array:{}", &ps.digest[..12.min(ps.digest.len())]), opts).map_err(|e| e.to_string())
+    sampler_from_sets(&ps, &format!("array:{name}:{}", &ps.digest[..12.min(ps.digest.len())]), opts).map_err(|e| e.to_string())
 }
 
 /// Checks and registers a point array ([`array_sampler`]); returns the sampler name to pass in
@@ -121,6 +121,16 @@ fn relmse(a: &Bound<'_, PyBytes>, b: &Bound<'_, PyBytes>) -> PyResult<f64> {
     strata::report::rel_mse(&rgb(a.as_bytes()), &rgb(b.as_bytes())).map_err(err)
 }
 
+/// Reads an EXR as `strata render`/`reference` write it: (RGB f32 bytes, variance f32 bytes or
+/// None, width, height, metadata as (key, value) pairs).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn read_exr(py: Python<'_>, path: std::path::PathBuf) -> PyResult<(Py<PyBytes>, Option<Py<PyBytes>>, u32, u32, Vec<(String, String)>)> {
+    let img = strata::film::read_exr(&path).map_err(|e| err(format!("{}: {e}", path.display())))?;
+    let var = img.variance.as_ref().map(|v| PyBytes::new(py, &rgb_bytes(v)).unbind());
+    Ok((PyBytes::new(py, &rgb_bytes(&img.rgb)).unbind(), var, img.width, img.height, img.meta))
+}
+
 /// The crate version.
 #[pyfunction]
 fn version() -> &'static str {
@@ -136,6 +146,7 @@ fn _strata(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check_points, m)?)?;
     m.add_function(wrap_pyfunction!(mse, m)?)?;
     m.add_function(wrap_pyfunction!(relmse, m)?)?;
+    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())
 }

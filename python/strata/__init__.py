@@ -21,7 +21,7 @@ import numpy as np
 from . import _strata
 from ._strata import StrataError
 
-__all__ = ["render", "reference", "compare", "Image", "Scene", "StrataError", "metrics", "points_sampler"]
+__all__ = ["render", "reference", "compare", "Image", "Scene", "StrataError", "metrics", "points_sampler", "read_exr"]
 __version__ = _strata.version()
 
 
@@ -122,6 +122,15 @@ def render(scene=None, **flags):
         np.frombuffer(var, dtype="<f4").reshape(shape),
         json.loads(stats),
     )
+
+
+def read_exr(path):
+    """Reads an EXR as strata writes it (a reference, say) into an :class:`Image`; ``stats``
+    holds the file's ``strata.*`` metadata, ``variance`` its variance layer (or None)."""
+    rgb, var, w, h, meta = _strata.read_exr(os.fspath(path))
+    shape = (h, w, 3)
+    variance = None if var is None else np.frombuffer(var, dtype="<f4").reshape(shape)
+    return Image(np.frombuffer(rgb, dtype="<f4").reshape(shape), variance, dict(meta))
 
 
 def reference(scene=None, **flags):

@@ -104,7 +104,7 @@ impl SamplerSpec {
 /// loaded and checked); the error lists the registry's names for an unknown one.
 pub fn resolve_sampler(s: &str) -> Result<SamplerKind, PointSetError> {
     if let Some(kind) = file::loaded_named(s.trim()) {
-        return Ok(kind); // a point array registered by name (the Python module's `array:DIGEST`)
+        return Ok(kind); // a point array registered by name (the Python module's `array:NAME:DIGEST`)
     }
     match SamplerSpec::parse(s) {
         Some(spec) => spec?.load(),

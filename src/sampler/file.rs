@@ -252,7 +252,7 @@ fn loaded(j: usize) -> &'static Loaded {
     LOADED[j].get().expect("a loaded kind exists only after its slot is set")
 }
 
-/// The loaded kind registered under `name` (arrays are named `array:DIGEST`), if any.
+/// The loaded kind registered under `name` (arrays are named `array:NAME:DIGEST`), if any.
 pub fn loaded_named(name: &str) -> Option<SamplerKind> {
     let keys = KEYS.lock().unwrap_or_else(|p| p.into_inner());
     keys.iter().map(|(_, k)| *k).find(|k| name.starts_with("array:") && k.name() == name)
