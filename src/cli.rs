@@ -297,6 +297,7 @@ impl RenderArgs {
     pub(crate) fn options(self) -> RenderOptions {
         RenderOptions {
             scene: self.scene,
+            parsed: None,
             spp: self.spp,
             size: self.size,
             seed: self.seed,

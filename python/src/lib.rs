@@ -58,12 +58,33 @@ fn check_points(name: &str, data: &Bound<'_, PyBytes>, shape: [usize; 3], option
     array_sampler(name, data.as_bytes(), shape, options).map(|k| k.name().to_string()).map_err(err)
 }
 
-/// Renders `strata render ARGS` (point arrays are named in them after [`check_points`]);
-/// `write`: also write the CLI's outputs (`-o`). Returns (mean RGB f32 bytes, variance-of-mean
-/// f32 bytes, width, height, stats JSON).
+/// A scene file parsed once (`strata.Scene`): renders given it start from the parsed scene.
+#[pyclass(frozen, name = "ParsedScene")]
+struct ParsedScene {
+    desc: Arc<strata::scene::desc::SceneDesc>,
+}
+
+/// Parses the scene of `strata render ARGS` (its file, `--limit`s) once, with the CLI's checks.
 #[pyfunction]
-fn render(py: Python<'_>, args: Vec<String>, write: bool) -> PyResult<(Py<PyBytes>, Py<PyBytes>, u32, u32, String)> {
+fn parse_scene(py: Python<'_>, args: Vec<String>) -> PyResult<ParsedScene> {
+    let opts = strata::frontend::render_options(&args).map_err(err)?;
+    let desc = py.detach(|| session::parse_scene(&opts)).map_err(err)?;
+    Ok(ParsedScene { desc: Arc::new(desc) })
+}
+
+/// Renders `strata render ARGS` (point arrays are named in them after [`check_points`]; `scene`:
+/// the file parsed already); `write`: also write the CLI's outputs (`-o`). Returns (mean RGB f32
+/// bytes, variance-of-mean f32 bytes, width, height, stats JSON).
+#[pyfunction]
+#[pyo3(signature = (args, write, scene=None))]
+fn render(
+    py: Python<'_>,
+    args: Vec<String>,
+    write: bool,
+    scene: Option<&ParsedScene>,
+) -> PyResult<(Py<PyBytes>, Py<PyBytes>, u32, u32, String)> {
     let mut opts: RenderOptions = strata::frontend::render_options(&args).map_err(err)?;
+    opts.parsed = scene.map(|s| Arc::clone(&s.desc));
     let stop = Arc::new(AtomicBool::new(false));
     opts.stop = Some(Arc::clone(&stop));
     let outcome = py.detach(|| {
@@ -141,6 +162,8 @@ fn version() -> &'static str {
 #[pymodule]
 fn _strata(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("StrataError", m.py().get_type::<StrataError>())?;
+    m.add_class::<ParsedScene>()?;
+    m.add_function(wrap_pyfunction!(parse_scene, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(check_points, m)?)?;

@@ -41,14 +41,14 @@ class Image(np.ndarray):
 
 
 class Scene:
-    """A scene file with scene-level flags (``size``, ``camera``, ``integrator``, ...) checked once
-    (a bad file raises here, not at the first render) and reused by every render given it."""
+    """A scene file parsed once (a bad file raises here), rendered many times: every render
+    given it starts from the parsed scene (the Embree scene is still built per render), with
+    ``flags`` (e.g. ``size``, ``camera``, ``integrator``) applied before the render's own."""
 
     def __init__(self, path, **flags):
         self.path = os.fspath(path)
         self.flags = dict(flags)
-        if not os.path.isfile(self.path):
-            raise StrataError(f"{self.path}: no such file")
+        self._parsed = _strata.parse_scene(_render_args(self.path, {**self.flags, "progress": True}))
 
     def __repr__(self):
         return f"strata.Scene({self.path!r}, {self.flags!r})"
@@ -115,7 +115,8 @@ def render(scene=None, **flags):
     ``integrator``, ...), point arrays ``pixel_points`` / ``light_points`` / ``points``, and
     ``out`` (also write OUT.exr and OUT.png as the CLI does). Returns an :class:`Image`."""
     write = flags.get("out") is not None
-    rgb, var, w, h, stats = _strata.render(_render_args(scene, flags), write)
+    parsed = scene._parsed if isinstance(scene, Scene) else None
+    rgb, var, w, h, stats = _strata.render(_render_args(scene, flags), write, parsed)
     shape = (h, w, 3)
     return Image(
         np.frombuffer(rgb, dtype="<f4").reshape(shape),

@@ -167,3 +167,15 @@ def test_example_runs_at_a_small_size(tmp_path):
     for name in ("rank1", "jittered", "sobol"):
         errs = [r["rmse"] for r in sorted(rows, key=lambda r: r["spp"]) if r["sampler"] == name]
         assert errs[-1] < errs[0], (name, errs)
+
+
+def test_a_scene_is_parsed_once_and_renders_like_its_path(tmp_path):
+    path = tmp_path / "s.test"
+    path.write_text(SCENE.read_text())
+    scene = strata.Scene(path, size=(16, 8))
+    path.write_text("this is no longer a scene\n")  # renders use the parsed scene, not the file
+    a = strata.render(scene, spp=4, seed=2)
+    b = strata.render(SCENE, spp=4, seed=2, size=(16, 8))
+    assert np.array_equal(np.asarray(a), np.asarray(b))
+    with pytest.raises(strata.StrataError, match="s.test:1"):
+        strata.Scene(path)
