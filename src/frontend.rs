@@ -110,8 +110,8 @@ pub fn compare_variants(
         let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
         let mut args: Vec<String> = scene.iter().map(|p| p.display().to_string()).collect();
         args.extend(flags.split_whitespace().map(str::to_string));
-        let mut opts = render_options(&args)
-            .map_err(|e| format!("--variant {name}: {}", e.lines().next().unwrap_or("")))?;
+        let mut opts =
+            render_options(&args).map_err(|e| format!("--variant {name}: {}", e.lines().next().unwrap_or("")))?;
         opts.size = size.or(opts.size);
         opts.threads = threads;
         opts.progress = false;

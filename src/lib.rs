@@ -4,13 +4,13 @@
 // `frontend` (and through it the Python module) parses flags exactly as the binary does; its
 // `strata::` paths name this crate.
 extern crate self as strata;
-#[allow(dead_code)]
-#[path = "cli.rs"]
-mod cli;
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod checkpoint;
+#[allow(dead_code)]
+#[path = "cli.rs"]
+mod cli;
 pub mod film;
 pub mod frontend;
 pub mod integrator;

@@ -161,11 +161,9 @@ fn pointset_command_exports_and_measures() {
         assert!(dir.join("report").join(f).is_file(), "{f}");
     }
     // The exported file measures like the layout itself (same sets).
-    let again = strata()
-        .args(["pointset", dir.join("pmj.txt").to_str().unwrap(), "--trials", "32"])
-        .output()
-        .unwrap();
+    let again = strata().args(["pointset", dir.join("pmj.txt").to_str().unwrap(), "--trials", "32"]).output().unwrap();
     let t2 = String::from_utf8_lossy(&again.stdout);
-    let rows = |t: &str| t.lines().filter(|l| l.trim_start().starts_with(['0', '1'])).map(String::from).collect::<Vec<_>>();
+    let rows =
+        |t: &str| t.lines().filter(|l| l.trim_start().starts_with(['0', '1'])).map(String::from).collect::<Vec<_>>();
     assert_eq!(rows(&text), rows(&t2), "{text}\n{t2}");
 }

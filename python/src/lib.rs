@@ -43,12 +43,18 @@ fn rgb_bytes(v: &[[f32; 3]]) -> Vec<u8> {
 /// Checks an array of points (float64 bytes, shape `[sets, points, dims]`) as a file's points are
 /// checked (messages name `<array NAME>`), and registers it as a sampler; returns the sampler's
 /// name (`array:NAME:DIGEST?options`), which render flags then accept like a registry name.
-fn array_sampler(name: &str, data: &[u8], shape: [usize; 3], options: &str) -> Result<strata::sampler::SamplerKind, String> {
+fn array_sampler(
+    name: &str,
+    data: &[u8],
+    shape: [usize; 3],
+    options: &str,
+) -> Result<strata::sampler::SamplerKind, String> {
     let source = format!("<array {name}>");
     let ps = PointSets::new(&source, shape[0], shape[1], shape[2], f64s(data)).map_err(|e| e.to_string())?;
     let mut opts = Options::default();
     options.split('&').filter(|kv| !kv.is_empty()).try_for_each(|kv| opts.set(kv)).map_err(|e| e.to_string())?;
-    sampler_from_sets(&ps, &format!("array:{name}:{}", &ps.digest[..12.min(ps.digest.len())]), opts).map_err(|e| e.to_string())
+    sampler_from_sets(&ps, &format!("array:{name}:{}", &ps.digest[..12.min(ps.digest.len())]), opts)
+        .map_err(|e| e.to_string())
 }
 
 /// Checks and registers a point array ([`array_sampler`]); returns the sampler name to pass in
@@ -57,6 +63,10 @@ fn array_sampler(name: &str, data: &[u8], shape: [usize; 3], options: &str) -> R
 fn check_points(name: &str, data: &Bound<'_, PyBytes>, shape: [usize; 3], options: &str) -> PyResult<String> {
     array_sampler(name, data.as_bytes(), shape, options).map(|k| k.name().to_string()).map_err(err)
 }
+
+/// A render's result for Python: (mean RGB f32 bytes, variance-of-mean f32 bytes, width, height,
+/// stats JSON).
+type Rendered = (Py<PyBytes>, Py<PyBytes>, u32, u32, String);
 
 /// A scene file parsed once (`strata.Scene`): renders given it start from the parsed scene.
 #[pyclass(frozen, name = "ParsedScene")]
@@ -77,12 +87,7 @@ fn parse_scene(py: Python<'_>, args: Vec<String>) -> PyResult<ParsedScene> {
 /// bytes, variance-of-mean f32 bytes, width, height, stats JSON).
 #[pyfunction]
 #[pyo3(signature = (args, write, scene=None))]
-fn render(
-    py: Python<'_>,
-    args: Vec<String>,
-    write: bool,
-    scene: Option<&ParsedScene>,
-) -> PyResult<(Py<PyBytes>, Py<PyBytes>, u32, u32, String)> {
+fn render(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedScene>) -> PyResult<Rendered> {
     let mut opts: RenderOptions = strata::frontend::render_options(&args).map_err(err)?;
     opts.parsed = scene.map(|s| Arc::clone(&s.desc));
     let stop = Arc::new(AtomicBool::new(false));
@@ -146,7 +151,10 @@ fn relmse(a: &Bound<'_, PyBytes>, b: &Bound<'_, PyBytes>) -> PyResult<f64> {
 /// None, width, height, metadata as (key, value) pairs).
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-fn read_exr(py: Python<'_>, path: std::path::PathBuf) -> PyResult<(Py<PyBytes>, Option<Py<PyBytes>>, u32, u32, Vec<(String, String)>)> {
+fn read_exr(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+) -> PyResult<(Py<PyBytes>, Option<Py<PyBytes>>, u32, u32, Vec<(String, String)>)> {
     let img = strata::film::read_exr(&path).map_err(|e| err(format!("{}: {e}", path.display())))?;
     let var = img.variance.as_ref().map(|v| PyBytes::new(py, &rgb_bytes(v)).unbind());
     Ok((PyBytes::new(py, &rgb_bytes(&img.rgb)).unbind(), var, img.width, img.height, img.meta))

@@ -69,9 +69,8 @@ fn exact_integrals() {
     // Midpoint rule on a fine grid agrees with the closed forms.
     for f in Integrand::ALL {
         let g = 2000;
-        let sum: f64 = (0..g * g)
-            .map(|i| f.eval(((i % g) as f64 + 0.5) / g as f64, ((i / g) as f64 + 0.5) / g as f64))
-            .sum();
+        let sum: f64 =
+            (0..g * g).map(|i| f.eval(((i % g) as f64 + 0.5) / g as f64, ((i / g) as f64 + 0.5) / g as f64)).sum();
         let mid = sum / (g * g) as f64;
         assert!((mid - f.exact()).abs() < 1e-4, "{}: {mid} vs {}", f.name(), f.exact());
     }

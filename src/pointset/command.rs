@@ -186,10 +186,11 @@ pub fn write_outputs(dir: &Path, r: &Report) -> Result<(), PointSetError> {
             integration += &format!("{},{n},{e}\n", c.integrand);
         }
     }
-    let spec_series =
-        [Series { name: r.name.clone(), points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p)).collect() }];
-    let spec_svg =
-        loglog_svg(&spec_series, &format!("radial power spectrum: {}", r.name), "frequency", "power", 0.0);
+    let spec_series = [Series {
+        name: r.name.clone(),
+        points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p)).collect(),
+    }];
+    let spec_svg = loglog_svg(&spec_series, &format!("radial power spectrum: {}", r.name), "frequency", "power", 0.0);
     let int_series: Vec<Series> = r
         .convergence
         .iter()

@@ -233,7 +233,8 @@ pub fn write(path: &Path, ps: &PointSets) -> Result<(), PointSetError> {
                 .writer(&mut out)
                 .begin_nd()
                 .map_err(|source| PointSetError::Io { path: path.to_path_buf(), source })?;
-            w.extend(ps.data.iter().copied()).map_err(|source| PointSetError::Io { path: path.to_path_buf(), source })?;
+            w.extend(ps.data.iter().copied())
+                .map_err(|source| PointSetError::Io { path: path.to_path_buf(), source })?;
             w.finish().map_err(|source| PointSetError::Io { path: path.to_path_buf(), source })?;
         }
     }

@@ -109,7 +109,10 @@ pub fn resolve_sampler(s: &str) -> Result<SamplerKind, PointSetError> {
     match SamplerSpec::parse(s) {
         Some(spec) => spec?.load(),
         None => SamplerKind::parse(s).ok_or_else(|| {
-            PointSetError::Spec(format!("unknown sampler `{s}` ({}, or file:PATH for a point-set file)", SamplerKind::names()))
+            PointSetError::Spec(format!(
+                "unknown sampler `{s}` ({}, or file:PATH for a point-set file)",
+                SamplerKind::names()
+            ))
         }),
     }
 }
@@ -134,7 +137,8 @@ pub fn sampler_from_sets(ps: &PointSets, name: &str, options: Options) -> Result
         })
         .collect();
     let too_big = || PointSetError::Format { source_name: ps.source.clone(), why: "too many points".into() };
-    let (sets, points) = (u32::try_from(ps.sets).map_err(|_| too_big())?, u32::try_from(ps.points).map_err(|_| too_big())?);
+    let (sets, points) =
+        (u32::try_from(ps.sets).map_err(|_| too_big())?, u32::try_from(ps.points).map_err(|_| too_big())?);
     let table = PointTable::new(sets, points, xy).ok_or_else(too_big)?;
     let layout = FileLayout { table, map: options.map, scramble: options.scramble, pad: options.pad };
     Ok(file::register(&format!("{name}{}", options.suffix()), &ps.digest, layout)?)

@@ -45,7 +45,10 @@ fn each_format_round_trips() {
 fn npy_float32_two_dimensional_and_fortran_order_load() {
     // Hand-written NumPy v1 headers (as numpy.save writes them).
     let npy = |descr: &str, fortran: bool, shape: &str, body: &[u8]| {
-        let mut h = format!("{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}", if fortran { "True" } else { "False" });
+        let mut h = format!(
+            "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}",
+            if fortran { "True" } else { "False" }
+        );
         while (10 + h.len() + 1) % 64 != 0 {
             h.push(' ');
         }

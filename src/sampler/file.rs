@@ -207,12 +207,8 @@ pub enum RegisterError {
 /// Registers `layout` under `name` (e.g. `file:pts.npy`) with content `digest` (a hash of the
 /// points and options: equal digests give the same kind, so loading a file twice costs nothing).
 pub fn register(name: &str, digest: &str, layout: FileLayout) -> Result<SamplerKind, RegisterError> {
-    let key = format!(
-        "{digest}/{}/{}/{}",
-        layout.map.name(),
-        layout.scramble.name(),
-        layout.pad.map_or("-", |k| k.name())
-    );
+    let key =
+        format!("{digest}/{}/{}/{}", layout.map.name(), layout.scramble.name(), layout.pad.map_or("-", |k| k.name()));
     let mut keys = KEYS.lock().unwrap_or_else(|p| p.into_inner());
     if let Some((_, kind)) = keys.iter().find(|(k, _)| *k == key) {
         return Ok(*kind);
@@ -303,40 +299,34 @@ mod tests {
         let a = kind(SetMap::Hash, Scramble::Shift, "twice");
         assert_eq!(a, kind(SetMap::Hash, Scramble::Shift, "twice"));
         assert_ne!(a, kind(SetMap::Hash, Scramble::Owen, "twice"));
-        assert_eq!(file_info(a).map(|(d, s, p)| (d, s, p)), Some(("twice", 3, 16)));
+        assert_eq!(file_info(a), Some(("twice", 3, 16)));
         assert_eq!(file_info(SamplerKind::SOBOL), None);
     }
 
     #[test]
     fn scrambles_keep_their_structure() {
         // Shift: differences mod 1 between points of one set are kept; xor: XOR differences kept;
-        // owen: the order of the top digit's halves is consistent (nested), every scramble varies
+        // owen: points sharing their top digits still share them (nested); every scramble varies
         // with pixel, dim and seed.
         let t = table(1, 16);
         for scramble in [Scramble::Shift, Scramble::Xor, Scramble::Owen] {
             let k = kind(SetMap::Hash, scramble, "structure");
             let set = PointSet::new(k, 16);
             let p = |pixel, dim, seed, i| set.point(pixel, 0, dim, i, seed).map(fixed24_f32);
-            let _ = &t;
             let a: Vec<_> = (0..16).map(|i| p(3, 1, 7, i)).collect();
             let b: Vec<_> = (0..16).map(|i| p(4, 1, 7, i)).collect();
             assert_ne!(a, b, "{scramble:?}");
             assert_ne!(a, (0..16).map(|i| p(3, 2, 7, i)).collect::<Vec<_>>());
             assert_ne!(a, (0..16).map(|i| p(3, 1, 8, i)).collect::<Vec<_>>());
-            let raw = |i: usize| t.xy[i];
-            for i in 0..16 {
+            for (got, raw) in a.iter().zip(&t.xy) {
                 for ax in 0..2 {
+                    let (g, g0, r, r0) = (got[ax], a[0][ax], raw[ax], t.xy[0][ax]);
                     match scramble {
-                        Scramble::Shift => assert_eq!(
-                            a[i][ax].wrapping_sub(a[0][ax]) & 0xff_ffff,
-                            raw(i)[ax].wrapping_sub(raw(0)[ax]) & 0xff_ffff
-                        ),
-                        Scramble::Xor => assert_eq!(a[i][ax] ^ a[0][ax], raw(i)[ax] ^ raw(0)[ax]),
+                        Scramble::Shift => assert_eq!(g.wrapping_sub(g0) & 0xff_ffff, r.wrapping_sub(r0) & 0xff_ffff),
+                        Scramble::Xor => assert_eq!(g ^ g0, r ^ r0),
                         _ => {
-                            // Nested: points sharing their top d digits still share them.
                             for d in 1..8 {
-                                let same = raw(i)[ax] >> (24 - d) == raw(0)[ax] >> (24 - d);
-                                assert_eq!(a[i][ax] >> (24 - d) == a[0][ax] >> (24 - d), same);
+                                assert_eq!(g >> (24 - d) == g0 >> (24 - d), r >> (24 - d) == r0 >> (24 - d));
                             }
                         }
                     }

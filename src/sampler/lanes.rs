@@ -100,7 +100,15 @@ impl Lanes for u32 {
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         f(self)
     }
-    fn dyn_point(l: &dyn DynLayout, set: &SetShape, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> (f32, f32) {
+    fn dyn_point(
+        l: &dyn DynLayout,
+        set: &SetShape,
+        pixel: u32,
+        sample: u32,
+        dim: u32,
+        k: u32,
+        seed: u64,
+    ) -> (f32, f32) {
         l.point_1(set, pixel, sample, dim, k, seed)
     }
 }
