@@ -3,12 +3,14 @@
 //!
 //! A loaded [`PointTable`] has `sets` sets of `points` points (24-bit fixed point, as every
 //! layout's output). Point k of the n-point set of stream (pixel, sample, dim) under seed is point
-//! `i = (sample * n + k) mod points` of one set of the table, randomized per (pixel, dim):
+//! `i mod points` of one set of the table, `i = sample * n + k`, randomized per (pixel, dim, block
+//! `i / points`); renders of a fixed spp are refused when they would need a block past the first
+//! (the session's check), equal-time runs go on with freshly randomized blocks:
 //!
 //! - **which set** ([`SetMap`]): `hash` (the default) picks set `floor(h * sets / 2^32)` with
-//!   `h = hash(TAG_FILE, seed, dim, pixel)` (murmur3 `fmix32` folding, see `hash.rs`), so one set
-//!   can serve a whole image; `pixel` takes set `pixel mod sets` (a file holding one set per
-//!   pixel, e.g. a layout exported by `strata pointset --export`).
+//!   `h = hash(TAG_FILE, seed, dim, pixel, block)` (murmur3 `fmix32` folding, see `hash.rs`), so
+//!   one set can serve a whole image; `pixel` takes set `pixel mod sets` (a file holding one set
+//!   per pixel, e.g. a layout exported by `strata pointset --export`).
 //! - **how it is randomized** ([`Scramble`], keyed by `h`): `shift` (the default), a
 //!   Cranley-Patterson rotation `x + s mod 1` per axis; `owen`, a nested uniform (Owen) digit
 //!   scramble in base 2; `xor`, a random digital shift; `none` (deterministic, biased).
@@ -161,8 +163,11 @@ impl Layout for FileLayout {
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
         let t = &self.table;
         let points = t.points;
-        let i = sample.mul(L::splat(set.n())).add(k).map(|i| i % points);
-        let h = hash(TAG_FILE, seed, dim, [pixel]);
+        let i = sample.mul(L::splat(set.n())).add(k);
+        // Block `i / points` of an index past the set (equal-time runs, whose spp is not known in
+        // advance) gets its own set and randomization: blocks of `points` points, each unbiased.
+        let (block, i) = (i.map(|i| i / points), i.map(|i| i % points));
+        let h = hash(TAG_FILE, seed, dim, [pixel, block]);
         let s = match self.map {
             SetMap::Hash => h.mulhi(L::splat(t.sets)),
             SetMap::Pixel => pixel.map(|p| p % t.sets),
@@ -273,8 +278,11 @@ mod tests {
     }
 
     fn kind(map: SetMap, scramble: Scramble, digest: &str) -> SamplerKind {
-        let layout = FileLayout { table: table(3, 16), map, scramble, pad: None };
-        register("file:test", digest, layout).unwrap()
+        kind_of(table(3, 16), map, scramble, digest)
+    }
+
+    fn kind_of(table: PointTable, map: SetMap, scramble: Scramble, digest: &str) -> SamplerKind {
+        register("file:test", digest, FileLayout { table, map, scramble, pad: None }).unwrap()
     }
 
     #[test]
@@ -291,6 +299,11 @@ mod tests {
         // Sample s of an n-point draw is point s * n + k (mod points), as the sequence layouts.
         assert_eq!(PointSet::new(k, 4).point(1, 2, 0, 3, 0), set.point(1, 0, 0, 11, 0));
         assert_eq!(set.point(1, 1, 0, 3, 0), set.point(1, 0, 0, 3, 0));
+        // Scrambled, the next block of `points` indices is a fresh randomization of a set.
+        let shifted = PointSet::new(kind(SetMap::Hash, Scramble::Shift, "blocks"), 16);
+        let block = |b: u32| (0..16).map(|i| shifted.point(1, b, 0, i, 0)).collect::<Vec<_>>();
+        assert_ne!(block(0), block(1));
+        assert_eq!(block(1), (0..16).map(|i| shifted.point(1, 0, 0, 16 + i, 0)).collect::<Vec<_>>());
         assert!(k.is_biased() && k.info().period == Some(16));
     }
 
@@ -310,7 +323,7 @@ mod tests {
         // with pixel, dim and seed.
         let t = table(1, 16);
         for scramble in [Scramble::Shift, Scramble::Xor, Scramble::Owen] {
-            let k = kind(SetMap::Hash, scramble, "structure");
+            let k = kind_of(t.clone(), SetMap::Hash, scramble, "structure: one set");
             let set = PointSet::new(k, 16);
             let p = |pixel, dim, seed, i| set.point(pixel, 0, dim, i, seed).map(fixed24_f32);
             let a: Vec<_> = (0..16).map(|i| p(3, 1, 7, i)).collect();
