@@ -179,3 +179,17 @@ def test_a_scene_is_parsed_once_and_renders_like_its_path(tmp_path):
     assert np.array_equal(np.asarray(a), np.asarray(b))
     with pytest.raises(strata.StrataError, match="s.test:1"):
         strata.Scene(path)
+
+
+def test_files_and_arrays_compare_against_sobol_at_equal_time(tmp_path):
+    """The issue's run in one go (small): a hand-written UTK text set, a .npy and an array, each
+    against Sobol' with compare's --budget on the hw2 sphere (needs ../shared)."""
+    assert (SHARED / "cse168" / "hw2" / "sphere.test").is_file(), "the shared corpus is required"
+    example = ROOT / "examples" / "python" / "point_sets_at_equal_time.py"
+    r = subprocess.run([sys.executable, str(example), "--small", "--out", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    rows = json.loads((tmp_path / "compare" / "rows.json").read_text())
+    assert [row["variant"] for row in rows] == ["utk-text", "npy", "array", "sobol"]
+    for row in rows:
+        assert row["spp"] > 4 and 0 < row["mse"] < 0.01, row
