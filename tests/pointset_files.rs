@@ -167,3 +167,57 @@ fn pointset_command_exports_and_measures() {
         |t: &str| t.lines().filter(|l| l.trim_start().starts_with(['0', '1'])).map(String::from).collect::<Vec<_>>();
     assert_eq!(rows(&text), rows(&t2), "{text}\n{t2}");
 }
+
+#[test]
+fn file_samplers_work_in_shards_and_profile() {
+    let dir = tmpdir("pointset-shards");
+    let sc = scene(&dir);
+    let pts = dir.join("pts.npy");
+    let data: Vec<f64> = (0..2 * 32 * 2).map(|i| ((i * 37 % 64) as f64 + 0.5) / 64.0).collect();
+    formats::write(&pts, &strata::pointset::PointSets::new("pts", 2, 32, 2, data).unwrap()).unwrap();
+    let spec = format!("file:{}", pts.display());
+    let render = |extra: &[&str], out: &str| {
+        let o = strata()
+            .args([
+                "render",
+                sc.to_str().unwrap(),
+                "-q",
+                "--spp",
+                "8",
+                "--light-sampler",
+                &spec,
+                "--pixel-sampler",
+                &spec,
+            ])
+            .args(extra)
+            .arg("-o")
+            .arg(dir.join(out))
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    render(&["--samples", "0..3"], "a");
+    render(&["--samples", "3..8"], "b");
+    render(&[], "whole");
+    let m = strata()
+        .arg("merge")
+        .arg(dir.join("a.ckpt"))
+        .arg(dir.join("b.ckpt"))
+        .arg("-q")
+        .arg("-o")
+        .arg(dir.join("merged"))
+        .output()
+        .unwrap();
+    assert!(m.status.success(), "{}", String::from_utf8_lossy(&m.stderr));
+    let read = |n: &str| strata::film::read_exr(&dir.join(format!("{n}.exr"))).unwrap().rgb;
+    assert!(read("merged") == read("whole"), "shards of a file-sampler render merge bit-identically");
+    let p = strata()
+        .args(["profile", sc.to_str().unwrap(), "-q", "--spp", "8", "--repeats", "1", "--light-sampler", &spec])
+        .arg("--json")
+        .arg(dir.join("p.json"))
+        .output()
+        .unwrap();
+    assert!(p.status.success(), "{}", String::from_utf8_lossy(&p.stderr));
+    let json = std::fs::read_to_string(dir.join("p.json")).unwrap();
+    assert!(json.contains(&format!("light {spec}")), "the replay names the file sampler");
+}
