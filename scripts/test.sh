@@ -23,7 +23,7 @@ if [ ${#args[@]} -eq 0 ]; then
   fi
   echo "test: cargo fmt --check" >&2
   cargo fmt --check
-  echo "test: cargo clippy --release --all-targets -- -D warnings" >&2
+  echo "test: cargo clippy --release --workspace --all-targets -- -D warnings" >&2
   cargo clippy --release --workspace --all-targets -- -D warnings
 fi
 cargo test --release ${args[@]+"${args[@]}"}
