@@ -94,35 +94,13 @@ fn main() -> ExitCode {
                 }
             })
         }
-        Cmd::Compare {
-            scene,
-            reference,
-            variants,
-            runs,
-            budget,
-            spp_ladder,
-            size,
-            threads,
-            out,
-            profile,
-            profile_svg,
-        } => {
-            let profile = strata::frontend::ProfileOut { json: profile, svg: profile_svg };
-            let args = strata::frontend::CompareArgs {
-                scene,
-                reference,
-                variants,
-                runs,
-                budget,
-                spp_ladder,
-                size,
-                threads,
-                out,
-                profile,
-            };
-            strata::frontend::run_compare(&args).map(|o| {
-                println!("{}", o.markdown);
-                println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", args.out.display());
+        // The library's copy of this grammar parses the same arguments into `CompareArgs`.
+        Cmd::Compare { .. } => {
+            strata::frontend::compare_args(&std::env::args().skip(2).collect::<Vec<_>>()).and_then(|args| {
+                strata::frontend::run_compare(&args).map(|o| {
+                    println!("{}", o.markdown);
+                    println!("written to {}/ (rows.csv, rows.json, table.md, error.svg)", args.out.display());
+                })
             })
         }
         Cmd::GenMesh { out, triangles } => {
