@@ -198,13 +198,27 @@ pub(crate) struct RenderArgs {
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     pub(crate) threads: usize,
+    // Every sampling dimension's layout; the help lists the sampler registry.
+    #[arg(long, value_parser = parse_sampler, help = format!(
+        "Sampler of every dimension (pixel, light point and choice, lobe, direction, roulette): {} \
+         (default stratified; --pixel-sampler and --light-sampler override their dimensions), or \
+         file:PATH[?options] (a point-set file, as --light-sampler)",
+        SamplerKind::help_list()
+    ))]
+    pub(crate) sampler: Option<SamplerKind>,
     // Light sample layout; the help lists the sampler registry.
     #[arg(long, value_parser = parse_sampler, help = format!(
-        "Light sample layout: {}, or file:PATH[?scramble=shift|owen|xor|none&sets=hash|pixel&pad=NAME] \
-         (a point-set file: UTK text, UTK .bin or .npy; see docs/POINTSETS.md)",
+        "Light sample layout (light point and choice, in direct and the path tracer): {}, or \
+         file:PATH[?scramble=shift|owen|xor|none&sets=hash|pixel&pad=NAME] (a point-set file: UTK text, \
+         UTK .bin or .npy; see docs/POINTSETS.md)",
         SamplerKind::help_list()
     ))]
     pub(crate) light_sampler: Option<SamplerKind>,
+    /// Where a one-light choice (--light-selection uniform, power, spatial) takes its number from:
+    /// reuse (the light point's first coordinate, remapped, as Mitsuba does; default) or dimension
+    /// (a sampler dimension of its own).
+    #[arg(long, value_name = "MODE")]
+    pub(crate) light_choice: Option<strata::integrator::LightChoice>,
     /// Light samples per light (default: the scene's lightsamples).
     #[arg(long)]
     pub(crate) light_samples: Option<u32>,
@@ -266,7 +280,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, value_parser = parse_range)]
     pub(crate) samples: Option<(u32, u32)>,
     /// Render whole passes until this many seconds are spent and record the spp reached
-    /// (independent pixel and path layouts; --spp, if given, caps the samples).
+    /// (progressive samplers continue their sequence across passes; a sampler that needs its
+    /// count in advance is refused; --spp, if given, caps the samples).
     #[arg(long)]
     pub(crate) time_budget: Option<f64>,
     /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
@@ -302,7 +317,9 @@ impl RenderArgs {
             size: self.size,
             seed: self.seed,
             threads: self.threads,
+            sampler: self.sampler,
             light_sampler: self.light_sampler,
+            light_choice: self.light_choice,
             light_samples: self.light_samples,
             pixel_sampler: self.pixel_sampler,
             out: self.out,

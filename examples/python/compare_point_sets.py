@@ -56,14 +56,14 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     size, spps, ref_spp = ((80, 60), [16, 32, 64], 1024) if a.small else ((640, 480), [16, 32, 64, 128, 256], 8192)
     common = dict(size=size, light_samples=1, threads=0)
-    ref = strata.render(SPHERE, spp=ref_spp, pixel_sampler="sobol", light_sampler="sobol", seed=99, **common)
+    ref = strata.render(SPHERE, spp=ref_spp, sampler="sobol", seed=99, **common)
     rng = np.random.default_rng(2018)
     rows = []
     for spp in spps:
         samplers = {
             "rank1": dict(points=rank1_lattice(spp)),
             "jittered": dict(points=jittered(spp, rng)),
-            "sobol": dict(pixel_sampler="sobol", light_sampler="sobol"),
+            "sobol": dict(sampler="sobol"),
         }
         for name, flags in samplers.items():
             img = strata.render(SPHERE, spp=spp, seed=1, **common, **flags)

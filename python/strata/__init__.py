@@ -97,12 +97,9 @@ def _render_args(scene, flags):
         scene = scene.path
     arrays = {k: flags.pop(k) for k in ("pixel_points", "light_points", "points") if flags.get(k) is not None}
     opts = {k: flags.pop(k, None) for k in ("scramble", "sets", "pad")}
+    flag = {"pixel_points": "pixel_sampler", "light_points": "light_sampler", "points": "sampler"}
     for name, array in arrays.items():
-        sampler = points_sampler(name, array, **opts)
-        if name in ("pixel_points", "points"):
-            flags["pixel_sampler"] = sampler
-        if name in ("light_points", "points"):
-            flags["light_sampler"] = sampler
+        flags[flag[name]] = points_sampler(name, array, **opts)
     if not flags.pop("progress", False):
         flags["quiet"] = True
     args = [] if scene is None else [os.fspath(scene)]

@@ -83,6 +83,8 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("pixel_sampler", json!(it.pixel_set.kind().name())),
         ("light_sampler", json!(it.light_set.kind().name())),
         ("light_samples", json!(it.light_set.n())),
+        ("sampler", json!(it.path_set.set().kind().name())),
+        ("light_choice", json!(it.light_choice.name())),
         ("layout", json!(if time_budget { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
         ("clamp", json!(it.clamp)),
@@ -92,9 +94,17 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
     // A point-set file's (or array's) content is part of the identity, not only its name.
-    .chain([("pixel_sampler", it.pixel_set.kind()), ("light_sampler", it.light_set.kind())].into_iter().filter_map(
-        |(k, kind)| crate::sampler::file::file_info(kind).map(|(digest, ..)| (format!("{k}_digest"), json!(digest))),
-    ))
+    .chain(
+        [
+            ("pixel_sampler", it.pixel_set.kind()),
+            ("light_sampler", it.light_set.kind()),
+            ("sampler", it.path_set.set().kind()),
+        ]
+        .into_iter()
+        .filter_map(|(k, kind)| {
+            crate::sampler::file::file_info(kind).map(|(digest, ..)| (format!("{k}_digest"), json!(digest)))
+        }),
+    )
     .collect();
     Header {
         strata_version: env!("CARGO_PKG_VERSION").to_string(),
