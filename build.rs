@@ -110,4 +110,6 @@ fn main() {
     println!("cargo:rustc-link-search=native={}", dir.display());
     println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
     println!("cargo:rustc-env=STRATA_EMBREE_LIBDIR={}", dir.display());
+    // For dependents' build scripts (python/build.rs adds the same rpath to the Python module).
+    println!("cargo:libdir={}", dir.display());
 }

@@ -7,8 +7,17 @@
 #   - NVIDIA's flip-evaluator (FLIP's reference implementation, with numpy) into target/py, for
 #     tests/flip.rs (pip --target: no system packages touched)
 #   - a Rust toolchain is assumed (cargo on PATH); rustup is used to install it if missing.
+#   - with --python: the project virtualenv .venv (maturin, numpy, pytest, matplotlib from PyPI)
+#     with the `strata` Python module built into it (scripts/test.sh asks for it).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+python_module=
+for a in "$@"; do
+  case "$a" in
+    --python) python_module=1 ;;
+    *) echo "setup: unknown option $a (known: --python)" >&2; exit 2 ;;
+  esac
+done
 
 need_apt=()
 dpkg -s libclang-dev >/dev/null 2>&1 || need_apt+=(libclang-dev)
@@ -16,6 +25,8 @@ command -v pkg-config >/dev/null 2>&1 || need_apt+=(pkg-config)
 command -v python3 >/dev/null 2>&1 || need_apt+=(python3)
 python3 -m pip --version >/dev/null 2>&1 || need_apt+=(python3-pip)
 command -v chromium >/dev/null 2>&1 || need_apt+=(chromium)
+# The Python module's virtualenv needs venv with ensurepip (Debian's python3-venv).
+[ -z "$python_module" ] || python3 -c 'import ensurepip, venv' >/dev/null 2>&1 || need_apt+=(python3-venv)
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "setup: installing ${need_apt[*]}" >&2
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
@@ -34,13 +45,13 @@ if ! command -v cargo >/dev/null 2>&1; then
 fi
 command -v cargo >/dev/null 2>&1 || { echo "setup: cargo not found; install Rust with rustup first" >&2; exit 1; }
 
-if [ -n "${EMBREE_DIR:-}" ] || pkg-config --exists embree4 2>/dev/null; then
-  exit 0
-fi
+embree_ready() {
+  [ -n "${EMBREE_DIR:-}" ] && return 0
+  pkg-config --exists embree4 2>/dev/null && return 0
+  [ -e "$root/.embree/lib/libembree4.so" ] && ls "$root/.embree/lib"/libtbb*.so* >/dev/null 2>&1
+}
+if ! embree_ready; then
 lib="$root/.embree/lib"
-if [ -e "$lib/libembree4.so" ] && ls "$lib"/libtbb*.so* >/dev/null 2>&1; then
-  exit 0
-fi
 echo "setup: fetching Embree 4.4 from the PyPI wheel embreex==4.4.0.post1 into .embree/" >&2
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
@@ -61,3 +72,21 @@ emb="$(ls "$lib"/libembree4-*.so.4 | head -n1)"
 ln -sf "$(basename "$emb")" "$lib/libembree4.so"
 ln -sf "$(basename "$emb")" "$lib/libembree4.so.4"
 echo "setup: Embree ready in $lib" >&2
+fi
+
+# ---- Python module (issue 24; `--python`): .venv with maturin, numpy, pytest, matplotlib and the
+# ---- `strata` module built from python/ (sharing target/ with the renderer). Idempotent: the
+# ---- packages are installed once (a stamp lists them); cargo rebuilds the module only on change.
+if [ -n "$python_module" ]; then
+  venv="$root/.venv"
+  [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+  want="maturin>=1.5,<2 numpy pytest matplotlib"
+  if [ "$(cat "$venv/.strata-packages" 2>/dev/null)" != "$want" ]; then
+    echo "setup: installing $want into .venv" >&2
+    # shellcheck disable=SC2086
+    "$venv/bin/python" -m pip install -q $want
+    echo "$want" >"$venv/.strata-packages"
+  fi
+  echo "setup: building the strata Python module into .venv (maturin develop --release)" >&2
+  (cd "$root/python" && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" maturin develop --release --quiet)
+fi

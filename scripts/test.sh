@@ -4,7 +4,8 @@
 # --slurm: afterwards, also run scripts/test-slurm.sh (a real one-node Slurm: the job-array
 # recipe of examples/cluster with a requeued task, merged bit-identically; root, about a minute).
 # A full run (no cargo test args) first checks `cargo fmt --check` and
-# `cargo clippy --release --all-targets -- -D warnings`.
+# `cargo clippy --release --workspace --all-targets -- -D warnings` (the renderer and python/), and
+# after the Rust tests builds the Python module into .venv and runs its pytest suite (python/tests).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 slurm=
@@ -22,10 +23,17 @@ if [ ${#args[@]} -eq 0 ]; then
   fi
   echo "test: cargo fmt --check" >&2
   cargo fmt --check
-  echo "test: cargo clippy --release --all-targets -- -D warnings" >&2
-  cargo clippy --release --all-targets -- -D warnings
+  echo "test: cargo clippy --release --workspace --all-targets -- -D warnings" >&2
+  cargo clippy --release --workspace --all-targets -- -D warnings
 fi
 cargo test --release ${args[@]+"${args[@]}"}
+if [ ${#args[@]} -eq 0 ]; then
+  # The Python module (scripts/setup.sh --python builds it into .venv), tested against the binary
+  # cargo test just built.
+  "$root/scripts/setup.sh" --python
+  echo "test: pytest python/tests" >&2
+  STRATA_BIN="$root/target/release/strata" "$root/.venv/bin/python" -m pytest -q "$root/python/tests"
+fi
 if [ -n "$slurm" ]; then
   "$root/scripts/test-slurm.sh"
 fi

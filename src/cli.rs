@@ -130,6 +130,45 @@ pub(crate) enum Cmd {
         #[arg(long, default_value_t = 2)]
         sheet_factor: u32,
     },
+    /// Measure a point set (a file: UTK text, UTK .bin, .npy; or a registry sampler NAME): per set
+    /// the L2 star discrepancy and minimum distance, the radial power spectrum (CSV, SVG) and the
+    /// integration error on a disk and a Gaussian for N = 4..4096 with the fitted slope.
+    Pointset {
+        /// Point-set file or registry sampler name.
+        target: String,
+        /// Folder for spectrum.csv/svg, integration.csv/svg and pointset.json.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Write the sets to FILE (.txt UTK text, .bin UTK binary, .npy NumPy): a layout's sets
+        /// (set j = pixel j's points), or a file's in another format.
+        #[arg(long, value_name = "FILE")]
+        export: Option<PathBuf>,
+        /// Registry layouts: number of sets (set j is pixel j's).
+        #[arg(long, default_value_t = 4)]
+        sets: u32,
+        /// Registry layouts: points per set.
+        #[arg(long, default_value_t = 1024)]
+        points: u32,
+        /// Base seed (layouts' sets; the integration test's randomizations).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Registry layouts: sampler dimension of the sets (0 = the camera's).
+        #[arg(long, default_value_t = 0)]
+        dim: u32,
+        /// Registry layouts: image width the pixel ids refer to (screen-space layouts, e.g. zsobol).
+        #[arg(long, default_value_t = 0)]
+        width: u32,
+        /// Randomizations per N in the integration test.
+        #[arg(long, default_value_t = 256)]
+        trials: u32,
+        /// Largest radial frequency of the spectrum.
+        #[arg(long, default_value_t = 64)]
+        max_freq: usize,
+        /// Files: how the integration test randomizes the sets (as a render would), e.g.
+        /// scramble=owen (repeatable).
+        #[arg(long = "option", value_name = "KEY=VALUE")]
+        options: Vec<String>,
+    },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
     Rays {
         #[command(flatten)]
@@ -180,13 +219,16 @@ pub(crate) struct RenderArgs {
     // Every sampling dimension's layout; the help lists the sampler registry.
     #[arg(long, value_parser = parse_sampler, help = format!(
         "Sampler of every dimension (pixel, light point and choice, lobe, direction, roulette): {} \
-         (default stratified; --pixel-sampler and --light-sampler override their dimensions)",
+         (default stratified; --pixel-sampler and --light-sampler override their dimensions), or \
+         file:PATH[?options] (a point-set file, as --light-sampler)",
         SamplerKind::help_list()
     ))]
     pub(crate) sampler: Option<SamplerKind>,
     // Light sample layout; the help lists the sampler registry.
     #[arg(long, value_parser = parse_sampler, help = format!(
-        "Light sample layout (light point and choice, in direct and the path tracer): {}",
+        "Light sample layout (light point and choice, in direct and the path tracer): {}, or \
+         file:PATH[?scramble=shift|owen|xor|none&sets=hash|pixel&pad=NAME] (a point-set file: UTK text, \
+         UTK .bin or .npy; see docs/POINTSETS.md)",
         SamplerKind::help_list()
     ))]
     pub(crate) light_sampler: Option<SamplerKind>,
@@ -201,7 +243,7 @@ pub(crate) struct RenderArgs {
     // Pixel sample layout; the help lists the sampler registry.
     #[arg(long, value_parser = parse_sampler, help = format!(
         "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
-         puts the sample at the pixel centre)",
+         puts the sample at the pixel centre), or file:PATH[?options] (a point-set file, as --light-sampler)",
         SamplerKind::help_list()
     ))]
     pub(crate) pixel_sampler: Option<SamplerKind>,
@@ -294,6 +336,7 @@ impl RenderArgs {
     pub(crate) fn options(self) -> RenderOptions {
         RenderOptions {
             scene: self.scene,
+            parsed: None,
             spp: self.spp,
             size: self.size,
             seed: self.seed,
@@ -378,8 +421,9 @@ pub(crate) fn parse_range(s: &str) -> Result<(u32, u32), String> {
     Ok((a, b))
 }
 
+/// A registry sampler name, or `file:PATH?options` (the file is loaded and checked here).
 pub(crate) fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
-    SamplerKind::parse(s).ok_or_else(|| format!("unknown sampler `{s}` ({})", SamplerKind::names()))
+    strata::pointset::spec::resolve_sampler(s).map_err(|e| e.to_string())
 }
 
 pub(crate) fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {

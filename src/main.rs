@@ -99,30 +99,15 @@ fn main() -> ExitCode {
                 }
             })
         }
-        Cmd::Compare {
-            scene,
-            reference,
-            variants,
-            baseline,
-            force,
-            quiet,
-            runs,
-            budget,
-            spp_ladder,
-            size,
-            threads,
-            out,
-            profile,
-            profile_svg,
-        } => {
-            let profile_out = ProfileOut { json: profile, svg: profile_svg };
-            let mode = match (budget, spp_ladder) {
-                (Some(b), _) => strata::lab::Mode::Budget(b),
-                (None, Some(l)) => strata::lab::Mode::Ladder(l),
-                (None, None) => strata::lab::Mode::Ladder(Vec::new()),
-            };
-            let opts = strata::lab::Options { runs, mode, baseline, force, size, threads, progress: !quiet };
-            run_compare(scene, &reference, &variants, &opts, &out, &profile_out)
+        // The library's copy of this grammar parses the same arguments into `CompareArgs`.
+        Cmd::Compare { .. } => {
+            strata::frontend::compare_args(&std::env::args().skip(2).collect::<Vec<_>>()).and_then(|args| {
+                strata::frontend::run_compare(&args).map(|o| {
+                    println!("{}", o.markdown);
+                    println!("written to {}/ (report.html, rows.csv, rows.json, runs.csv, runs.json, table.md, error.svg)", args.out.display());
+                })
+            })
+        }
         }
         Cmd::GenMesh { out, triangles } => gen_mesh(&out, triangles),
         Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
@@ -142,6 +127,9 @@ fn main() -> ExitCode {
                 println!("{md}");
                 println!("written to {}/ (report.html, results.md, results.json, *.svg)", out.display());
             })
+        }
+        Cmd::Pointset { target, out, export, sets, points, seed, dim, width, trials, max_freq, options } => {
+            run_pointset(target, out, export, [sets, points, dim, width, trials], seed, max_freq, &options)
         }
         Cmd::Rays { args, json } => {
             session::run_rays(&args.options()).map_err(|e| e.to_string()).map(|(rates, name)| {
@@ -227,72 +215,39 @@ fn gen_mesh(out: &std::path::Path, triangles: usize) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", out.display()))
 }
 
-/// Where `compare` writes its variants' profiles (`--profile`, `--profile-svg`).
-struct ProfileOut {
-    json: Option<PathBuf>,
-    svg: Option<PathBuf>,
-}
-
-/// Splits `--variant NAME=FLAGS` into the name and its flags (shell quoting, `shlex`).
-fn variant_flags(spec: &str) -> Result<(&str, Vec<String>), String> {
-    let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
-    let words = shlex::split(flags).ok_or_else(|| format!("--variant {name}: unbalanced quotes in `{flags}`"))?;
-    Ok((name, words))
-}
-
-/// The command line of this process, shell-quoted (`shlex`), for the report.
-fn command_line() -> String {
-    let args: Vec<String> = std::env::args().collect();
-    shlex::try_join(args.iter().map(String::as_str)).unwrap_or_else(|_| args.join(" "))
-}
-
-fn run_compare(
-    scene: Option<PathBuf>,
-    reference: &std::path::Path,
-    specs: &[String],
-    opts: &strata::lab::Options,
-    out: &std::path::Path,
-    profile_out: &ProfileOut,
+/// `strata pointset`: `counts` are sets, points, dim, width, trials.
+fn run_pointset(
+    target: String,
+    out: Option<PathBuf>,
+    export: Option<PathBuf>,
+    counts: [u32; 5],
+    seed: u64,
+    max_freq: usize,
+    options: &[String],
 ) -> Result<(), String> {
-    if matches!(&opts.mode, strata::lab::Mode::Ladder(l) if l.is_empty()) {
-        return Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into());
+    let [sets, points, dim, width, trials] = counts;
+    let mut opts = strata::pointset::spec::Options::default();
+    options.iter().try_for_each(|kv| opts.set(kv)).map_err(|e| e.to_string())?;
+    let args = strata::pointset::command::Args {
+        target,
+        out: out.clone(),
+        export: export.clone(),
+        sets,
+        points,
+        seed,
+        dim,
+        width,
+        trials,
+        max_freq,
+        options: opts,
+    };
+    let (_, table) = strata::pointset::command::run(&args).map_err(|e| e.to_string())?;
+    println!("{table}");
+    if let Some(d) = out {
+        println!("written to {}/ (spectrum.csv/svg, integration.csv/svg, pointset.json)", d.display());
     }
-    let mut variants = Vec::new();
-    for spec in specs {
-        let (name, flags) = variant_flags(spec)?;
-        let mut argv = vec!["strata".to_string(), "render".to_string()];
-        argv.extend(scene.iter().map(|p| p.display().to_string()));
-        argv.extend(flags.iter().cloned());
-        let cli = Cli::try_parse_from(&argv)
-            .map_err(|e| format!("--variant {name}: {}", e.to_string().lines().next().unwrap_or("")))?;
-        let Cmd::Render(args) = cli.cmd else { unreachable!("parsed as render") };
-        variants.push(strata::lab::Variant { name: name.to_string(), opts: args.options(), flags });
+    if let Some(e) = export {
+        println!("sets written to {}", e.display());
     }
-    for f in [&profile_out.json, &profile_out.svg].into_iter().flatten() {
-        session::checks::check_output_file(f).map_err(|e| e.to_string())?;
-    }
-    let c = strata::lab::run(&variants, reference, opts).map_err(|e| e.to_string())?;
-    let title = format!(
-        "{} vs {}",
-        scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
-        reference.display()
-    );
-    let md = strata::lab::write_outputs(&c, out, &title, &[command_line()]).map_err(|e| e.to_string())?;
-    let profiles = &c.profiles;
-    if let Some(f) = &profile_out.json {
-        let text = serde_json::to_string_pretty(profiles).map_err(|e| e.to_string())?;
-        session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
-    }
-    if let Some(f) = &profile_out.svg {
-        let entries: Vec<(&str, &session::Profile)> =
-            profiles.iter().map(|v| (v.variant.as_str(), &v.profile)).collect();
-        let svg = session::profile::profile_svg(&entries, &format!("phases per variant: {title}"));
-        session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
-    }
-    println!("{md}");
-    println!(
-        "written to {}/ (report.html, rows.csv, rows.json, runs.csv, runs.json, table.md, error.svg)",
-        out.display()
-    );
     Ok(())
 }

@@ -1,5 +1,5 @@
 //! The convergence matrix: every registered unbiased sampler (read from `SAMPLERS`, so a new
-//! sampler is covered without editing this file) x the integrator configurations that draw light
+//! sampler is covered without editing this file) and a file-backed one x the integrator configurations that draw light
 //! choices, light points, lobes, directions and roulette, on scenes with one light, three lights,
 //! GGX and many lights. Each render is checked against a high-spp independent reference of the
 //! same configuration, with the reference's own noise (its variance of the mean) subtracted:
@@ -157,8 +157,24 @@ fn block_z(img: &(Rgb, Rgb), reference: &(Rgb, Rgb), (w, h): (u32, u32)) -> f64 
 }
 
 /// Every unbiased registered sampler (grid centres are deterministic and biased: excluded).
+/// And a file-backed one (`file:PATH`, issue 24): 16 sets of 256 Sobol' points written by
+/// `strata pointset`'s export, Owen-scrambled per pixel and dimension.
 fn samplers() -> Vec<SamplerKind> {
-    SAMPLERS.iter().filter(|s| !s.biased).map(|s| SamplerKind::parse(s.name).expect("registered")).collect()
+    let mut kinds: Vec<SamplerKind> =
+        SAMPLERS.iter().filter(|s| !s.biased).map(|s| SamplerKind::parse(s.name).expect("registered")).collect();
+    kinds.push(file_sampler());
+    kinds
+}
+
+fn file_sampler() -> SamplerKind {
+    static KIND: std::sync::OnceLock<SamplerKind> = std::sync::OnceLock::new();
+    *KIND.get_or_init(|| {
+        use strata::pointset::{command, formats, spec};
+        let path = common::tmpdir("convergence-file").join("sobol.npy");
+        let args = command::Args { sets: 16, points: 256, ..command::Args::default() };
+        formats::write(&path, &command::layout_sets(SamplerKind::SOBOL, &args).expect("sets")).expect("written");
+        spec::resolve_sampler(&format!("file:{}?scramble=owen", path.display())).expect("loads")
+    })
 }
 
 #[test]

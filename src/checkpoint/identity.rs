@@ -138,6 +138,18 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
     .into_iter()
     .chain(backend_options(scene))
     .map(|(k, v)| (k.to_string(), v))
+    // A point-set file's (or array's) content is part of the identity, not only its name.
+    .chain(
+        [
+            ("pixel_sampler", it.pixel_set.kind()),
+            ("light_sampler", it.light_set.kind()),
+            ("sampler", it.path_set.set().kind()),
+        ]
+        .into_iter()
+        .filter_map(|(k, kind)| {
+            crate::sampler::file::file_info(kind).map(|(digest, ..)| (format!("{k}_digest"), json!(digest)))
+        }),
+    )
     .collect();
     Header {
         strata_version: env!("CARGO_PKG_VERSION").to_string(),

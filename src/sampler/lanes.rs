@@ -1,6 +1,7 @@
 //! The scalar/x8 lane abstraction every generator is written against. All arithmetic wraps modulo
 //! 2^32, so the `u32` and the [`U8`] instantiation of one generic generator agree bit for bit.
 
+use super::layout::{DynLayout, SetShape};
 use crate::simd::{i32x8, F8, U8};
 
 /// Unsigned 32-bit lanes: `u32` (one lane) or `U8` (eight). Every generator is written once against
@@ -38,6 +39,17 @@ pub trait Lanes: Copy {
     fn mulhi(self, o: Self) -> Self {
         self.mul_wide(o).1
     }
+    /// `layout`'s point for these lanes (a run-time layout inside a generic one: file padding).
+    #[allow(clippy::too_many_arguments)]
+    fn dyn_point(
+        layout: &dyn DynLayout,
+        set: &SetShape,
+        pixel: Self,
+        sample: Self,
+        dim: u32,
+        k: Self,
+        seed: u64,
+    ) -> (Self::F, Self::F);
 }
 
 const INV_2_24: f32 = 1.0 / 16_777_216.0;
@@ -87,6 +99,17 @@ impl Lanes for u32 {
     }
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         f(self)
+    }
+    fn dyn_point(
+        l: &dyn DynLayout,
+        set: &SetShape,
+        pixel: u32,
+        sample: u32,
+        dim: u32,
+        k: u32,
+        seed: u64,
+    ) -> (f32, f32) {
+        l.point_1(set, pixel, sample, dim, k, seed)
     }
 }
 
@@ -144,5 +167,9 @@ impl Lanes for U8 {
     #[inline]
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         U8::new(self.to_array().map(f))
+    }
+    #[inline]
+    fn dyn_point(l: &dyn DynLayout, set: &SetShape, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
+        l.point_8(set, pixel, sample, dim, k, seed)
     }
 }

@@ -29,6 +29,7 @@
 use crate::simd::{F8, U8};
 
 mod divisor;
+pub mod file;
 mod grid;
 mod hash;
 mod lanes;
@@ -194,13 +195,27 @@ impl SamplerKind {
         self.info().biased
     }
 
-    /// Its registry entry.
+    /// Its registry entry (for a loaded point set, the entry [`file::register`] made).
     pub fn info(self) -> &'static SamplerInfo {
         #[cfg(test)]
         if self.0 == u8::MAX {
             return &slow_test::INFO;
         }
-        &SAMPLERS[self.0 as usize]
+        match self.loaded_index() {
+            Some(j) => file::info(j),
+            None => &SAMPLERS[self.0 as usize],
+        }
+    }
+
+    /// The kind of loaded point set `j` (made by [`file::register`] only).
+    const fn loaded(j: usize) -> Self {
+        SamplerKind((SAMPLERS.len() + j) as u8)
+    }
+
+    /// For a loaded point set (`file:PATH`, a Python array), its index among them.
+    pub fn loaded_index(self) -> Option<usize> {
+        let i = self.0 as usize;
+        (i >= SAMPLERS.len() && self.0 != u8::MAX).then(|| i - SAMPLERS.len())
     }
 
     /// Its generator.

@@ -170,6 +170,13 @@ fn rotl<L: Lanes>(x: L, s: u32) -> L {
     x.shl(s).or(x.shr(32 - s))
 }
 
+/// Nested uniform (Owen) scramble of the 24-bit fixed-point coordinate `x` under `key`: digit j
+/// (from the top) is flipped by a keyed function of the digits above it.
+#[inline]
+pub(super) fn owen24<L: Lanes>(x: L, key: L) -> L {
+    reverse_bits(lk_permute(reverse_bits(x.shl(8)), key)).shr(8)
+}
+
 /// Reverses the 32 bits of every lane.
 #[inline]
 fn reverse_bits<L: Lanes>(x: L) -> L {

@@ -136,17 +136,22 @@ pub fn check_sampler_periods(opts: &RenderOptions, desc: &SceneDesc, spp: u32) -
     let flag = |own: Option<SamplerKind>, name| if own.is_some() || opts.sampler.is_none() { name } else { "sampler" };
     let asked_light = u64::from(spp) * u64::from(n_light);
     let cases = [
-        (pixel, u64::from(spp), format!("{spp} spp"), flag(opts.pixel_sampler, "pixel-sampler")),
+        (pixel, u64::from(spp), format!("{spp} spp"), flag(opts.pixel_sampler, "pixel-sampler"), "--spp"),
         (
             light,
             asked_light,
             format!("{spp} spp x {n_light} light samples = {asked_light} points"),
             flag(opts.light_sampler, "light-sampler"),
+            "--spp or --light-samples",
         ),
-        (base, u64::from(spp), format!("{spp} spp"), "sampler"),
+        (base, u64::from(spp), format!("{spp} spp"), "sampler", "--spp"),
     ];
-    for (kind, asked, phrase, flag) in cases {
+    for (kind, asked, phrase, flag, lower) in cases {
         let info = kind.info();
+        if let Some((_, _, points)) = crate::sampler::file::file_info(kind).filter(|f| asked > u64::from(f.2)) {
+            let (sampler, points) = (info.name, u64::from(points));
+            return Err(SessionError::FilePoints { sampler, points, asked: phrase, need: asked, lower });
+        }
         if let Some(period) = info.period.filter(|&p| asked > p) {
             let alternative = if info.name == "sobol" { "independent" } else { "sobol" };
             return Err(SessionError::SamplerPeriod { sampler: info.name, period, asked: phrase, flag, alternative });

@@ -189,6 +189,23 @@ pub enum SessionError {
         /// the checkpoint error
         source: Box<SessionError>,
     },
+    /// A point-set file (or array) has fewer points per set than the render draws per pixel.
+    #[error(
+        "{sampler}: its sets have {points} points, but {asked} are drawn per pixel (sets of {points} points \
+         are the limit: lower {lower}, or give sets of at least {need} points)"
+    )]
+    FilePoints {
+        /// the sampler's name (`file:PATH`)
+        sampler: &'static str,
+        /// points per set
+        points: u64,
+        /// what was asked, as a phrase ("64 spp")
+        asked: String,
+        /// points needed
+        need: u64,
+        /// the flags that lower the count ("--spp", "--spp or --light-samples")
+        lower: &'static str,
+    },
     /// A signal handler could not be installed.
     #[error("signal handler: {0}")]
     Signal(std::io::Error),

@@ -36,5 +36,5 @@ pub use pass::{render_to_film, stop_on_signals, RenderOutput};
 pub use profile::{profile_table, run_profile, run_profile_capped, Profile};
 pub use rays::{rates_table, run_rays};
 pub use replay::{KindReplay, SamplerReplay};
-pub use scene::{is_obj, load_scene, parse_camera, prepare, scene_hash};
+pub use scene::{is_obj, load_scene, parse_camera, parse_scene, prepare, scene_hash};
 pub use stats::{stats_json, summary};

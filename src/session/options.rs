@@ -18,6 +18,9 @@ pub const DEFAULT_CHECKPOINT_EVERY: f64 = 300.0;
 pub struct RenderOptions {
     /// scene file; None renders the built-in Cornell box
     pub scene: Option<PathBuf>,
+    /// `scene` already parsed ([`super::parse_scene`]; the Python module's `strata.Scene`): each
+    /// render starts from it instead of reading the file again (the overrides still apply)
+    pub parsed: Option<Arc<crate::scene::desc::SceneDesc>>,
     /// samples per pixel (default: the scene's `spp`)
     pub spp: Option<u32>,
     /// image size override, keeping the camera

@@ -15,13 +15,23 @@ fn over(flag: &'static str, value: String, max: u64, unit: &'static str, field: 
     SessionError::OverLimit { flag, value, max, unit, hint: parse::limit_hint(field) }
 }
 
-/// Parses the scene named in `opts` (or the built-in one) and applies the size override.
-pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
+/// Parses the scene named in `opts` (or the built-in one), without the overrides.
+pub fn parse_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     let limits = opts.limits;
-    let mut desc = match &opts.scene {
+    Ok(match &opts.scene {
         Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits)?,
         Some(p) => parse::parse_file(p, &limits)?,
         None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits)?,
+    })
+}
+
+/// Parses the scene named in `opts` (or the built-in one; or takes `opts.parsed`) and applies
+/// the overrides.
+pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
+    let limits = opts.limits;
+    let mut desc = match &opts.parsed {
+        Some(d) => SceneDesc::clone(d),
+        None => parse_scene(opts)?,
     };
     if let Some((w, h)) = opts.size {
         if w == 0 || h == 0 {

@@ -1,0 +1,183 @@
+//! `strata._strata`: the native half of the Python module. A thin layer over the library functions
+//! the CLI runs (`strata::frontend`, `strata::session`, `strata::pointset`, `strata::report`): the
+//! Python half (`strata/__init__.py`) turns keyword arguments into the CLI's flags and numpy arrays
+//! into little-endian bytes, so nothing here decides anything the CLI does not.
+//!
+//! Renders run with the GIL released, on a scoped thread, while the calling thread polls Python's
+//! signal handlers: Ctrl-C stops the render after its pass (as `strata render` does on SIGINT,
+//! checkpoint included) and raises `KeyboardInterrupt`.
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use strata::pointset::spec::Options;
+use strata::pointset::{sampler_from_sets, PointSets};
+use strata::session::{self, RenderOptions};
+
+create_exception!(_strata, StrataError, PyRuntimeError, "An error strata reports (the CLI's message).");
+
+fn err(e: impl ToString) -> PyErr {
+    StrataError::new_err(e.to_string())
+}
+
+/// f64 values from little-endian bytes.
+fn f64s(bytes: &[u8]) -> Vec<f64> {
+    bytes.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect()
+}
+
+/// f32 RGB triples from little-endian bytes.
+fn rgb(bytes: &[u8]) -> Vec<[f32; 3]> {
+    bytes
+        .chunks_exact(12)
+        .map(|c| std::array::from_fn(|i| f32::from_le_bytes(c[4 * i..4 * i + 4].try_into().expect("4 bytes"))))
+        .collect()
+}
+
+fn rgb_bytes(v: &[[f32; 3]]) -> Vec<u8> {
+    v.iter().flatten().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// Checks an array of points (float64 bytes, shape `[sets, points, dims]`) as a file's points are
+/// checked (messages name `<array NAME>`), and registers it as a sampler; returns the sampler's
+/// name (`array:NAME:DIGEST?options`), which render flags then accept like a registry name.
+fn array_sampler(
+    name: &str,
+    data: &[u8],
+    shape: [usize; 3],
+    options: &str,
+) -> Result<strata::sampler::SamplerKind, String> {
+    let source = format!("<array {name}>");
+    let ps = PointSets::new(&source, shape[0], shape[1], shape[2], f64s(data)).map_err(|e| e.to_string())?;
+    let mut opts = Options::default();
+    options.split('&').filter(|kv| !kv.is_empty()).try_for_each(|kv| opts.set(kv)).map_err(|e| e.to_string())?;
+    sampler_from_sets(&ps, &format!("array:{name}:{}", &ps.digest[..12.min(ps.digest.len())]), opts)
+        .map_err(|e| e.to_string())
+}
+
+/// Checks and registers a point array ([`array_sampler`]); returns the sampler name to pass in
+/// render flags (`--pixel-sampler NAME`).
+#[pyfunction]
+fn check_points(name: &str, data: &Bound<'_, PyBytes>, shape: [usize; 3], options: &str) -> PyResult<String> {
+    array_sampler(name, data.as_bytes(), shape, options).map(|k| k.name().to_string()).map_err(err)
+}
+
+/// A render's result for Python: (mean RGB f32 bytes, variance-of-mean f32 bytes, width, height,
+/// stats JSON).
+type Rendered = (Py<PyBytes>, Py<PyBytes>, u32, u32, String);
+
+/// A scene file parsed once (`strata.Scene`): renders given it start from the parsed scene.
+#[pyclass(frozen, name = "ParsedScene")]
+struct ParsedScene {
+    desc: Arc<strata::scene::desc::SceneDesc>,
+}
+
+/// Parses the scene of `strata render ARGS` (its file, `--limit`s) once, with the CLI's checks.
+#[pyfunction]
+fn parse_scene(py: Python<'_>, args: Vec<String>) -> PyResult<ParsedScene> {
+    let opts = strata::frontend::render_options(&args).map_err(err)?;
+    let desc = py.detach(|| session::parse_scene(&opts)).map_err(err)?;
+    Ok(ParsedScene { desc: Arc::new(desc) })
+}
+
+/// Renders `strata render ARGS` (point arrays are named in them after [`check_points`]; `scene`:
+/// the file parsed already); `write`: also write the CLI's outputs (`-o`). Returns (mean RGB f32
+/// bytes, variance-of-mean f32 bytes, width, height, stats JSON).
+#[pyfunction]
+#[pyo3(signature = (args, write, scene=None))]
+fn render(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedScene>) -> PyResult<Rendered> {
+    let mut opts: RenderOptions = strata::frontend::render_options(&args).map_err(err)?;
+    opts.parsed = scene.map(|s| Arc::clone(&s.desc));
+    let stop = Arc::new(AtomicBool::new(false));
+    opts.stop = Some(Arc::clone(&stop));
+    let outcome = py.detach(|| {
+        std::thread::scope(|s| {
+            let job = s.spawn(|| if write { session::run_render(&opts) } else { session::render_to_film(&opts) });
+            let mut signal = None;
+            while !job.is_finished() {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                if signal.is_none() {
+                    if let Err(e) = Python::attach(|py| py.check_signals()) {
+                        stop.store(true, Ordering::SeqCst);
+                        signal = Some(e);
+                    }
+                }
+            }
+            let result = job.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+            (result, signal)
+        })
+    });
+    let out = match outcome {
+        (Ok(o), Some(e)) if e.is_instance_of::<PyKeyboardInterrupt>(py) => {
+            let ck = o.checkpoint.as_ref().map_or(String::new(), |p| format!("; checkpoint {}", p.display()));
+            return Err(PyKeyboardInterrupt::new_err(format!(
+                "render interrupted after {} spp{ck}",
+                o.film.samples().len()
+            )));
+        }
+        (_, Some(e)) => return Err(e),
+        (Err(e), None) => return Err(err(e)),
+        (Ok(o), None) => o,
+    };
+    let (mean, var) = (out.film.mean(), out.film.variance_of_mean());
+    let stats = session::stats_json(&out).to_string();
+    let (w, h) = (out.film.width, out.film.height);
+    Ok((PyBytes::new(py, &rgb_bytes(&mean)).unbind(), PyBytes::new(py, &rgb_bytes(&var)).unbind(), w, h, stats))
+}
+
+/// Runs `strata compare ARGS` (writing its outputs as the CLI does); returns the rows as JSON.
+#[pyfunction]
+fn compare(py: Python<'_>, args: Vec<String>) -> PyResult<String> {
+    let a = strata::frontend::compare_args(&args).map_err(err)?;
+    let out = py.detach(|| strata::frontend::run_compare(&a)).map_err(err)?;
+    Ok(strata::report::to_json(&out.rows).to_string())
+}
+
+/// Mean squared error of two RGB f32 images (bytes of equal length), as `strata compare`.
+#[pyfunction]
+fn mse(a: &Bound<'_, PyBytes>, b: &Bound<'_, PyBytes>) -> PyResult<f64> {
+    strata::report::mse(&rgb(a.as_bytes()), &rgb(b.as_bytes())).map_err(err)
+}
+
+/// Relative MSE of an RGB f32 image against a reference, as `strata compare`.
+#[pyfunction]
+fn relmse(a: &Bound<'_, PyBytes>, b: &Bound<'_, PyBytes>) -> PyResult<f64> {
+    strata::report::rel_mse(&rgb(a.as_bytes()), &rgb(b.as_bytes())).map_err(err)
+}
+
+/// Reads an EXR as `strata render`/`reference` write it: (RGB f32 bytes, variance f32 bytes or
+/// None, width, height, metadata as (key, value) pairs).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn read_exr(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+) -> PyResult<(Py<PyBytes>, Option<Py<PyBytes>>, u32, u32, Vec<(String, String)>)> {
+    let img = strata::film::read_exr(&path).map_err(|e| err(format!("{}: {e}", path.display())))?;
+    let var = img.variance.as_ref().map(|v| PyBytes::new(py, &rgb_bytes(v)).unbind());
+    Ok((PyBytes::new(py, &rgb_bytes(&img.rgb)).unbind(), var, img.width, img.height, img.meta))
+}
+
+/// The crate version.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// The native module.
+#[pymodule]
+fn _strata(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("StrataError", m.py().get_type::<StrataError>())?;
+    m.add_class::<ParsedScene>()?;
+    m.add_function(wrap_pyfunction!(parse_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(check_points, m)?)?;
+    m.add_function(wrap_pyfunction!(mse, m)?)?;
+    m.add_function(wrap_pyfunction!(relmse, m)?)?;
+    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,172 @@
+"""strata from Python: render, reference and compare scenes as the CLI does, with point sets
+given as numpy arrays; error metrics on numpy images.
+
+Keyword arguments are the CLI's flags (``light_samples=4`` is ``--light-samples 4``; ``True``
+passes a bare flag; ``size=(w, h)``; a list repeats the flag), parsed by the CLI's own grammar,
+so every CLI error is raised here as :class:`StrataError` with the same message. Renders release
+the GIL; Ctrl-C stops a render after its pass (writing the checkpoint the CLI would) and raises
+``KeyboardInterrupt``.
+
+Point sets (``pixel_points``, ``light_points``, ``points``) are float arrays shaped
+``[sets, points, dims]`` or ``[points, dims]`` with values in [0, 1), checked and mapped to
+(pixel, dimension) exactly as ``--pixel-sampler file:PATH`` files are (``scramble=``, ``sets=``,
+``pad=`` are the file options; see docs/POINTSETS.md).
+"""
+
+import json
+import os
+
+import numpy as np
+
+from . import _strata
+from ._strata import StrataError
+
+__all__ = ["render", "reference", "compare", "Image", "Scene", "StrataError", "metrics", "points_sampler", "read_exr"]
+__version__ = _strata.version()
+
+
+class Image(np.ndarray):
+    """A render: float32 H x W x 3 linear RGB (the per-pixel mean), with ``variance`` (the
+    variance of that mean, H x W x 3) and ``stats`` (the ``--stats`` JSON as a dict)."""
+
+    def __new__(cls, rgb, variance, stats):
+        obj = np.asarray(rgb, dtype=np.float32).view(cls)
+        obj.variance = variance
+        obj.stats = stats
+        return obj
+
+    def __array_finalize__(self, obj):
+        self.variance = getattr(obj, "variance", None)
+        self.stats = getattr(obj, "stats", None)
+
+
+class Scene:
+    """A scene file parsed once (a bad file raises here), rendered many times: every render
+    given it starts from the parsed scene (the Embree scene is still built per render), with
+    ``flags`` (e.g. ``size``, ``camera``, ``integrator``) applied before the render's own."""
+
+    def __init__(self, path, **flags):
+        self.path = os.fspath(path)
+        self.flags = dict(flags)
+        self._parsed = _strata.parse_scene(_render_args(self.path, {**self.flags, "progress": True}))
+
+    def __repr__(self):
+        return f"strata.Scene({self.path!r}, {self.flags!r})"
+
+
+def _flag_args(flags):
+    args = []
+    for key, value in flags.items():
+        if value is None or value is False:
+            continue
+        flag = "--" + key.replace("_", "-")
+        if value is True:
+            args.append(flag)
+        elif key == "size" and isinstance(value, (tuple, list)):
+            args += [flag, f"{value[0]}x{value[1]}"]
+        elif key == "samples" and isinstance(value, (tuple, list, range)):
+            lo, hi = (value.start, value.stop) if isinstance(value, range) else value
+            args += [flag, f"{lo}..{hi}"]
+        elif isinstance(value, (list, tuple)):
+            for v in value:
+                args += [flag, str(v)]
+        else:
+            args += [flag, os.fspath(value) if isinstance(value, os.PathLike) else str(value)]
+    return args
+
+
+def points_sampler(name, array, scramble=None, sets=None, pad=None):
+    """Checks a point array as a point-set file is checked (the messages name ``<array NAME>``)
+    and registers it; returns the sampler name that render flags accept."""
+    a = np.asarray(array)
+    if a.dtype.kind != "f":
+        raise StrataError(f"<array {name}>: dtype {a.dtype}: expected float32 or float64")
+    if a.ndim == 2:
+        a = a[None]
+    if a.ndim != 3:
+        raise StrataError(f"<array {name}>: shape {list(np.shape(array))}: expected [sets, points, dims] or [points, dims]")
+    options = "&".join(f"{k}={v}" for k, v in (("scramble", scramble), ("sets", sets), ("pad", pad)) if v)
+    data = np.ascontiguousarray(a, dtype="<f8").tobytes()
+    return _strata.check_points(name, data, list(a.shape), options)
+
+
+def _render_args(scene, flags):
+    flags = dict(flags)
+    if isinstance(scene, Scene):
+        flags = {**scene.flags, **flags}
+        scene = scene.path
+    arrays = {k: flags.pop(k) for k in ("pixel_points", "light_points", "points") if flags.get(k) is not None}
+    opts = {k: flags.pop(k, None) for k in ("scramble", "sets", "pad")}
+    flag = {"pixel_points": "pixel_sampler", "light_points": "light_sampler", "points": "sampler"}
+    for name, array in arrays.items():
+        flags[flag[name]] = points_sampler(name, array, **opts)
+    if not flags.pop("progress", False):
+        flags["quiet"] = True
+    args = [] if scene is None else [os.fspath(scene)]
+    return args + _flag_args(flags)
+
+
+def render(scene=None, **flags):
+    """Renders ``scene`` (a path, a :class:`Scene`, or None for the built-in Cornell box) with the
+    CLI's render flags (``spp``, ``seed``, ``threads``, ``pixel_sampler``, ``light_sampler``,
+    ``integrator``, ...), point arrays ``pixel_points`` / ``light_points`` / ``points``, and
+    ``out`` (also write OUT.exr and OUT.png as the CLI does). Returns an :class:`Image`."""
+    write = flags.get("out") is not None
+    parsed = scene._parsed if isinstance(scene, Scene) else None
+    rgb, var, w, h, stats = _strata.render(_render_args(scene, flags), write, parsed)
+    shape = (h, w, 3)
+    return Image(
+        np.frombuffer(rgb, dtype="<f4").reshape(shape),
+        np.frombuffer(var, dtype="<f4").reshape(shape),
+        json.loads(stats),
+    )
+
+
+def read_exr(path):
+    """Reads an EXR as strata writes it (a reference, say) into an :class:`Image`; ``stats``
+    holds the file's ``strata.*`` metadata, ``variance`` its variance layer (or None)."""
+    rgb, var, w, h, meta = _strata.read_exr(os.fspath(path))
+    shape = (h, w, 3)
+    variance = None if var is None else np.frombuffer(var, dtype="<f4").reshape(shape)
+    return Image(np.frombuffer(rgb, dtype="<f4").reshape(shape), variance, dict(meta))
+
+
+def reference(scene=None, **flags):
+    """``strata reference``: a render (same flags; give ``spp`` and ``out`` to keep the EXR with
+    its variance layer), returned as an :class:`Image`."""
+    return render(scene, **flags)
+
+
+def _variant_flags(name, v):
+    if isinstance(v, str):
+        return v
+    args = []
+    for a in _render_args(None, {**v, "progress": True}):
+        if " " in a:
+            raise StrataError(f"variant {name}: `{a}`: compare splits flags at spaces")
+        args.append(a)
+    return " ".join(args)
+
+
+def compare(scene=None, *, reference, variants, **flags):
+    """``strata compare``: ``variants`` maps names to render flags (a string as on the command
+    line, or a dict of keyword arguments, point arrays included); the other keywords are
+    compare's flags (``runs``, ``budget``, ``spp_ladder``, ``size``, ``threads``, ``out``, ...).
+    Writes the CLI's outputs and returns the rows (a pandas DataFrame if pandas is installed,
+    else a list of dicts)."""
+    args = [] if scene is None else [os.fspath(scene.path if isinstance(scene, Scene) else scene)]
+    args += ["--reference", os.fspath(reference)]
+    for name, v in variants.items():
+        args += ["--variant", f"{name}={_variant_flags(name, v)}"]
+    ladder = flags.pop("spp_ladder", None)
+    if ladder is not None:
+        args += ["--spp-ladder", ",".join(str(s) for s in ladder)]
+    rows = json.loads(_strata.compare(args + _flag_args(flags)))
+    try:
+        import pandas
+    except ImportError:
+        return rows
+    return pandas.DataFrame(rows)
+
+
+from . import metrics  # noqa: E402  (uses _strata)

@@ -1,0 +1,213 @@
+//! `strata pointset PATH|NAME`: the quality of a point-set file or a registry layout, per set
+//! (L2 star discrepancy, minimum toroidal distance), the radial power spectrum (CSV and SVG) and
+//! the integration error on the disk and the Gaussian for N = 4..4096 with the fitted slopes (CSV,
+//! SVG); `--export FILE` writes the sets (a layout's, or the file's in another format).
+
+use super::analysis::{self, Convergence};
+use super::spec::Options;
+use super::{formats, PointSetError, PointSets};
+use crate::sampler::{PointSet, SamplerKind};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// What `strata pointset` is asked.
+#[derive(Clone, Debug)]
+pub struct Args {
+    /// a point-set file or a registry sampler name
+    pub target: String,
+    /// folder for spectrum.csv/svg, integration.csv/svg, pointset.json (None: write nothing)
+    pub out: Option<PathBuf>,
+    /// write the sets here (format by extension)
+    pub export: Option<PathBuf>,
+    /// registry layouts: sets to make (set j is pixel j's)
+    pub sets: u32,
+    /// registry layouts: points per set
+    pub points: u32,
+    /// registry layouts: base seed; also the randomization of the integration trials
+    pub seed: u64,
+    /// registry layouts: sampler dimension of the sets
+    pub dim: u32,
+    /// registry layouts: image width the pixel ids refer to (screen-space layouts)
+    pub width: u32,
+    /// randomizations per N in the integration test
+    pub trials: u32,
+    /// largest radial frequency of the spectrum
+    pub max_freq: usize,
+    /// how a file's sets are randomized in the integration test (as in a render)
+    pub options: Options,
+}
+
+impl Default for Args {
+    fn default() -> Self {
+        Self {
+            target: String::new(),
+            out: None,
+            export: None,
+            sets: 4,
+            points: 1024,
+            seed: 0,
+            dim: 0,
+            width: 0,
+            trials: 256,
+            max_freq: 64,
+            options: Options::default(),
+        }
+    }
+}
+
+/// One set's measures.
+#[derive(Clone, Debug, Serialize)]
+pub struct SetRow {
+    /// set index
+    pub set: usize,
+    /// points
+    pub points: usize,
+    /// L2 star discrepancy
+    pub l2_star_discrepancy: f64,
+    /// minimum toroidal distance
+    pub min_distance: f64,
+    /// minimum distance over the hexagonal packing's
+    pub min_distance_relative: f64,
+}
+
+/// Everything `strata pointset` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// the file or layout
+    pub name: String,
+    /// the sampler kind the integration test drew from
+    pub sampler: String,
+    /// per-set measures (at most [`MAX_SETS_MEASURED`] sets)
+    pub sets: Vec<SetRow>,
+    /// radially averaged power, ring r = frequencies [r, r + 1)
+    pub spectrum: Vec<f64>,
+    /// error curves and slopes
+    pub convergence: Vec<Convergence>,
+}
+
+/// Sets measured one by one (the O(N^2) measures); the spectrum averages the same sets.
+pub const MAX_SETS_MEASURED: usize = 16;
+
+/// The sets of registry layout `kind`: set j holds points 0..n of pixel j (sample 0, `dim`).
+pub fn layout_sets(kind: SamplerKind, args: &Args) -> Result<PointSets, PointSetError> {
+    let set = PointSet::for_image(kind, args.points, args.width);
+    let data = (0..args.sets)
+        .flat_map(|j| (0..args.points).map(move |k| (j, k)))
+        .flat_map(|(j, k)| set.point(j, 0, args.dim, k, args.seed).map(f64::from))
+        .collect();
+    PointSets::new(kind.name(), args.sets as usize, args.points as usize, 2, data)
+}
+
+/// Runs `strata pointset`: measures, writes the outputs asked for, returns the report and its
+/// text table.
+pub fn run(args: &Args) -> Result<(Report, String), PointSetError> {
+    let (ps, kind, ns) = match SamplerKind::parse(&args.target) {
+        Some(kind) => {
+            let ps = layout_sets(kind, args)?;
+            (ps, kind, (2..=12).map(|m| 1u32 << m).collect::<Vec<u32>>())
+        }
+        None => {
+            let path = PathBuf::from(args.target.strip_prefix("file:").unwrap_or(&args.target));
+            let ps = formats::read(&path)?;
+            let kind = super::sampler_from_sets(&ps, &format!("file:{}", path.display()), args.options)?;
+            // Prefixes of the file's sets: powers of two from 4 up to its size, and its size.
+            let p = ps.points as u32;
+            let mut ns: Vec<u32> = (2..=12).map(|m| 1u32 << m).filter(|&n| n < p).collect();
+            ns.push(p);
+            (ps, kind, ns)
+        }
+    };
+    if let Some(e) = &args.export {
+        formats::write(e, &ps)?;
+    }
+    let measured: Vec<Vec<[f64; 2]>> = (0..ps.sets.min(MAX_SETS_MEASURED)).map(|s| ps.set_2d(s)).collect();
+    let sets = measured
+        .iter()
+        .enumerate()
+        .map(|(set, pts)| {
+            let d = analysis::min_distance(pts);
+            SetRow {
+                set,
+                points: pts.len(),
+                l2_star_discrepancy: analysis::l2_star_discrepancy(pts),
+                min_distance: d,
+                min_distance_relative: d / analysis::max_min_distance(pts.len()),
+            }
+        })
+        .collect();
+    let report = Report {
+        name: ps.source.clone(),
+        sampler: kind.name().to_string(),
+        sets,
+        spectrum: analysis::radial_spectrum(&measured, args.max_freq),
+        convergence: analysis::convergence(kind, &ns, args.trials, args.seed),
+    };
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &report)?;
+    }
+    let table = table(&report);
+    Ok((report, table))
+}
+
+/// The report as text: one line per set, then the slopes.
+pub fn table(r: &Report) -> String {
+    let mut s = format!("{} (integration drawn as sampler {})\n", r.name, r.sampler);
+    s += "  set   points  L2 star discrepancy  min distance  (/ hex packing)\n";
+    for row in &r.sets {
+        s += &format!(
+            "  {:>3} {:>8} {:>20.6e} {:>13.6} {:>15.3}\n",
+            row.set, row.points, row.l2_star_discrepancy, row.min_distance, row.min_distance_relative
+        );
+    }
+    for c in &r.convergence {
+        let first = c.points.first().map_or(0.0, |p| p.0);
+        let last = c.points.last().map_or(0.0, |p| p.0);
+        s += &format!("  integration error, {:<8} N = {first}..{last}: slope {:+.3}\n", c.integrand, c.slope);
+    }
+    s.pop();
+    s
+}
+
+fn io(path: &Path) -> impl Fn(std::io::Error) -> PointSetError + '_ {
+    move |source| PointSetError::Io { path: path.to_path_buf(), source }
+}
+
+/// spectrum.csv/svg, integration.csv/svg and pointset.json in `dir`.
+pub fn write_outputs(dir: &Path, r: &Report) -> Result<(), PointSetError> {
+    use crate::report::{loglog_svg, Series};
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let mut spectrum = String::from("frequency,power\n");
+    for (f, p) in r.spectrum.iter().enumerate().skip(1) {
+        spectrum += &format!("{f},{p}\n");
+    }
+    let mut integration = String::from("integrand,n,rmse\n");
+    for c in &r.convergence {
+        for (n, e) in &c.points {
+            integration += &format!("{},{n},{e}\n", c.integrand);
+        }
+    }
+    let spec_series = [Series {
+        name: r.name.clone(),
+        points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p)).collect(),
+    }];
+    let spec_svg = loglog_svg(&spec_series, &format!("radial power spectrum: {}", r.name), "frequency", "power", 0.0);
+    let int_series: Vec<Series> = r
+        .convergence
+        .iter()
+        .map(|c| Series { name: format!("{} (slope {:+.2})", c.integrand, c.slope), points: c.points.clone() })
+        .collect();
+    let int_svg =
+        loglog_svg(&int_series, &format!("integration error: {}", r.name), "points N", "RMSE", analysis::RANDOM_SLOPE);
+    let json = serde_json::to_string_pretty(r).map_err(|e| PointSetError::Spec(e.to_string()))?;
+    for (name, text) in [
+        ("spectrum.csv", spectrum),
+        ("spectrum.svg", spec_svg),
+        ("integration.csv", integration),
+        ("integration.svg", int_svg),
+        ("pointset.json", json),
+    ] {
+        let p = dir.join(name);
+        crate::film::write_atomic(&p, text.as_bytes()).map_err(io(&p))?;
+    }
+    Ok(())
+}
