@@ -244,6 +244,14 @@ pub(crate) struct RenderArgs {
     /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
     #[arg(long, value_name = "NAME")]
     pub(crate) light_selection: Option<strata::integrator::LightSelection>,
+    /// Up axis of an OBJ scene's automatic camera: x, y or z (default: guessed from the bounds,
+    /// z when they are flat in z, else y; announced on stderr with the camera).
+    #[arg(long, value_parser = parse_up)]
+    pub(crate) up: Option<strata::scene::obj::frame::UpAxis>,
+    /// A constant environment light ("sky") of this radiance, R or R,G,B (path tracer; sampled
+    /// at every vertex besides the area lights, NEE and MIS like any light).
+    #[arg(long, value_name = "RADIANCE", value_parser = parse_sky)]
+    pub(crate) sky: Option<glam::Vec3>,
     /// Keep an OBJ scene without emitters unlit (by default an area light is added above and
     /// behind the camera, announced on stderr).
     #[arg(long)]
@@ -284,6 +292,8 @@ impl RenderArgs {
             first_sample: self.first_sample,
             light_selection: self.light_selection,
             no_default_light: self.no_default_light,
+            up: self.up,
+            sky: self.sky,
             rendering: None,
         }
     }
@@ -358,4 +368,25 @@ pub(crate) fn parse_on_off(s: &str) -> Result<bool, String> {
 
 pub(crate) fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, String> {
     ImportanceSampling::parse(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+}
+
+pub(crate) fn parse_up(s: &str) -> Result<strata::scene::obj::frame::UpAxis, String> {
+    strata::scene::obj::frame::UpAxis::parse(s).ok_or_else(|| format!("expected x, y or z, got `{s}`"))
+}
+
+/// `R` or `R,G,B` (or `R G B`): finite radiances >= 0.
+pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, String> {
+    let bad = || format!("expected a radiance R or R,G,B of finite numbers >= 0, got `{s}`");
+    let v: Vec<f32> =
+        s.split([',', ' ']).filter(|t| !t.is_empty()).map(|t| t.parse::<f32>().map_err(|_| bad())).collect::<Result<_, _>>()?;
+    let v = match v.as_slice() {
+        [r] => glam::Vec3::splat(*r),
+        [r, g, b] => glam::Vec3::new(*r, *g, *b),
+        _ => return Err(bad()),
+    };
+    if v.is_finite() && v.min_element() >= 0.0 {
+        Ok(v)
+    } else {
+        Err(bad())
+    }
 }

@@ -88,6 +88,8 @@ pub struct Scene {
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
+    /// the constant environment light (`--sky`), if any
+    pub sky: Option<crate::light::sky::Sky>,
     /// materials (desc materials, then one black material per light)
     pub materials: Vec<Material>,
     /// per triangle: material index
@@ -264,11 +266,13 @@ impl Scene {
         b.add_spheres(&points)?;
         b.add_ellipsoids(&ell_user)?;
         let accel = b.commit()?;
+        let sky = desc.sky.map(crate::light::sky::Sky::new);
         Ok(Self {
             desc,
             camera,
             lights,
             emitters,
+            sky,
             materials,
             tri_material,
             tri_normal,

@@ -81,6 +81,10 @@ pub struct RenderOptions {
     pub light_selection: Option<crate::light::select::LightSelection>,
     /// `--no-default-light`: an OBJ scene without emitters stays unlit (default: a light is added)
     pub no_default_light: bool,
+    /// `--up x|y|z`: the up axis of an OBJ scene's automatic camera (default: guessed from its bounds)
+    pub up: Option<crate::scene::obj::frame::UpAxis>,
+    /// `--sky R[,G,B]`: a constant environment light of this radiance (path tracer)
+    pub sky: Option<glam::Vec3>,
     /// set while the pass loop runs (a signal then stops after the pass and checkpoints; outside
     /// it the binary exits at once with code 130)
     pub rendering: Option<Arc<AtomicBool>>,
