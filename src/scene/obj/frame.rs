@@ -130,7 +130,8 @@ pub struct Framing {
 }
 
 impl Framing {
-    /// The camera as a `--camera "..."` argument (6 significant digits; parses back to it).
+    /// The camera as a `--camera "..."` argument (each number the shortest decimal that parses
+    /// back to it, so the pasted camera renders the same image).
     pub fn camera_arg(&self) -> String {
         camera_arg(&self.camera)
     }
@@ -142,18 +143,12 @@ pub fn camera_arg(c: &CameraDesc) -> String {
     format!("--camera \"{}\"", n.join(" "))
 }
 
-/// `x` with 6 significant digits, without trailing zeros.
+/// `x` as the shortest decimal that parses back to it (`-0` as `0`).
 fn short(x: f32) -> String {
     if x == 0.0 || !x.is_finite() {
-        return "0".into();
-    }
-    let digits = (5 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
-    let s = format!("{x:.digits$}");
-    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
-    if s == "-0" {
         "0".into()
     } else {
-        s
+        format!("{x}")
     }
 }
 
