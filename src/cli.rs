@@ -175,6 +175,18 @@ pub(crate) enum Cmd {
         #[arg(long, default_value_t = strata::session::profile::REPEATS, value_parser = parse_positive::<usize>)]
         repeats: usize,
     },
+    /// Print this command-line reference as Markdown (docs/cli.md is its output; a test fails
+    /// when that file is stale).
+    #[command(hide = true)]
+    HelpMarkdown,
+    /// Check that a command line parses and passes the subcommand's refusals, without running it
+    /// (the README's and docs' commands are tested so). Exit status 0 and `ok`, or the error.
+    #[command(hide = true)]
+    ParseCheck {
+        /// The command line after `strata`.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
 }
 
 /// `render` and `reference`: the render flags, and `--json FILE` (the statistics, as `--stats`).
@@ -503,4 +515,33 @@ pub(crate) fn parse_interval(s: &str) -> Result<f64, String> {
         Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
         _ => Err(format!("expected a number of seconds >= 0, got `{s}`")),
     }
+}
+
+/// The command-line reference as Markdown: every visible subcommand's `--help`, as clap renders it.
+pub(crate) fn help_markdown() -> String {
+    use clap::CommandFactory;
+    let mut cmd = Cli::command();
+    cmd.build();
+    let mut md = String::from(
+        "# strata command-line reference\n\n\
+         Generated from the command line's own definitions by `strata help-markdown` (hidden); \
+         `tests/docs.rs` fails when this file is stale. Regenerate it with\n\
+         `cargo run --release -- help-markdown > docs/cli.md`.\n\n",
+    );
+    let top = cmd.clone();
+    md.push_str("Subcommands:");
+    let visible = |s: &&clap::Command| !s.is_hide_set() && s.get_name() != "help";
+    for sub in top.get_subcommands().filter(visible) {
+        md.push_str(&format!(" [`{0}`](#strata-{0}),", sub.get_name()));
+    }
+    md.pop();
+    md.push_str(".\n\n## strata\n\n```text\n");
+    md.push_str(&cmd.render_long_help().to_string());
+    md.push_str("```\n");
+    for sub in top.get_subcommands().filter(visible) {
+        let name = sub.get_name().to_string();
+        let mut s = sub.clone().bin_name(format!("strata {name}"));
+        md.push_str(&format!("\n## strata {name}\n\n```text\n{}```\n", s.render_long_help()));
+    }
+    md
 }

@@ -41,6 +41,17 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     refuse_unused_flags(&cli.cmd);
     let result = match cli.cmd {
+        Cmd::HelpMarkdown => {
+            print!("{}", cli::help_markdown());
+            Ok(())
+        }
+        Cmd::ParseCheck { args } => {
+            let argv = std::iter::once("strata".to_string()).chain(args);
+            let parsed = Cli::try_parse_from(argv).unwrap_or_else(|e| e.exit());
+            refuse_unused_flags(&parsed.cmd);
+            println!("ok");
+            Ok(())
+        }
         Cmd::Render(cmd) | Cmd::Reference(cmd) => {
             let args = cmd.into_args();
             let quiet = args.quiet;
