@@ -465,8 +465,11 @@ pub(crate) fn parse_up(s: &str) -> Result<strata::scene::obj::frame::UpAxis, Str
 /// `R` or `R,G,B` (or `R G B`): finite radiances >= 0.
 pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, String> {
     let bad = || format!("expected a radiance R or R,G,B of finite numbers >= 0, got `{s}`");
-    let v: Vec<f32> =
-        s.split([',', ' ']).filter(|t| !t.is_empty()).map(|t| t.parse::<f32>().map_err(|_| bad())).collect::<Result<_, _>>()?;
+    let v: Vec<f32> = s
+        .split([',', ' '])
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse::<f32>().map_err(|_| bad()))
+        .collect::<Result<_, _>>()?;
     let v = match v.as_slice() {
         [r] => glam::Vec3::splat(*r),
         [r, g, b] => glam::Vec3::new(*r, *g, *b),

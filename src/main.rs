@@ -126,7 +126,18 @@ fn main() -> ExitCode {
             early
                 .map_err(|e| e.to_string())
                 .and_then(|()| {
-                    run_compare(scene, &reference, &variants, runs, budget, spp_ladder, size, threads, &out, &profile_out)
+                    run_compare(
+                        scene,
+                        &reference,
+                        &variants,
+                        runs,
+                        budget,
+                        spp_ladder,
+                        size,
+                        threads,
+                        &out,
+                        &profile_out,
+                    )
                 })
                 .and_then(|()| copy_rows_json(&out, json.as_deref()))
         }

@@ -303,7 +303,11 @@ fn aliases_and_spellings_are_accepted() {
     assert!(help.contains("--budget <CPU_SECONDS>") && help.contains("--cpu-budget"), "{help}");
     // rays: `--json` alone prints JSON (as before), `--json=FILE` writes it and prints the table.
     let rays_json = d.join("rays.json");
-    let r = strata().args(["rays", "--size", "16x16", "--spp", "1"]).arg(format!("--json={}", rays_json.display())).output().unwrap();
+    let r = strata()
+        .args(["rays", "--size", "16x16", "--spp", "1"])
+        .arg(format!("--json={}", rays_json.display()))
+        .output()
+        .unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert!(String::from_utf8_lossy(&r.stdout).contains("renderer / raw"));
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&rays_json).unwrap()).unwrap();

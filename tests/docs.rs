@@ -32,7 +32,12 @@ fn the_cli_reference_is_fresh() {
 fn subcommands() -> Vec<String> {
     let help = stdout_of(&["--help"]);
     let list = &help[help.find("Commands:").unwrap()..help.find("Options:").unwrap()];
-    list.lines().skip(1).filter_map(|l| l.split_whitespace().next()).filter(|n| *n != "help").map(String::from).collect()
+    list.lines()
+        .skip(1)
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|n| *n != "help")
+        .map(String::from)
+        .collect()
 }
 
 #[test]
@@ -100,8 +105,9 @@ fn commands(md: &str) -> Vec<Vec<String>> {
             }
             _ => continue,
         }
-        let args: Vec<String> =
-            words.take_while(|w| !w.starts_with('#') && !["|", "&&", ";", ">", "2>", "&"].contains(&w.as_str())).collect();
+        let args: Vec<String> = words
+            .take_while(|w| !w.starts_with('#') && !["|", "&&", ";", ">", "2>", "&"].contains(&w.as_str()))
+            .collect();
         out.push(args);
     }
     out
@@ -121,7 +127,11 @@ fn every_command_in_the_readme_parses() {
 fn the_command_extractor_finds_commands_and_a_bad_one_fails_to_parse() {
     let md = "text `strata merge a.ckpt -o m` and `strata: note`\n```sh\n$ strata render a.test \\\n  --spp 4 -o out # comment\nls\nX=1 target/release/strata rays --json | jq .\n```\n";
     let cmds = commands(md);
-    let want = [vec!["merge", "a.ckpt", "-o", "m"], vec!["render", "a.test", "--spp", "4", "-o", "out"], vec!["rays", "--json"]];
+    let want = [
+        vec!["merge", "a.ckpt", "-o", "m"],
+        vec!["render", "a.test", "--spp", "4", "-o", "out"],
+        vec!["rays", "--json"],
+    ];
     assert_eq!(cmds, want);
     let r = strata().args(["parse-check", "render", "--sppp", "4"]).output().unwrap();
     assert_eq!(r.status.code(), Some(2));

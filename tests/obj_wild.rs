@@ -75,7 +75,9 @@ const TABLE: &[(&str, Expect)] = &[
     ("cornell-original/CornellBox-Original.obj", Renders),
     (
         "cornell-tinyobj/cornell_box.obj",
-        RendersWithWarnings(&["cornell_box.mtl:22: material 'light': Ka above 1 and no Ke: read as emission Ke 20 20 20"]),
+        RendersWithWarnings(&[
+            "cornell_box.mtl:22: material 'light': Ka above 1 and no Ke: read as emission Ke 20 20 20",
+        ]),
     ),
     (
         "cornell-water-lab/CornellBox-Water.obj",
@@ -442,7 +444,8 @@ fn wild_scenes_get_the_up_axis_and_the_view_they_need() {
         }
     }
     // The tinyobj box is open at -z (its classic camera stands at z = -800).
-    let (desc, _) = obj::scene_from_obj_with_warnings(&dir.join("cornell-tinyobj/cornell_box.obj"), &Limits::default()).unwrap();
+    let (desc, _) =
+        obj::scene_from_obj_with_warnings(&dir.join("cornell-tinyobj/cornell_box.obj"), &Limits::default()).unwrap();
     assert!(desc.camera.unwrap().eye.z < 0.0);
     // And it is lit: its 'light' (Ka 20 20 20, no Ke) is an emitter.
     assert_eq!(desc.emissive_triangles.len(), 2);
@@ -468,7 +471,10 @@ fn the_printed_camera_renders_the_same_image() {
         String::from_utf8_lossy(&r.stderr).into_owned()
     };
     let err = run(&[], "auto");
-    assert!(err.contains("up axis y (guessed from its bounds; set it with --up x|y|z); looking in through the open side"), "{err}");
+    assert!(
+        err.contains("up axis y (guessed from its bounds; set it with --up x|y|z); looking in through the open side"),
+        "{err}"
+    );
     let line = err.lines().find_map(|l| l.split_once("automatic camera, to edit: --camera \"")).expect(&err).1;
     let cam = line.trim_end_matches('"');
     run(&["--camera", cam], "pasted");

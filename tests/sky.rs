@@ -76,7 +76,11 @@ fn white_furnace_converges_to_the_sky_radiance_in_every_mode() {
     }
     // Convergence: the error keeps falling as samples grow (MIS, 16 -> 256 spp: about 4x).
     let rms = |spp| {
-        let o = RenderOptions { sky: Some(glam::Vec3::splat(sky)), nee: Some(Nee::Mis), ..opts(scene.clone(), 24, 24, spp) };
+        let o = RenderOptions {
+            sky: Some(glam::Vec3::splat(sky)),
+            nee: Some(Nee::Mis),
+            ..opts(scene.clone(), 24, 24, spp)
+        };
         let (m, v) = render(&o);
         z_against(&m, &v, sky as f64).1
     };

@@ -10,8 +10,8 @@
 //! Because it is not one of the lights the selection chooses from, every `--light-selection`
 //! mode treats it alike. Camera rays that escape see `L` directly (the background).
 
-use crate::sampling::sample_uniform_hemisphere_x8;
 use crate::sampling::power_heuristic_x8;
+use crate::sampling::sample_uniform_hemisphere_x8;
 
 use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;

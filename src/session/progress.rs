@@ -168,8 +168,7 @@ mod tests {
         let mut p = Progress::new(true, &(0..16), 0, None, 4);
         let first = p.message(0, 0.4);
         assert!(first.contains("0.4 s elapsed") && !first.contains("Mrays/s"), "{first}");
-        let mut st = RenderStats::default();
-        st.seconds = 2.0;
+        let mut st = RenderStats { seconds: 2.0, ..Default::default() };
         st.counters.camera = 4_000_000;
         p.pass(1, &st, 2.5);
         let later = p.message(1, 2.5);

@@ -139,7 +139,8 @@ impl Framing {
 
 /// `--camera "ex ey ez cx cy cz ux uy uz fovy"` for `c`.
 pub fn camera_arg(c: &CameraDesc) -> String {
-    let n = [c.eye, c.center, c.up].iter().flat_map(|v| v.to_array()).chain([c.fovy_deg]).map(short).collect::<Vec<_>>();
+    let n =
+        [c.eye, c.center, c.up].iter().flat_map(|v| v.to_array()).chain([c.fovy_deg]).map(short).collect::<Vec<_>>();
     format!("--camera \"{}\"", n.join(" "))
 }
 
