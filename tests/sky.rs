@@ -167,4 +167,17 @@ fn cli_sky_refusals() {
     assert_eq!(r.status.code(), Some(1), "{err}");
     assert!(err.contains("--sky needs the path tracer"), "{err}");
     assert!(!dir.join("x.png").exists());
+    // Accepted: R,G,B, recorded in the statistics' scene features.
+    let stats = dir.join("s.json");
+    let r = strata()
+        .args(["render", "--sky", "0.5,0.25,1", "--integrator", "pathtracer", "--spp", "1", "--size", "8x8", "-q"])
+        .arg("--stats")
+        .arg(&stats)
+        .arg("-o")
+        .arg(dir.join("y"))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(j["features"]["sky"], serde_json::json!([0.5, 0.25, 1.0]), "{j}");
 }
