@@ -196,7 +196,7 @@ fn equal_time(c: &mut Criterion) {
         .iter()
         .map(|(_, _, opts, spp)| {
             let (scene, integ) = strata::session::prepare(opts).unwrap();
-            (scene, integ.resampled(Some(*spp)))
+            (scene, integ.resampled(*spp))
         })
         .collect();
     let render = |i: usize| {

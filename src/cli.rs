@@ -227,6 +227,13 @@ pub(crate) struct RenderArgs {
     /// Base seed of every sample stream.
     #[arg(long, help_heading = SAMPLING, default_value_t = 0, value_parser = parse_count::<u64>)]
     pub(crate) seed: u64,
+    // Every sampling dimension's layout; the help lists the sampler registry.
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_sampler, help = format!(
+        "Sampler of every dimension (pixel, light point and choice, lobe, direction, roulette): {} \
+         (default stratified; --pixel-sampler and --light-sampler override their dimensions)",
+        SamplerKind::help_list()
+    ))]
+    pub(crate) sampler: Option<SamplerKind>,
     // Pixel sample layout; the help lists the sampler registry.
     #[arg(long, help_heading = SAMPLING, value_parser = parse_sampler, help = format!(
         "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
@@ -241,8 +248,16 @@ pub(crate) struct RenderArgs {
     #[arg(long, help_heading = SAMPLING, value_parser = parse_first_sample)]
     pub(crate) first_sample: Option<strata::integrator::FirstSample>,
     // Light sample layout; the help lists the sampler registry.
-    #[arg(long, help_heading = LIGHTS, value_parser = parse_sampler, help = format!("Light sample layout: {}", SamplerKind::help_list()))]
+    #[arg(long, help_heading = LIGHTS, value_parser = parse_sampler, help = format!(
+        "Light sample layout (light point and choice, in direct and the path tracer): {}",
+        SamplerKind::help_list()
+    ))]
     pub(crate) light_sampler: Option<SamplerKind>,
+    /// Where a one-light choice (--light-selection uniform, power, spatial) takes its number from:
+    /// reuse (the light point's first coordinate, remapped, as Mitsuba does; default) or dimension
+    /// (a sampler dimension of its own).
+    #[arg(long, help_heading = LIGHTS, value_name = "MODE")]
+    pub(crate) light_choice: Option<strata::integrator::LightChoice>,
     /// Light samples per light, at least 1 (default: the scene's lightsamples).
     #[arg(long, help_heading = LIGHTS, value_parser = parse_positive::<u32>)]
     pub(crate) light_samples: Option<u32>,
@@ -319,7 +334,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, visible_alias = "nthreads", help_heading = LIMITS, default_value_t = 0, value_parser = parse_count::<usize>)]
     pub(crate) threads: usize,
     /// Render whole passes until this many wall-clock seconds are spent and record the spp
-    /// reached (independent pixel and path layouts; --spp, if given, caps the samples).
+    /// reached (progressive samplers continue their sequence across passes; a sampler that needs
+    /// its count in advance is refused; --spp, if given, caps the samples).
     #[arg(long, visible_alias = "wall-budget", value_name = "WALL_SECONDS", help_heading = LIMITS, value_parser = parse_seconds)]
     pub(crate) time_budget: Option<f64>,
     /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
@@ -354,7 +370,9 @@ impl RenderArgs {
             size: self.size,
             seed: self.seed,
             threads: self.threads,
+            sampler: self.sampler,
             light_sampler: self.light_sampler,
+            light_choice: self.light_choice,
             light_samples: self.light_samples,
             pixel_sampler: self.pixel_sampler,
             out: self.out,

@@ -254,7 +254,9 @@ fn time_budget_renders_whole_passes_and_records_spp() {
     assert_eq!(j["layout"], "time-budget");
     let (_, _, meta) = image(&d.join("b"));
     assert_eq!(meta["strata.spp"], spp.to_string());
-    assert_eq!(meta["strata.pixel_sampler"], "independent", "budget renders use spp-free layouts");
+    // The default (stratified) needs its count: equal time runs the progressive sobol, and says so.
+    assert_eq!(meta["strata.pixel_sampler"], "sobol", "budget renders use progressive layouts");
+    assert_eq!(j["pixel_sampler"], "sobol");
     assert_eq!(j["rays"]["camera"].as_u64().unwrap(), 64 * 48 * spp, "whole passes: every pixel got spp samples");
     // --spp caps a budgeted render (a budget far larger than the 24 samples need).
     let mut c = render_cmd(24, &d.join("c"), &["--time-budget", "300"]);
@@ -262,6 +264,23 @@ fn time_budget_renders_whole_passes_and_records_spp() {
     run_ok(c);
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!(j["spp"], 24);
+    // A named progressive sampler is kept; a named one that needs its count is refused, with a
+    // message naming the progressive ones (never swapped silently).
+    let mut c = render_cmd(24, &d.join("p"), &["--time-budget", "300", "--sampler", "pmj02"]);
+    c.arg("--stats").arg(&stats);
+    run_ok(c);
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!((j["pixel_sampler"].as_str(), j["sampler"].as_str()), (Some("pmj02"), Some("pmj02")));
+    for (flag, name) in [("--pixel-sampler", "stratified"), ("--sampler", "zsobol"), ("--light-sampler", "grid-center")]
+    {
+        let err = run_err(render_cmd(24, &d.join("r"), &["--time-budget", "1", flag, name]));
+        assert!(
+            err.contains(flag)
+                && err.contains(name)
+                && err.contains("progressive samplers: independent, halton, sobol, pmj02"),
+            "{err}"
+        );
+    }
     std::fs::remove_dir_all(&d).ok();
 }
 

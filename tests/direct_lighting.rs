@@ -102,6 +102,8 @@ fn direct_and_exact(scene: std::path::PathBuf, spp: u32, sampler: Option<Sampler
     o.light_sampler = sampler;
     let f = film(&o);
     o.integrator = Some(IntegratorKind::AnalyticDirect);
+    // (analyticdirect samples no light: a light sampler would be refused as changing nothing)
+    o.light_sampler = None;
     let exact = means(&film(&o));
     (means(&f), var_of_mean(&f), exact)
 }

@@ -19,12 +19,6 @@ pub fn eval_plus(kd: Vec3, spec: Vec3) -> Vec3 {
 pub fn eval_plus_x8(kd: Vec3x8, spec: Vec3x8) -> Vec3x8 {
     kd.mul_add(F8::FRAC_1_PI, spec)
 }
-/// kd/pi as `direct` has always computed it (kd scaled by the f32 quotient 1/pi, which may differ
-/// from [`FRAC_1_PI`] in the last bit): the base of `Material8::eval_world`.
-#[inline]
-pub fn eval_world_x8(kd: Vec3x8) -> Vec3x8 {
-    kd.scale(F8::splat(1.0 / std::f32::consts::PI))
-}
 
 /// Density of [`sample`] per unit solid angle.
 #[inline]

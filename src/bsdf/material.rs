@@ -4,7 +4,7 @@
 //! use [`AllLobes`], kernels the set compiled for the scene (`*_k::<L>`).
 
 use super::lobe::{AllLobes, LobeSet};
-use super::{diffuse, phong, BrdfKind, ImportanceSampling, Phong};
+use super::{diffuse, BrdfKind, ImportanceSampling};
 use crate::sampling::{fmadd, sample_uniform_hemisphere, sample_uniform_hemisphere_x8};
 use crate::sampling::{uniform_hemisphere_pdf, uniform_hemisphere_pdf_x8};
 use crate::simd::{and_mask, Mask8, Vec3x8, F8};
@@ -205,20 +205,5 @@ impl Material8 {
         };
         let (f, pdf) = self.eval_pdf_k::<L>(strategy, wo, wi, active);
         (wi, pdf, f)
-    }
-
-    /// f(wo, wi) in world space about the shading normal `n` (unit vectors, wo towards the viewer):
-    /// kd/pi plus, when `L` has the Phong lobe and some lane has ks > 0, the Phong lobe about the
-    /// world mirror direction on every lane; zero on inactive lanes. This is `direct`'s BRDF (hw2's
-    /// materials are Phong; the horizon test is the caller's, from its cosines). It equals
-    /// [`Material8::eval`] up to rounding (the frame change); it is kept in world space because
-    /// `direct`'s images are defined by it bit for bit.
-    #[inline]
-    pub fn eval_world<L: LobeSet>(&self, n: Vec3x8, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
-        let mut f = diffuse::eval_world_x8(self.kd);
-        if L::has::<Phong>() && self.ks.max_elem().simd_gt(F8::ZERO).any() {
-            f += phong::world_x8(n, wo, wi, self.ks, self.shininess);
-        }
-        Vec3x8::select(active, f, Vec3x8::ZERO)
     }
 }

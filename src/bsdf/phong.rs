@@ -94,17 +94,3 @@ impl Lobe for Phong {
         sample_x8(wo, u, m.shininess, active)
     }
 }
-
-/// The Phong lobe in world space about the normal `n` (what `direct` evaluates, see
-/// `Material8::eval_world`): ks (s+2)/(2 pi) max(0, r . wi)^s with r the mirror of wo about n.
-/// c^s is taken from 1 - c = sin^2 / (1 + c) with sin^2 = |r x wi|^2, as [`lobe_x8`] does, so a lobe
-/// of s = 1e6 keeps its shape near the mirror direction.
-#[inline]
-pub(super) fn world_x8(n: Vec3x8, wo: Vec3x8, wi: Vec3x8, ks: Vec3x8, s: F8) -> Vec3x8 {
-    let r = n.scale(F8::splat(2.0) * n.dot(wo)) - wo;
-    let c = r.dot(wi);
-    let has_spec = c.simd_gt(F8::ZERO);
-    let pow = cos_pow_x8(c, r.cross(wi).length_squared(), s);
-    let spec = pow * (s + F8::splat(2.0)) * F8::splat(0.5 / std::f32::consts::PI);
-    ks.scale(has_spec.select(spec, F8::ZERO))
-}

@@ -83,6 +83,8 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("pixel_sampler", json!(it.pixel_set.kind().name())),
         ("light_sampler", json!(it.light_set.kind().name())),
         ("light_samples", json!(it.light_set.n())),
+        ("sampler", json!(it.path_set.set().kind().name())),
+        ("light_choice", json!(it.light_choice.name())),
         ("layout", json!(if time_budget { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
         ("clamp", json!(it.clamp)),

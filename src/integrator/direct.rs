@@ -6,7 +6,8 @@
 //! picks a triangle by power and a point on it, see `light::emitters`). Each group adds the mean
 //! over the `lightsamples` samples of L f cos(th_i) cos(th_l) / (d^2 pdf_area) where the shadow ray
 //! is clear. A quad group's radiance and area are constant, so they scale its sum once at the end.
-//! f is `bsdf::Material8::eval_world`, the world-space form of the path tracer's material code.
+//! f is the path tracer's material code (`bsdf::Material8::eval_pdf_k` in the local shading frame):
+//! diffuse, Phong and GGX alike.
 //!
 //! That loop is `--light-selection all` (the default for `.test` scenes). With `uniform`, `power`
 //! or `spatial` each of the `lightsamples` samples instead picks one light from the integrator's
@@ -21,9 +22,10 @@ use super::{Integrator, DIM_LIGHT_BASE};
 use crate::accel::Ray8;
 use crate::bsdf::{LobeSet, Material8};
 use crate::light::emitters::{Emitter, LightSample8};
-use crate::light::select::LightSelection;
+use crate::light::select::{LightChoice, LightSelection};
+use crate::sampler::PathDim;
 use crate::scene::build::{Scene, SurfaceHit8};
-use crate::simd::{Mask8, Vec3x8, F8, U8};
+use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 
 /// One sampling group of `direct`.
 #[derive(Clone, Copy)]
@@ -61,13 +63,15 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
     let sample_idx = U8::splat(s);
+    let streams = it.light_streams();
     shading_lanes(scene, sc);
     for (gi, group) in groups(scene).enumerate() {
         let dim = DIM_LIGHT_BASE + gi as u32;
+        let table = LightTable::new(it, dim, s);
         sc.acc.clear();
         sc.acc.resize(pks.len(), Vec3x8::ZERO);
         sc.streams.clear();
-        {
+        if streams {
             let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
             light_streams(it, pks, &sc.shade, sample_idx, dim, &mut sc.streams);
             crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, dim);
@@ -86,10 +90,12 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 if shade.none() {
                     continue;
                 }
-                let (u, v) = {
+                let (u, v) = if streams {
                     let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
                     crate::sampler::replay::light_point(j, k);
                     sc.streams[j as usize].point_k(&point_k)
+                } else {
+                    table.point(it, pks[i].pixel, k)
                 };
                 j += 1;
                 let ls = {
@@ -151,6 +157,31 @@ fn shading_pixels<'a>(pks: &'a [crate::camera::PixelPacket], shade: &'a [Mask8])
     pks.iter().zip(shade).filter(|(_, m)| m.any()).map(|(pk, _)| pk.pixel)
 }
 
+/// One light dimension of pixel sample `s` drawn from the integrator's light table, over all
+/// spp x N light samples of the pixel (light sample k of pixel sample s is the table's sample
+/// `s N + k`): used unless the layout is a per-sample grid ([`Integrator::light_streams`]).
+struct LightTable {
+    dim: PathDim,
+    first: u32,
+}
+
+impl LightTable {
+    /// Dimension `dim` for pixel sample `s`.
+    fn new(it: &Integrator, dim: u32, s: u32) -> Self {
+        let n = it.light_table.set().n();
+        Self { dim: it.light_table.path_dim(n, dim, it.seed), first: s.wrapping_mul(it.light_set.n()) }
+    }
+
+    /// Light sample `k` of the pixels `pixel`.
+    #[inline]
+    fn point(&self, it: &Integrator, pixel: U8, k: u32) -> (F8, F8) {
+        let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+        let index = U8::splat(self.first.wrapping_add(k));
+        crate::sampler::replay::path_point(pixel, index, self.dim.dim(), true);
+        it.light_table.path_point_x8(&self.dim, pixel, index)
+    }
+}
+
 /// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
 #[inline(never)]
 fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
@@ -163,13 +194,17 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
     // choice dimension is not drawn (every sample is a pure function of its own dimension: the
     // others are unchanged).
     let one_light = it.light_sampler.selection() == LightSelection::Uniform && it.light_sampler.len() == 1;
+    // The choice from a dimension of its own, or reused from the light point's u (Mitsuba's).
+    let own_choice = !one_light && it.light_choice == LightChoice::Dimension;
+    let streams = it.light_streams();
+    let (table, choice_table) = (LightTable::new(it, DIM_LIGHT_BASE, s), LightTable::new(it, DIM_LIGHT_BASE + 1, s));
     sc.streams.clear();
     sc.choice_streams.clear();
-    {
+    if streams {
         let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
         light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE, &mut sc.streams);
         crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, DIM_LIGHT_BASE);
-        if !one_light {
+        if own_choice {
             light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE + 1, &mut sc.choice_streams);
             let choice = shading_pixels(pks, &sc.shade);
             crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
@@ -188,23 +223,30 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
             if shade.none() {
                 continue;
             }
-            let (u, v) = {
+            let (u, v) = if streams {
                 let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
                 crate::sampler::replay::light_point(j, k);
                 sc.streams[j as usize].point_k(&point_k)
+            } else {
+                table.point(it, pks[i].pixel, k)
             };
             let (ls, ok) = if one_light {
                 // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
-            } else {
-                let (uc, _) = {
+            } else if own_choice {
+                let (uc, _) = if streams {
                     let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
                     crate::sampler::replay::light_point(n_shading + j, k);
                     sc.choice_streams[j as usize].point_k(&point_k)
+                } else {
+                    choice_table.point(it, pks[i].pixel, k)
                 };
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
+            } else {
+                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                it.light_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, v))
             };
             j += 1;
             let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
@@ -252,7 +294,10 @@ fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) ->
     }
     let f = {
         let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-        material(sh).eval_world::<L>(sh.n, sh.wo, wi, lit)
+        // The path tracer's material code, in the local shading frame.
+        let frame = Frame8::from_normal(sh.n);
+        let strategy = crate::scene::desc::ImportanceSampling::Cosine;
+        material(sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
     };
     Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
 }

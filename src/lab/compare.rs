@@ -82,6 +82,8 @@ pub fn compare_profiled(
         };
         for step in steps {
             let (mut images, mut secs, mut spps) = (Vec::new(), 0.0, 0.0);
+            // The samplers the runs of this step used (equal time may replace a default).
+            let mut ran = String::new();
             let mut step_stats = RenderStats { threads: all.threads, ..Default::default() };
             for run in 0..runs {
                 let mut it = integ.clone();
@@ -89,16 +91,16 @@ pub fn compare_profiled(
                 let mut film = Film::new(img.width, img.height);
                 let (seconds, spp) = match (step, mode) {
                     (Some(spp), _) => {
-                        it = it.resampled(Some(spp));
+                        it = it.resampled(spp);
                         let st = render::render(&scene, &it, &mut film, 0..spp, &pool);
                         step_stats.merge(&st);
                         (st.cpu_seconds, spp)
                     }
                     (None, Mode::Budget(b)) => {
                         // Equal time: whole passes of one sample until the budget (the workers' CPU
-                        // seconds) is spent. The pixel layout assumes an spp it cannot know in
-                        // advance: independent.
-                        it = it.resampled(None);
+                        // seconds) is spent. Progressive layouts continue their sequences pass
+                        // after pass; one that needs its count in advance is refused.
+                        it = it.equal_time().map_err(session::SessionError::from)?;
                         let (mut t, mut s) = (0.0, 0u32);
                         while t < *b {
                             let st = render::render(&scene, &it, &mut film, s..s + 1, &pool);
@@ -110,6 +112,7 @@ pub fn compare_profiled(
                     }
                     (None, Mode::Ladder(_)) => unreachable!("ladder steps are Some"),
                 };
+                ran = samplers_ran(&it);
                 secs += seconds;
                 spps += f64::from(spp);
                 images.push(film.mean());
@@ -118,10 +121,10 @@ pub fn compare_profiled(
                 .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
             let step_profile = Profile::from_stats("", &step_stats);
             all.merge(&step_stats);
-            rows.push(
-                Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?
-                    .with_sampler(step_profile.sampler_ns_per_sample(), step_profile.sampler_share()),
-            );
+            let mut row = Row::new(v.name.clone(), secs / runs as f64, spps / runs as f64, &stats)?
+                .with_sampler(step_profile.sampler_ns_per_sample(), step_profile.sampler_share());
+            row.setting = ran;
+            rows.push(row);
         }
         let profile = Profile::from_stats(&scene.desc.source.display().to_string(), &all);
         profiles.push(VariantProfile { variant: v.name.clone(), profile });
@@ -151,4 +154,11 @@ pub fn write_outputs(rows: &[Row], dir: &Path, title: &str) -> Result<String, La
         film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
     }
     Ok(md)
+}
+
+/// The samplers an integrator runs, for the `samplers` column: pixel, light and the others, and
+/// the light choice.
+fn samplers_ran(it: &crate::integrator::Integrator) -> String {
+    let [pixel, light, path] = it.kinds().map(|k| k.name());
+    format!("pixel {pixel}, light {light}, other {path}, choice {}", it.light_choice.name())
 }

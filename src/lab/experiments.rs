@@ -90,7 +90,7 @@ pub struct Runs {
 pub fn runs_profiled(opts: &RenderOptions, spp: u32, k: usize) -> Result<Runs, LabError> {
     let (scene, integ) = session::prepare(opts)?;
     let pool = render::thread_pool(opts.threads)?;
-    let integ = integ.resampled(Some(spp));
+    let integ = integ.resampled(spp);
     let mut images = Vec::with_capacity(k);
     let mut all = render::RenderStats { threads: pool.current_num_threads(), ..Default::default() };
     let _profiling = crate::profile::enable();

@@ -121,6 +121,38 @@ impl std::str::FromStr for LightSelection {
     }
 }
 
+/// Where a one-light selection takes its choice from (`--light-choice`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightChoice {
+    /// a 1D sampler dimension of its own, decorrelated from the light point's
+    Dimension,
+    /// Mitsuba's reuse: the light point's first coordinate u picks the light, and is remapped to
+    /// [0, 1) within the light's interval of u, so the light point's 2D set stays stratified per
+    /// light (one dimension fewer; the default)
+    Reuse,
+}
+
+impl LightChoice {
+    /// Every choice mode with its name, in a fixed order.
+    pub const ALL: [(LightChoice, &'static str); 2] = [(Self::Reuse, "reuse"), (Self::Dimension, "dimension")];
+
+    /// Name (`dimension`, `reuse`).
+    pub fn name(self) -> &'static str {
+        Self::ALL.iter().find(|(c, _)| *c == self).map(|(_, n)| *n).unwrap_or("reuse")
+    }
+}
+
+impl std::str::FromStr for LightChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .iter()
+            .find(|(_, n)| n.eq_ignore_ascii_case(s.trim()))
+            .map(|(c, _)| *c)
+            .ok_or_else(|| format!("unknown light choice '{s}' (expected one of: reuse, dimension)"))
+    }
+}
+
 /// One slot of the alias table: stay with `light` when the fraction is below `q`, else `alias`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct AliasSlot {
@@ -201,6 +233,74 @@ impl LightSampler {
             }
             LightSelection::Spatial => self.tree.sample(u, p, n),
         }
+    }
+
+    /// [`LightSampler::sample`] for reuse of `u`: the light, its probability, and `u` remapped to
+    /// [0, 1) within the light's interval of u (uniform given the light; stratified u stays
+    /// stratified per light). The light and pmf equal `sample`'s for uniform and spatial choice;
+    /// for power choice they follow the same alias table (same pmf).
+    #[inline]
+    pub fn sample_remap(&self, u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32, f32)> {
+        if self.n == 0 {
+            return None;
+        }
+        let uniform = |u: f32| {
+            let x = u * self.n as f32;
+            let i = (x as u32).min(self.n - 1);
+            (i, self.inv_n, (x - i as f32).clamp(0.0, ONE_MINUS))
+        };
+        match self.selection {
+            LightSelection::All => None,
+            LightSelection::Uniform => Some(uniform(u)),
+            LightSelection::Power if self.alias.is_empty() => Some(uniform(u)),
+            LightSelection::Power => {
+                let m = self.alias.len();
+                let x = u * m as f32;
+                let j = (x as usize).min(m - 1);
+                let frac = (x - j as f32).clamp(0.0, ONE_MINUS);
+                let s = &self.alias[j];
+                let (i, rest) = if frac < s.q { (s.light, frac / s.q) } else { (s.alias, (frac - s.q) / (1.0 - s.q)) };
+                Some((i, self.power_pmf[i as usize], rest.clamp(0.0, ONE_MINUS)))
+            }
+            LightSelection::Spatial => self.tree.sample_remap(u, p, n),
+        }
+    }
+
+    /// [`LightSampler::sample_point_x8`] with the choice reused from the light point: the light
+    /// chosen by `u` ([`LightSampler::sample_remap`]) and the point `(u', v)` on it, u' the
+    /// remapped u. Inactive lanes and lanes without a light get light 0 and are off in the mask.
+    #[inline]
+    pub fn sample_point_reuse_x8(
+        &self,
+        emitters: &Emitters,
+        p: Vec3x8,
+        n: Vec3x8,
+        active: Mask8,
+        (u, v): (F8, F8),
+    ) -> (LightSample8, Mask8) {
+        let on = mask_to_bools(active);
+        let (idx, pmf, rest) = if self.selection == LightSelection::Uniform && self.n > 0 {
+            // Lane-wise, the scalar arithmetic.
+            let x = u * F8::splat(self.n as f32);
+            let i = x.to_array().map(|x| (x as u32).min(self.n - 1));
+            let fi = F8::new(i.map(|i| i as f32));
+            let rest = (x - fi).max(F8::ZERO).min(F8::splat(ONE_MINUS));
+            (U8::new(i), active.select(F8::splat(self.inv_n), F8::ZERO), rest)
+        } else {
+            let (us, ps, ns) = (u.to_array(), p.to_lanes(), n.to_lanes());
+            let (mut idx, mut pmf, mut rest) = ([0u32; 8], [0f32; 8], [0f32; 8]);
+            for l in 0..8 {
+                if on[l] {
+                    if let Some((i, q, r)) = self.sample_remap(us[l], ps[l], ns[l]) {
+                        (idx[l], pmf[l], rest[l]) = (i, q, r);
+                    }
+                }
+            }
+            (U8::new(idx), F8::new(pmf), F8::new(rest))
+        };
+        let ok = active & pmf.simd_gt(F8::ZERO);
+        let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
+        (emitters.place_x8(idx, inv_pmf, rest, v), ok)
     }
 
     /// Probability that [`LightSampler::sample`] picks light `i` at `(p, n)`: bit-identical to

@@ -378,3 +378,57 @@ fn wide_importance_equals_the_binary_bound() {
     }
     assert_eq!(leaves, 50 * lights.iter().filter(|e| e.power() > 0.0).count());
 }
+
+/// `--light-choice reuse`: `sample_remap` picks the light `sample` picks (uniform, spatial) or
+/// one with the same pmf (power, through the same alias table); its remapped u lies in [0, 1) and
+/// is uniform given the light (chi-square of 16 bins per light over stratified u); the x8 form
+/// equals the scalar one lane by lane.
+#[test]
+fn reused_choice_remaps_u_uniformly_per_light() {
+    let mut rng = Rng::new(77);
+    let lights = random_lights(&mut rng, 12, 3.0);
+    let emitters = Emitters::new(lights.clone(), std::iter::empty());
+    for sel in PICKING {
+        let s = LightSampler::new(&lights, sel);
+        let (p, nrm) = (Vec3::new(0.1, 0.2, 0.3), unit(&mut rng));
+        let n = 1 << 16;
+        let mut hist: Vec<[f64; 16]> = vec![[0.0; 16]; lights.len()];
+        for i in 0..n {
+            let u = (i as f32 + 0.5) / n as f32;
+            let Some((l, pmf, r)) = s.sample_remap(u, p, nrm) else { continue };
+            assert!((0.0..1.0).contains(&r), "{sel:?}: remapped {r}");
+            assert_eq!(pmf.to_bits(), s.pmf(p, nrm, l).to_bits(), "{sel:?}");
+            if sel != LightSelection::Power {
+                assert_eq!(s.sample(u, p, nrm), Some((l, pmf)), "{sel:?} u {u}");
+            }
+            hist[l as usize][(r * 16.0) as usize] += 1.0;
+        }
+        for (l, h) in hist.iter().enumerate() {
+            let total: f64 = h.iter().sum();
+            if total < 16.0 * 50.0 {
+                continue;
+            }
+            let e = total / 16.0;
+            let chi2: f64 = h.iter().map(|&c| (c - e).powi(2) / e).sum();
+            // Stratified u makes the bins near-exact; allow generous slack for interval ends.
+            assert!(chi2 < 60.0, "{sel:?} light {l}: chi2 {chi2} over {total} samples");
+        }
+        // x8 == scalar per lane.
+        let u = F8::new(std::array::from_fn(|_| rng.f32()));
+        let v = F8::new(std::array::from_fn(|_| rng.f32()));
+        let (ps, ns) = (Vec3x8::splat(p), Vec3x8::splat(nrm));
+        let (ls, ok) = s.sample_point_reuse_x8(&emitters, ps, ns, mask_all(), (u, v));
+        let (ua, va, oka) = (u.to_array(), v.to_array(), mask_to_bools(ok));
+        let ys = ls.y.to_lanes();
+        for k in 0..8 {
+            match s.sample_remap(ua[k], p, nrm) {
+                Some((l, _, r)) => {
+                    assert!(oka[k]);
+                    assert_eq!(ls.light.to_array()[k], l);
+                    assert_eq!(ys[k], lights[l as usize].point(r, va[k]), "{sel:?} lane {k}");
+                }
+                None => assert!(!oka[k]),
+            }
+        }
+    }
+}

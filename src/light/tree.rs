@@ -388,6 +388,12 @@ impl LightTree {
         self.wide.sample(u, p, n)
     }
 
+    /// [`LightTree::sample`] with `u` remapped within the chosen light's interval.
+    #[inline]
+    pub(crate) fn sample_remap(&self, u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32, f32)> {
+        self.wide.sample_remap(u, p, n)
+    }
+
     /// Probability that [`LightTree::sample`] picks `light` at `(p, n)` (the same products).
     #[inline]
     pub(crate) fn pmf(&self, p: Vec3, n: Vec3, light: u32) -> f32 {

@@ -164,7 +164,13 @@ impl WideTree {
 
     /// Light chosen by `u` in [0, 1) at `(p, n)` and its probability; `None` when no light can
     /// contribute (every importance 0 at some node on the way).
-    pub(crate) fn sample(&self, mut u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32)> {
+    pub(crate) fn sample(&self, u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32)> {
+        self.sample_remap(u, p, n).map(|(i, pmf, _)| (i, pmf))
+    }
+
+    /// [`WideTree::sample`] with `u` remapped to [0, 1) within the chosen light's interval of
+    /// the descent (u rescaled at every level), for reuse as a sample coordinate.
+    pub(crate) fn sample_remap(&self, mut u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32, f32)> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -193,7 +199,7 @@ impl WideTree {
             u = ((u - lo) / q).clamp(0.0, ONE_MINUS);
             pmf *= q;
             if node.leaf & (1 << c) != 0 {
-                return if pmf > 0.0 { Some((node.child[c], pmf)) } else { None };
+                return if pmf > 0.0 { Some((node.child[c], pmf, u)) } else { None };
             }
             k = node.child[c] as usize;
         }

@@ -220,6 +220,7 @@ pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bi
 /// The columns of `table.md` of `strata compare` ([`to_markdown`]).
 pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "variant", cell: |r, _| r.variant.replace('|', "\\|") },
+    Column { header: "samplers", cell: |r, _| r.setting.replace('|', "\\|") },
     Column { header: "seconds", cell: |r, _| sci(r.seconds) },
     Column { header: "spp", cell: |r, _| sci(r.spp) },
     Column { header: "sampler ns/sample", cell: |r, _| ns1(r.sampler_ns_per_sample) },
@@ -283,6 +284,8 @@ pub fn to_markdown(rows: &[Row]) -> String {
 #[derive(Serialize)]
 struct FlatRow<'a> {
     variant: &'a str,
+    /// the samplers that ran (`strata compare` puts them in the row's `setting`)
+    samplers: &'a str,
     seconds: f64,
     spp: f64,
     mse: f64,
@@ -304,6 +307,7 @@ pub fn to_json(rows: &[Row]) -> serde_json::Value {
         .iter()
         .map(|r| FlatRow {
             variant: &r.variant,
+            samplers: &r.setting,
             seconds: r.seconds,
             spp: r.spp,
             mse: r.stats.mse,

@@ -88,6 +88,7 @@ fn json_has_the_compare_keys_and_round_trips_the_numbers() {
     let keys: Vec<&str> = value[0].as_object().unwrap().keys().map(String::as_str).collect();
     let mut want = [
         "variant",
+        "samplers",
         "seconds",
         "spp",
         "mse",

@@ -1,5 +1,7 @@
 //! `halton`: bases 2 and 3, nested (Owen) scrambled per (pixel, dim, seed), at global index
-//! `i = sample * n + k` (wrapping in u32): the n points of one pixel sample are consecutive Halton
+//! `i = sample * n + k` (wrapping in u32), shuffled per (pixel, dim, seed) by a permutation that
+//! keeps every prefix [0, 2^m) (so the first 2^m points of a stream are the first 2^m Halton
+//! points, and dims are decorrelated): the n points of one pixel sample are consecutive Halton
 //! points and successive samples continue the sequence, so for the camera `n = spp, k = s,
 //! sample = 0` and `n = 1, k = 0, sample = s` give the same points.
 //!
@@ -11,6 +13,7 @@ use super::divisor::Divisor;
 use super::hash::{mix, stream_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
+use super::sobol::prefix_shuffle;
 
 const TAG_HALTON: u32 = 0x51a7_0003;
 
@@ -25,11 +28,8 @@ pub(super) const INFO: super::SamplerInfo =
 impl Layout for Halton {
     #[inline]
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
-        let index = sample.mul(L::splat(set.n())).add(k);
-        let key = mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel);
-        let x = RADIX2.inverse(index, Some(mix(key, L::splat(2))));
-        let y = RADIX3.inverse(index, Some(mix(key, L::splat(3))));
-        (x.unit24(), y.unit24())
+        let s = self.stream(set, pixel, sample, dim, seed);
+        halton_point(s.prefix, s.base.add(k), dim)
     }
 
     #[inline]
@@ -40,11 +40,23 @@ impl Layout for Halton {
 
     #[inline]
     fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
-        let index = s.base.add(L::splat(k));
-        let x = RADIX2.inverse(index, Some(mix(s.prefix, L::splat(2))));
-        let y = RADIX3.inverse(index, Some(mix(s.prefix, L::splat(3))));
-        (x.unit24(), y.unit24())
+        halton_point(s.prefix, s.base.add(L::splat(k)), s.dim)
     }
+}
+
+/// Point `index` of the stream keyed `key` in dimension `dim`: outside dimension 0 the index is
+/// shuffled per stream (keeping every prefix [0, 2^m), `sobol::prefix_shuffle`), then both
+/// radical inverses are taken, each nested-scrambled. Without the shuffle every dim of a pixel
+/// would draw the same index of the same two bases, and nested scrambling flips the top digits by
+/// a constant per stream, so two dims' points were tied to each other (a pixel's light choice
+/// followed its light point). Dimension 0 (the camera) keeps the classic sequence, with its
+/// 2^a x 3^b elementary intervals for every prefix; shuffled dims keep them for prefixes of 2^m.
+#[inline]
+fn halton_point<L: Lanes>(key: L, index: L, dim: u32) -> (L::F, L::F) {
+    let index = if dim == 0 { index } else { prefix_shuffle(index, mix(key, L::splat(4))) };
+    let x = RADIX2.inverse(index, Some(mix(key, L::splat(2))));
+    let y = RADIX3.inverse(index, Some(mix(key, L::splat(3))));
+    (x.unit24(), y.unit24())
 }
 
 /// Unscrambled radical inverse of `index` in base 2 or 3 (`None` for other bases), in [0, 1): the

@@ -87,6 +87,9 @@ pub struct SamplerInfo {
     pub biased: bool,
     /// distinct points per (pixel, dim) before the sequence repeats, if it does
     pub period: Option<u64>,
+    /// sample s is the same whatever the pixel's sample count (a sequence): equal-time runs,
+    /// whose count is not known in advance, can continue it pass after pass
+    pub progressive: bool,
     /// the generator
     pub layout: &'static dyn DynLayout,
 }
@@ -99,7 +102,7 @@ impl SamplerInfo {
         description: &'static str,
         layout: &'static dyn DynLayout,
     ) -> Self {
-        Self { name, aliases, description, note: None, biased: false, period: None, layout }
+        Self { name, aliases, description, note: None, biased: false, period: None, progressive: true, layout }
     }
 
     /// Marks the sampler biased (its note becomes "biased").
@@ -112,6 +115,12 @@ impl SamplerInfo {
     /// Sets the help note.
     pub const fn note(mut self, note: &'static str) -> Self {
         self.note = Some(note);
+        self
+    }
+
+    /// Marks the layout as needing the pixel's sample count in advance (not progressive).
+    pub const fn needs_count(mut self) -> Self {
+        self.progressive = false;
         self
     }
 

@@ -24,24 +24,30 @@
 //!
 //! Use. [`TABLES`] tables of [`TABLE_POINTS`] points are built once (first call, `OnceLock`)
 //! from a fixed hash, so they are identical on every run and machine. Stream (pixel, dim, seed)
-//! picks one table and an axis swap by hash and XORs the 24-bit fixed-point coordinates with a
+//! picks one table and an axis swap (see below) and XORs the 24-bit fixed-point coordinates with a
 //! hashed 24-bit constant per axis (a random digital shift: it maps every dyadic interval onto a
 //! dyadic interval of the same size, so nets stay nets, and it makes each point uniform on the
 //! 2^-24 grid, so estimates are unbiased). Point k of the n-point set of (pixel, sample, dim) is
-//! sequence point `i = (sample * n + k) mod 4096` (wrapping u32 arithmetic; n == 0 acts as 1).
+//! sequence point `shuffle(i)`, `i = (sample * n + k) mod 4096` (wrapping u32 arithmetic; n == 0
+//! acts as 1; `shuffle` keeps every prefix, see below).
 //!
 //! Limitations: the sequence repeats after 4096 points per (pixel, dim) (use Sobol' beyond
 //! 4096 samples per pixel). Only prefixes [0, 2^m) and blocks [2^m, 2^(m+1)) are guaranteed nets;
 //! other aligned blocks (the set of pixel sample s >= 1 for n = 2^m, say) are stratified on the
 //! coarser levels only. Digital shifts randomize less than Owen scrambling, and there are only 128
-//! base sequences (64 tables x axis swap): two dims of one pixel share one with probability 1/128
-//! (then their points are XOR-related, i.e. correlated).
+//! base sequences (64 tables x axis swap). Dimensions of one pixel are decorrelated twice: the
+//! base sequence of dim d is (a per-pixel hash + d) mod 128, so dims less than 128 apart never share
+//! one, and the index is shuffled per (pixel, dim) by `sobol::prefix_shuffle`, which keeps every
+//! prefix [0, 2^m) (the net property of prefixes and the progressive order of whole prefixes).
+//! Without the shuffle, all tables come from the same forced construction, so two dims drawing
+//! the same index were correlated whatever table each used.
 
 use std::sync::OnceLock;
 
 use super::hash::{combine, combine_key, fmix};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape};
+use super::sobol::prefix_shuffle;
 use crate::simd::{F8, U8};
 
 /// Points per table: the period of every pmj02 stream (a power of two, 2^12).
@@ -85,10 +91,17 @@ pub fn pmj02_2d_x8(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) ->
 
 fn pmj02<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
     let key = combine(L::splat(combine_key(TAG_PMJ, seed, dim)), pixel);
+    // The index, shuffled per (pixel, dim) keeping every prefix [0, 2^m) (so prefixes stay nets):
+    // without it two dims drawing the same index of tables built by the same forced construction
+    // are correlated (a pixel's light choice then follows its light point).
     let index = sample.mul(L::splat(n.max(1))).add(k).and(L::splat(TABLE_POINTS - 1));
-    let pick = combine(key, L::splat(1));
-    // Table from the top bits, axis swap from the lowest bit (as an all-ones/all-zeros mask).
-    let slot = pick.shr(32 - LOG_TABLES).shl(LOG_POINTS).or(index);
+    let index = prefix_shuffle(index, combine(key, L::splat(4))).and(L::splat(TABLE_POINTS - 1));
+    // (Table, axis swap) = (pixel's offset + dim) mod 128: dims less than 128 apart never share a
+    // base sequence within a pixel.
+    let offset = combine(L::splat(combine_key(TAG_TABLE, seed, 0)), pixel).shr(32 - LOG_TABLES - 1);
+    let pick = offset.add(L::splat(dim)).and(L::splat((TABLES << 1) - 1));
+    // Table from the high bits, axis swap from the lowest bit (as an all-ones/all-zeros mask).
+    let slot = pick.shr(1).shl(LOG_POINTS).or(index);
     let swap = pick.and(L::splat(1)).mul(L::splat(u32::MAX));
     let table = tables();
     let (x, y) = (slot.map(|s| table[s as usize][0]), slot.map(|s| table[s as usize][1]));
@@ -268,8 +281,8 @@ mod tests {
         }
         let mut used = [[false; 2]; TABLES as usize];
         for p in 0..2000u32 {
-            let pick = combine(combine(combine_key(TAG_PMJ, 0, 0), p), 1);
-            used[(pick >> (32 - LOG_TABLES)) as usize][(pick & 1) as usize] = true;
+            let pick = combine(combine_key(TAG_TABLE, 0, 0), p) >> (32 - LOG_TABLES - 1);
+            used[(pick >> 1) as usize][(pick & 1) as usize] = true;
         }
         assert!(used.iter().flatten().all(|&u| u));
     }

@@ -46,6 +46,8 @@ const F_RESET: u32 = 1 << 7;
 /// On `OP_STREAM` / `OP_STREAM_POINT` (which have no k word): the camera's stream table, not the
 /// light streams' (the bit is `F_K_SPLAT` of `OP_POINT`).
 const F_CAMERA: u32 = 1 << 6;
+/// On `OP_PATH` (which has no k word): the light table, not the path table.
+const F_LIGHT_TABLE: u32 = 1 << 6;
 const DIM_SHIFT: u32 = 8;
 /// Dimensions from here on take a word of their own (escape: the op word's dim field is all ones).
 const DIM_WIDE: u32 = (1 << (32 - DIM_SHIFT)) - 1;
@@ -274,12 +276,14 @@ pub fn pixel_point(pixel: U8, sample: U8, dim: u32, k: U8) {
     }
 }
 
-/// Reports the path tracer's point of dimension `dim` for pixel samples `sample`:
-/// `path_set.point_x8(pixel, 0, dim, shuffled_index_x8(sample, spp, pixel, dim, seed), seed)`.
+/// Reports a table point of dimension `dim` for pixel samples `sample`
+/// ([`GridTable::path_point_x8`]): from the light table (`light`: light points and choices of
+/// either integrator) or the path table (the path tracer's other dimensions).
 #[inline]
-pub fn path_point(pixel: U8, sample: U8, dim: u32) {
+pub fn path_point(pixel: U8, sample: U8, dim: u32, light: bool) {
     if recording() {
-        LOG.with_borrow_mut(|l| l.push(OP_PATH, pixel, sample, dim, None));
+        let op = if light { OP_PATH | F_LIGHT_TABLE } else { OP_PATH };
+        LOG.with_borrow_mut(|l| l.push(op, pixel, sample, dim, None));
     }
 }
 
@@ -360,7 +364,9 @@ pub struct ReplaySets {
     pub pixel: PointSet,
     /// the light sample layout of `direct`
     pub light: PointSet,
-    /// the path tracer's layout of every path dimension
+    /// the light dimensions drawn over all of a pixel's light samples (both integrators)
+    pub light_table: GridTable,
+    /// the path tracer's layout of its other path dimensions
     pub path: GridTable,
     /// samples per pixel the path tracer shuffles strata over
     pub path_n: u32,
@@ -375,6 +381,7 @@ impl ReplaySets {
         Self {
             pixel: re(&self.pixel),
             light: re(&self.light),
+            light_table: GridTable::new(re(self.light_table.set())),
             path: GridTable::new(re(self.path.set())),
             path_n: self.path_n,
             seed: self.seed,
@@ -441,6 +448,7 @@ impl Recording {
         let mut point_k = sets.light.point_k(0);
         let mut last_k = 0u32;
         let mut path_dims: Vec<Option<PathDim>> = Vec::new();
+        let mut light_dims: Vec<Option<PathDim>> = Vec::new();
         let (mut calls, mut sum) = (0u64, 0u32);
         let sample_on = mode == ReplayMode::Sample;
         for t in &self.tiles {
@@ -529,12 +537,17 @@ impl Recording {
                         sum = if sample_on {
                             // The render hoists a dimension's lane-uniform work out of its
                             // packets (once per bounce): so does the replay, once per dim.
+                            let (table, n, dims) = if op & F_LIGHT_TABLE != 0 {
+                                (&sets.light_table, sets.light_table.set().n(), &mut light_dims)
+                            } else {
+                                (&sets.path, sets.path_n, &mut path_dims)
+                            };
                             let at = dim as usize;
-                            if path_dims.len() <= at {
-                                path_dims.resize(at + 1, None);
+                            if dims.len() <= at {
+                                dims.resize(at + 1, None);
                             }
-                            let d = *path_dims[at].get_or_insert_with(|| sets.path.path_dim(sets.path_n, dim, seed));
-                            let (x, y) = sets.path.path_point_x8(&d, pixel, sample);
+                            let d = *dims[at].get_or_insert_with(|| table.path_dim(n, dim, seed));
+                            let (x, y) = table.path_point_x8(&d, pixel, sample);
                             fold(sum, x.to_bits() ^ y.to_bits())
                         } else {
                             fold(sum, std::hint::black_box(pixel ^ sample ^ U8::splat(dim)))

@@ -106,6 +106,29 @@ fn keyed_point<L: Lanes>(key: L, index: L) -> (L::F, L::F) {
     (x.unit24(), y.unit24())
 }
 
+/// A keyed permutation of u32 that keeps every prefix `[0, 2^m)` (and every block
+/// `[2^m, 2^(m+1))`) as a set: the highest set bit of `i` stays, and each bit below it is flipped
+/// by a hash of `key` and the bits above it (a nested, top-down scramble of the index). Two
+/// dimensions that draw index i of the same base-2 construction (pmj02's tables, Halton's radical
+/// inverse, ZSobol's pixel block) are correlated however each is scrambled; shuffling the index
+/// per dimension with this permutation decorrelates them, while the first 2^m indices of a stream
+/// are still exactly the first 2^m points of the sequence (so nets and stratification of prefixes
+/// are kept, and the sequence stays progressive). Built on Burley's shuffle `nus`: bit q of
+/// `nus(i)` is bit q of i flipped by a function of the bits above q, so on the bits at and above
+/// the highest set bit (whose higher bits are all zero) it flips exactly the bits of `nus(0)`;
+/// undoing those flips keeps the highest set bit and the zeros above it.
+#[inline]
+pub(super) fn prefix_shuffle<L: Lanes>(i: L, key: L) -> L {
+    let nus = |x: L| reverse_bits(lk_permute(reverse_bits(x), key));
+    // Bits at and above the highest set bit of i (all bits for i = 0).
+    let mut smear = i;
+    for s in [1, 2, 4, 8, 16] {
+        smear = smear.or(smear.shr(s));
+    }
+    let top = smear.shr(1).xor(L::splat(u32::MAX));
+    nus(i).xor(nus(L::splat(0)).and(top))
+}
+
 /// Sobol' point `i` (dimensions 0, 1), Owen-scrambled with the axis keys `combine(key, 2)` and
 /// `combine(key, 3)`, as 24-bit fixed point (no index shuffle: callers choose the index). A
 /// building block for layouts that order the sequence themselves (`zsobol`).
@@ -224,6 +247,32 @@ pub(super) mod tests {
         // Natural-order Sobol' points 0..8: x = van der Corput, y = dimension 1.
         let y: Vec<f64> = (0..8u32).map(|i| f64::from(reverse_bits(pascal(i))) / 2f64.powi(32)).collect();
         assert_eq!(y, [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875]);
+    }
+
+    #[test]
+    fn prefix_shuffle_keeps_every_prefix_and_moves_low_bits() {
+        let mut st = 5u64;
+        for _ in 0..40 {
+            let key = lcg(&mut st);
+            for m in 0..=12u32 {
+                let mut seen = vec![false; 1 << m];
+                for i in 0..1u32 << m {
+                    let j = prefix_shuffle(i, key);
+                    assert!(j < 1 << m, "key {key:#x} m {m}: {i} -> {j}");
+                    assert!(!std::mem::replace(&mut seen[j as usize], true), "not a permutation");
+                    if i > 0 {
+                        assert_eq!(31 - j.leading_zeros(), 31 - i.leading_zeros(), "highest bit moved");
+                    }
+                }
+            }
+            for i in [u32::MAX, 1 << 31, 0x1234_5678] {
+                assert_eq!(prefix_shuffle(i, key).leading_zeros(), i.leading_zeros());
+            }
+        }
+        // Two keys: the lowest index bit (the top digit of a radical inverse) agrees for about
+        // half of the indices, not for all of them (what made dimensions correlated).
+        let same = (0..4096u32).filter(|&i| (prefix_shuffle(i, 17) ^ prefix_shuffle(i, 99)) & 1 == 0).count();
+        assert!((1600..2500).contains(&same), "{same}");
     }
 
     #[test]

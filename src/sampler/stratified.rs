@@ -27,12 +27,14 @@ pub(super) const JITTERED: super::SamplerInfo = super::SamplerInfo::new(
     &["jittered"],
     "one jittered point per strata cell",
     &Stratified { jitter: true },
-);
+)
+.needs_count();
 
 /// Its registry entry as strata cell centres (see [`super::SAMPLERS`]).
 pub(super) const CENTRES: super::SamplerInfo =
     super::SamplerInfo::new("grid-center", &["grid", "center", "grid-centre", "centre"], "strata cell centres", &Stratified { jitter: false })
-        .biased();
+        .biased()
+        .needs_count();
 
 /// Point in the 24-bit fixed-point span `[x lo, x hi, y lo, y hi]` picked by the stratified jitter
 /// hash of (pixel, sample, dim, k, seed); a zero-width span gives its lower edge.
@@ -127,6 +129,8 @@ pub struct GridTable {
     /// the same spans per axis when both axes have at most 8 cells (and the spans are a product
     /// of the axes): looked up by lane permutes instead of per-lane loads
     axes: Option<Axes>,
+    /// a grid layout (its points lie in fixed cells: `Layout::cell_span` is `Some`)
+    grid: bool,
 }
 
 /// The spans of a grid of at most 8 x 8 cells per axis: [x lo, x hi, y lo, y hi] of column or
@@ -180,12 +184,18 @@ impl GridTable {
             Vec::new()
         };
         let axes = Axes::of(&spans, shape.grid());
-        Self { set, spans, axes }
+        let grid = layout.cell_span(&shape, 0).is_some();
+        Self { set, spans, axes, grid }
     }
 
     /// The point set this table belongs to.
     pub fn set(&self) -> &PointSet {
         &self.set
+    }
+
+    /// A grid layout: [`GridTable::path_point_x8`] shuffles its strata per (pixel, dim).
+    pub fn is_grid(&self) -> bool {
+        self.grid
     }
 
     /// As [`PointSet::point`], bit for bit; coordinates in [0, 1).
@@ -254,10 +264,16 @@ impl GridTable {
         PathDim { dim, seed, shuffle, key, in_range: shuffle.n() <= self.set.n() }
     }
 
-    /// The path tracer's point of dimension `d` for pixel samples `s`: bit for bit
-    /// `point_x8(pixel, 0, dim, shuffled_index_x8(s, spp, pixel, dim, seed), seed)`.
+    /// The path tracer's point of dimension `d` for pixel samples `s`: for grid layouts bit for
+    /// bit `point_x8(pixel, 0, dim, shuffled_index_x8(s, spp, pixel, dim, seed), seed)` (strata
+    /// shuffled per (pixel, dim): padded stratified sampling), for the others (sequences, which
+    /// decorrelate their dims themselves and must keep the index's prefixes)
+    /// `point_x8(pixel, 0, dim, s, seed)`.
     #[inline(always)]
     pub fn path_point_x8(&self, d: &PathDim, pixel: U8, s: U8) -> (F8, F8) {
+        if !self.grid {
+            return self.set.point_x8(pixel, U8::splat(0), d.dim, s, d.seed);
+        }
         let k = d.shuffle.index_x8(s, pixel);
         if self.spans.is_empty() {
             return self.set.point_x8(pixel, U8::splat(0), d.dim, k, d.seed);

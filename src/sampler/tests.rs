@@ -205,7 +205,8 @@ fn permute_x8_and_grid_table_equal_their_scalar_forms_bit_for_bit() {
 }
 
 /// The path tracer's hoisted points (`GridTable::path_dim` + `path_point_x8`) equal the
-/// per-call form `point_x8(pixel, 0, dim, shuffled_index_x8(..))` bit for bit, for every layout,
+/// per-call form `point_x8(pixel, 0, dim, shuffled_index_x8(..))` (grids) or
+/// `point_x8(pixel, 0, dim, s)` (sequences) bit for bit, for every layout,
 /// with the spp equal to, above and below the set's n (and the equal-time `u32::MAX`).
 #[test]
 fn path_points_with_hoisted_dimensions_equal_the_per_call_form() {
@@ -222,6 +223,7 @@ fn path_points_with_hoisted_dimensions_equal_the_per_call_form() {
                     let s = u8_from(|l| if l == 7 { u32::MAX } else { lcg(&mut st) % spp.max(1) });
                     let k = shuffled_index_x8(s, spp, pixel, dim, seed);
                     assert_eq!(k.to_array(), ShuffleKey::new(spp, dim, seed).index_x8(s, pixel).to_array());
+                    let k = if table.is_grid() { k } else { s };
                     let (ex, ey) = table.point_x8(pixel, U8::splat(0), dim, k, seed);
                     let (x, y) = table.path_point_x8(&d, pixel, s);
                     assert_eq!(x.to_array().map(f32::to_bits), ex.to_array().map(f32::to_bits), "{kind:?} n={n}");
@@ -473,10 +475,23 @@ fn check_elementary(a: u32, b: u32, pixel: u32, dim: u32, seed: u64) {
 
 #[test]
 fn halton_elementary_intervals() {
+    // Dimension 0 is the classic (scrambled) sequence: every block of 2^a 3^b indices.
     for (a, b) in [(1, 1), (2, 2), (2, 1), (1, 2), (3, 2), (0, 3), (4, 0)] {
         for pixel in [0, 1, 99, u32::MAX] {
-            for (dim, seed) in [(0, 0), (1, 7), (13, u64::MAX)] {
-                check_elementary(a, b, pixel, dim, seed);
+            for seed in [0, 7, u64::MAX] {
+                check_elementary(a, b, pixel, 0, seed);
+            }
+        }
+    }
+    // Other dims shuffle the index keeping prefixes of 2^m: those are 2^a x 2^(m-a)... in base 2
+    // and 1D-stratified in x.
+    for m in 0..=8u32 {
+        for (pixel, dim, seed) in [(0, 1, 0), (99, 13, 7), (u32::MAX, 70, u64::MAX)] {
+            let set = PointSet::new(SamplerKind::HALTON, 1 << m);
+            let mut seen = vec![false; 1 << m];
+            for k in 0..1u32 << m {
+                let x = set.point(pixel, 0, dim, k, seed)[0];
+                assert!(!std::mem::replace(&mut seen[cell(x, 1 << m) as usize], true), "m {m} dim {dim}");
             }
         }
     }
@@ -484,12 +499,12 @@ fn halton_elementary_intervals() {
     let set = PointSet::new(SamplerKind::HALTON, 1);
     let mut sx = vec![false; 1 << 12];
     for i in 0..(1u32 << 12) {
-        let x = set.point(4, i, 1, 0, 3)[0];
+        let x = set.point(4, i, 0, 0, 3)[0];
         assert!(!std::mem::replace(&mut sx[cell(x, 1 << 12) as usize], true));
     }
     let mut sy = vec![false; 6561];
     for i in 0..6561 {
-        let y = set.point(4, i, 1, 0, 3)[1];
+        let y = set.point(4, i, 0, 0, 3)[1];
         assert!(!std::mem::replace(&mut sy[cell(y, 6561) as usize], true));
     }
 }

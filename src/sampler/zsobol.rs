@@ -11,8 +11,10 @@
 //! pixels get complementary points, and the error is spread like blue noise over the image, while
 //! each pixel's n = 2^b points are a (0, b, 2)-net, as with `sobol`.
 //!
-//! Point k of the set of (pixel, sample, dim) is index `m' 2^b + (k mod 2^b)` of the sequence
-//! scrambled for pixel sample `sample + k / 2^b` (so k >= 2^b continues in a fresh scramble). For
+//! Point k of the set of (pixel, sample, dim) is index `m' 2^b + P(k mod 2^b)` of the sequence
+//! scrambled for pixel sample `sample + k / 2^b` (so k >= 2^b continues in a fresh scramble), P a
+//! per-(pixel, dim) shuffle keeping every prefix [0, 2^m) (`sobol::prefix_shuffle`), which
+//! decorrelates the dims of one pixel. For
 //! the camera use `n = spp, k = s, sample = 0`. Pixel coordinates come from the set's image width
 //! ([`SetShape::pixel_xy`], `pixel = y * width + x`); with an unknown width (0) the linear pixel id
 //! itself is used as the Morton index. Coordinates use 16 bits each (images up to 65536 wide), and
@@ -21,7 +23,7 @@
 use super::hash::{combine, combine_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
-use super::sobol::scrambled_point;
+use super::sobol::{prefix_shuffle, scrambled_point};
 
 const TAG_ZSOBOL: u32 = 0x50b0_1005;
 
@@ -31,7 +33,7 @@ pub struct ZSobol;
 
 /// Its entry in the registry [`super::SAMPLERS`].
 pub(super) const INFO: super::SamplerInfo =
-    super::SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &ZSobol);
+    super::SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &ZSobol).needs_count();
 
 /// The 24 permutations of the four quadrants, lexicographic: entry `4 p + d` is digit d under
 /// permutation p.
@@ -108,6 +110,10 @@ fn block_point<L: Lanes>(set: &SetShape, start: L, sample: L, dim: u32, k: L, se
     let b = block_bits(set);
     let (low, high) = if b >= 32 { (k, L::splat(0)) } else { (k.and(L::splat((1 << b) - 1)), k.shr(b)) };
     let key = combine(L::splat(combine_key(TAG_ZSOBOL, seed, dim)), sample.add(high));
+    // The pixel's own indices shuffled per (pixel, dim), keeping every prefix [0, 2^m) (so the
+    // pixel's first 2^m points stay a net): otherwise every dim of a pixel draws the same index
+    // and their top digits are tied (a light choice follows the light point).
+    let low = prefix_shuffle(low, combine(key, start.or(L::splat(1 << 31))));
     let (x, y) = scrambled_point(start.or(low), key);
     (x.unit24(), y.unit24())
 }

@@ -64,17 +64,25 @@ fn check_writable(dir: &Path) -> Result<(), SessionError> {
 /// `period`, read from the registry): the pixel sampler uses indices `0..spp`, the light
 /// sampler `sample * n + k`, so `0..spp * light_samples`.
 pub fn check_sampler_periods(opts: &RenderOptions, desc: &SceneDesc, spp: u32) -> Result<(), SessionError> {
-    let pixel = opts.pixel_sampler.unwrap_or(SamplerKind::STRATIFIED);
+    let base = opts.sampler.unwrap_or(SamplerKind::STRATIFIED);
+    let pixel = opts.pixel_sampler.or(opts.sampler).unwrap_or(base);
     let n_light = opts.light_samples.unwrap_or(desc.light_samples).max(1);
-    let light = opts.light_sampler.unwrap_or(if desc.light_stratify {
+    let light = opts.light_sampler.or(opts.sampler).unwrap_or(if desc.light_stratify {
         SamplerKind::STRATIFIED
     } else {
         SamplerKind::INDEPENDENT
     });
+    let flag = |own: Option<SamplerKind>, name| if own.is_some() || opts.sampler.is_none() { name } else { "sampler" };
     let asked_light = u64::from(spp) * u64::from(n_light);
     let cases = [
-        (pixel, u64::from(spp), format!("{spp} spp"), "pixel-sampler"),
-        (light, asked_light, format!("{spp} spp x {n_light} light samples = {asked_light} points"), "light-sampler"),
+        (pixel, u64::from(spp), format!("{spp} spp"), flag(opts.pixel_sampler, "pixel-sampler")),
+        (
+            light,
+            asked_light,
+            format!("{spp} spp x {n_light} light samples = {asked_light} points"),
+            flag(opts.light_sampler, "light-sampler"),
+        ),
+        (base, u64::from(spp), format!("{spp} spp"), "sampler"),
     ];
     for (kind, asked, phrase, flag) in cases {
         let info = kind.info();

@@ -68,6 +68,17 @@ pub enum SessionError {
         /// how to raise the cap
         hint: String,
     },
+    /// A flag that changes nothing for the integrator that runs.
+    #[error("{flag} changes nothing here: {why}")]
+    FlagIgnored {
+        /// the flag
+        flag: &'static str,
+        /// why it changes nothing
+        why: String,
+    },
+    /// An equal-time run (`--time-budget`) of a sampler that needs its sample count.
+    #[error(transparent)]
+    NotProgressive(#[from] crate::integrator::NotProgressive),
     /// `--time-budget` not a positive number.
     #[error("--time-budget {0}: expected a positive number of seconds")]
     TimeBudget(f64),

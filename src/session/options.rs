@@ -26,8 +26,12 @@ pub struct RenderOptions {
     pub seed: u64,
     /// worker threads (0 = all cores)
     pub threads: usize,
-    /// light sample layout (default: the scene's `lightstratify`)
+    /// every dimension's layout (`--sampler`; default stratified)
+    pub sampler: Option<SamplerKind>,
+    /// light sample layout (default: `sampler`, else the scene's `lightstratify`)
     pub light_sampler: Option<SamplerKind>,
+    /// where a one-light choice takes its number from (`--light-choice`; default reuse)
+    pub light_choice: Option<crate::light::select::LightChoice>,
     /// light samples per light (default: the scene's `lightsamples`)
     pub light_samples: Option<u32>,
     /// pixel sample layout (default stratified)
@@ -56,8 +60,8 @@ pub struct RenderOptions {
     pub resume: Option<PathBuf>,
     /// render only sample indices A..B of the spp (a shard for `strata merge`)
     pub samples: Option<(u32, u32)>,
-    /// render whole passes until this many seconds are spent (independent pixel and path layouts;
-    /// `--spp`, if given, caps the samples)
+    /// render whole passes until this many seconds are spent (progressive layouts continue across
+    /// passes, others are refused; `--spp`, if given, caps the samples)
     pub time_budget: Option<f64>,
     /// set (e.g. by SIGINT/SIGTERM) to stop after the current pass, checkpoint and write the image
     pub stop: Option<Arc<AtomicBool>>,

@@ -48,8 +48,9 @@ pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError
         if !(b > 0.0 && b.is_finite()) {
             return Err(SessionError::TimeBudget(b));
         }
-        // The number of samples is not known in advance: layouts that need it become independent.
-        integrator = integrator.resampled(None);
+        // The number of samples is not known in advance: progressive layouts continue pass after
+        // pass; a layout named on the command line that needs its count is refused.
+        integrator = integrator.equal_time()?;
     }
     let every = opts.checkpoint_every.unwrap_or(DEFAULT_CHECKPOINT_EVERY);
     if !(every >= 0.0 && every.is_finite()) {

@@ -59,7 +59,14 @@ pub struct SamplerReplay {
 
 /// The layouts `it` draws from at each call site.
 pub fn replay_sets(it: &Integrator) -> ReplaySets {
-    ReplaySets { pixel: it.pixel_set, light: it.light_set, path: it.path_set.clone(), path_n: it.spp, seed: it.seed }
+    ReplaySets {
+        pixel: it.pixel_set,
+        light: it.light_set,
+        light_table: it.light_table.clone(),
+        path: it.path_set.clone(),
+        path_n: it.spp,
+        seed: it.seed,
+    }
 }
 
 /// Renders the job once with the sampler calls recorded (at most `cap_words` log words); returns

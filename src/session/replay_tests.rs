@@ -14,8 +14,9 @@ fn opts(kind: IntegratorKind, pixel: Option<SamplerKind>) -> RenderOptions {
         seed: 11,
         threads: 2,
         integrator: Some(kind),
-        pixel_sampler: pixel,
-        light_sampler: pixel,
+        // Every dimension (the light dimensions of raytracer and analyticdirect do not exist:
+        // `--light-sampler` would be refused there).
+        sampler: pixel,
         ..Default::default()
     }
 }

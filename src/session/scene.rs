@@ -132,8 +132,13 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
             if n == 1 { "" } else { "s" }
         );
     }
-    let mut integrator =
-        Integrator::new(&scene, spp, opts.seed, opts.light_sampler, opts.light_samples, opts.pixel_sampler);
+    let samplers = crate::integrator::SamplerChoice {
+        sampler: opts.sampler,
+        pixel: opts.pixel_sampler,
+        light: opts.light_sampler,
+    };
+    let mut integrator = Integrator::new(&scene, spp, opts.seed, samplers, opts.light_samples);
+    integrator.light_choice = opts.light_choice.unwrap_or(crate::light::select::LightChoice::Reuse);
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
@@ -149,7 +154,46 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         }
     });
     integrator.set_light_selection(&scene, selection);
+    check_flags_apply(opts, &scene, &integrator)?;
     Ok((scene, integrator))
+}
+
+/// Refuses a light-sampling flag that changes nothing for the integrator that runs, saying why:
+/// `--light-sampler`, `--light-choice`, `--light-selection` for raytracer and analyticdirect, and
+/// `--light-choice` where no light is chosen (selection `all`, fewer than two lights).
+fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<(), SessionError> {
+    use crate::light::select::LightSelection;
+    use crate::scene::desc::IntegratorKind;
+    let refuse = |flag: &'static str, why: String| Err(SessionError::FlagIgnored { flag, why });
+    let name = it.kind.name();
+    if matches!(it.kind, IntegratorKind::RayTracer | IntegratorKind::AnalyticDirect) {
+        let why = match it.kind {
+            IntegratorKind::RayTracer => "raytracer shades point and directional lights, it samples no area light",
+            _ => "analyticdirect integrates area lights exactly, it samples none",
+        };
+        let given = [
+            ("--light-sampler", opts.light_sampler.is_some()),
+            ("--light-choice", opts.light_choice.is_some()),
+            ("--light-selection", opts.light_selection.is_some()),
+        ];
+        if let Some((flag, _)) = given.into_iter().find(|(_, on)| *on) {
+            return refuse(flag, why.to_string());
+        }
+    }
+    if opts.light_choice.is_some() {
+        if it.light_selection == LightSelection::All {
+            return refuse(
+                "--light-choice",
+                format!("{name} with light selection all samples every light: there is no choice"),
+            );
+        }
+        if scene.emitters.len() < 2 {
+            return refuse("--light-choice", "the scene has fewer than two area lights: there is no choice".into());
+        }
+    }
+    // (`--light-samples` is accepted everywhere: scripts pass it over whole scene sets, and the
+    // `.test` keyword it overrides is there whatever the integrator.)
+    Ok(())
 }
 
 /// Hash of the scene's bytes (the file as read, or the built-in scene's text).

@@ -28,6 +28,8 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "pixel_sampler": out.integrator.pixel_set.kind().name(),
         "light_sampler": out.integrator.light_set.kind().name(),
         "light_samples": out.integrator.light_set.n(),
+        "sampler": out.integrator.path_set.set().kind().name(),
+        "light_choice": out.integrator.light_choice.name(),
         "rays": { "camera": c.camera, "shadow": c.shadow, "bounce": c.bounce, "total": c.total_rays() },
         "mrays_per_sec": out.stats.mrays_per_sec(),
         "packets": { "camera": c.camera_packets, "bounce": c.bounce_packets, "shadow": c.shadow_packets },
@@ -65,7 +67,10 @@ pub fn summary(out: &RenderOutput) -> String {
         ),
         IntegratorKind::PathTracer => {
             format!(
-                " (nee {}, lights {}, {} sampling, rr {}, maxdepth {})",
+                " (sampler {}, pixel {}, light {}, nee {}, lights {}, {} sampling, rr {}, maxdepth {})",
+                it.path_set.set().kind().name(),
+                it.pixel_set.kind().name(),
+                it.light_set.kind().name(),
                 it.nee.name(),
                 it.light_selection.name(),
                 it.strategy.name(),

@@ -11,9 +11,13 @@
 //! unbiased: no clamping unless `--clamp` asks for it (biased, reported).
 //!
 //! Sampler dimensions of vertex v: `DIM_PATH_BASE + 4 (v-1) + {0: light point, 1: (light choice,
-//! lobe choice), 2: BSDF direction, 3: (Russian roulette, -)}`. Each is a stratified set over the
-//! pixel's spp samples whose strata are shuffled per (pixel, dimension), so dimensions are
-//! stratified independently of one another.
+//! -), 2: BSDF direction, 3: (Russian roulette, lobe choice)}`. Dims 0 and 1 come from the light
+//! layout (`--light-sampler`), 2 and 3 from the path layout (`--sampler`), each over the pixel's
+//! spp samples (grid layouts with strata shuffled per (pixel, dimension), so dimensions are
+//! stratified independently of one another; sequences decorrelate their dims themselves). Dim 1
+//! is drawn only under `--light-choice dimension` with several lights (reuse takes the choice
+//! from dim 0's first coordinate); dim 3 only where roulette or the lobe pick needs it. A
+//! dimension not drawn changes no other.
 
 use super::context::{masked, TileCtx};
 use super::direct::material;
@@ -21,7 +25,7 @@ use super::{Integrator, RayKind};
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
 use crate::light::emitters::LightSample8;
-use crate::light::select::LightSelection;
+use crate::light::select::{LightChoice, LightSelection};
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::{Scene, SurfaceHit8};
@@ -83,12 +87,14 @@ pub struct PathScratch {
 }
 
 impl Integrator {
-    /// Stratified 2D point of dimension `d` for pixel samples `s`, strata shuffled per (pixel, dim).
+    /// 2D point of path dimension `d` for pixel samples `s`, from the light table (light point,
+    /// light choice) or the path table (the others); grid layouts shuffle their strata per
+    /// (pixel, dim).
     #[inline(always)]
-    fn path_point(&self, d: &PathDim, pixel: U8, s: U8) -> (F8, F8) {
+    fn path_point(&self, d: &PathDim, light: bool, pixel: U8, s: U8) -> (F8, F8) {
         let _p = crate::profile::leaf(crate::profile::Phase::SamplerPath);
-        crate::sampler::replay::path_point(pixel, s, d.dim());
-        self.path_set.path_point_x8(d, pixel, s)
+        crate::sampler::replay::path_point(pixel, s, d.dim(), light);
+        if light { &self.light_table } else { &self.path_set }.path_point_x8(d, pixel, s)
     }
 }
 
@@ -173,8 +179,11 @@ impl Integrator {
             next_prev.clear();
             shadow.clear();
             let dims = DIM_PATH_BASE + 4 * (v - 1);
-            let dk: [PathDim; 4] =
-                std::array::from_fn(|j| self.path_set.path_dim(self.spp, dims + j as u32, self.seed));
+            // Dims 0 and 1 (light point, light choice) are light dimensions, 2 and 3 the others.
+            let dk: [PathDim; 4] = std::array::from_fn(|j| {
+                let table = if j < 2 { &self.light_table } else { &self.path_set };
+                table.path_dim(self.spp, dims + j as u32, self.seed)
+            });
             let dsky = sky::sky_dim(self, scene.sky.as_ref(), v);
             let mut b = Bounce { it: self, scene, v, max_v, dk: &dk, dsky, keep_prev, next, next_prev, shadow };
             for (ci, (r, traced)) in rh.iter().enumerate() {
@@ -283,7 +292,6 @@ impl Bounce<'_> {
             Nee::Mis => {
                 let _p = crate::profile::leaf(crate::profile::Phase::Mis);
                 let p_light = match it.light_selection {
-                    LightSelection::Uniform => light_pdf_at_hit(self.scene, sh, vx.rh, is_light),
                     // N points on every light: multi-sample MIS against N p_light.
                     LightSelection::All => {
                         let pmf = F8::splat(it.light_set.n().max(1) as f32);
@@ -327,19 +335,17 @@ impl Bounce<'_> {
         let o = sh.ng.mul_add(eps, sh.p);
         // Smooth-shaded lanes: directions must also leave the geometric surface.
         let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
-        // (light choice, lobe choice): drawn only where one of them is used (several lights, or
-        // BRDF sampling's lobe pick); skipping it changes no other dimension.
-        let (u_choice, u_lobe) = if n_lights > 1 || it.strategy == ImportanceSampling::Brdf {
-            it.path_point(&self.dk[1], pixel, s)
-        } else {
-            (F8::ZERO, F8::ZERO)
-        };
+        // A light choice of its own: drawn only under `--light-choice dimension` with several
+        // lights to pick from (skipping a dimension changes no other).
+        let picks = it.light_selection.picks_one() && n_lights > 1;
+        let own_choice = picks && it.light_choice == LightChoice::Dimension;
 
         if nee_here {
             self.sky_next_event::<L>(vx, &frame, wo, &mat, o, shade, leaves);
         }
         if nee_here && n_lights > 0 {
-            let (u, w) = it.path_point(&self.dk[0], pixel, s);
+            let u_choice = if own_choice { it.path_point(&self.dk[1], true, pixel, s).0 } else { F8::ZERO };
+            let (u, w) = it.path_point(&self.dk[0], true, pixel, s);
             let shadow = &mut *self.shadow;
             let mut push = |ls: &LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
                 let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
@@ -380,13 +386,11 @@ impl Bounce<'_> {
                 shadow.advance(&pack);
             };
             match it.light_selection {
-                // One light chosen by `scene.emitters.all` (uniform among quads, by power with
-                // emissive triangles), one point on it, uniform in area: the historical path,
-                // kept bit-identical.
-                LightSelection::Uniform => {
+                // The one light (pmf 1), a point on it uniform in area.
+                LightSelection::Uniform if n_lights == 1 => {
                     let ls = {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                        scene.emitters.sample_x8(u_choice, u, w, shade)
+                        scene.emitters.list[0].sample_x8(u, w)
                     };
                     push(&ls, None, None, shade)
                 }
@@ -410,10 +414,17 @@ impl Bounce<'_> {
                         }
                     }
                 }
-                LightSelection::Power | LightSelection::Spatial => {
+                // One light from the light sampler (uniform 1/N over quads and triangles alike,
+                // power or spatial), the choice reused from u or drawn on its own.
+                LightSelection::Uniform | LightSelection::Power | LightSelection::Spatial => {
                     let (ls, ok) = {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                        it.light_sampler.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
+                        let ls = &it.light_sampler;
+                        if own_choice {
+                            ls.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
+                        } else {
+                            ls.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, w))
+                        }
                     };
                     push(&ls, None, None, ok);
                 }
@@ -422,7 +433,13 @@ impl Bounce<'_> {
 
         // Continue the path: sample the BSDF, then Russian roulette.
         if bounce_here {
-            let u2 = it.path_point(&self.dk[2], pixel, s);
+            // (Russian roulette, lobe choice): drawn only where one of them is used.
+            let (u_rr, u_lobe) = if it.russian_roulette || it.strategy == ImportanceSampling::Brdf {
+                it.path_point(&self.dk[3], false, pixel, s)
+            } else {
+                (F8::ZERO, F8::ZERO)
+            };
+            let u2 = it.path_point(&self.dk[2], false, pixel, s);
             let (wi_l, pdf, f) = {
                 let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
                 mat.sample_k::<L>(it.strategy, wo, [u2.0, u2.1], u_lobe, shade)
@@ -434,7 +451,6 @@ impl Bounce<'_> {
             let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
             let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
             if it.russian_roulette {
-                let (u_rr, _) = it.path_point(&self.dk[3], pixel, s);
                 let q = nb.max_elem().min(F8::ONE);
                 alive &= u_rr.simd_lt(q);
                 nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
@@ -453,21 +469,6 @@ impl Bounce<'_> {
             }
         }
     }
-}
-
-/// Solid-angle pdf with which NEE would have picked the point hit on a light: pmf d^2 / (A cos_l)
-/// (pmf = 1/#lights without emissive triangles); zero where `is_light` is off.
-#[inline]
-fn light_pdf_at_hit(scene: &Scene, sh: &crate::scene::build::SurfaceHit8, rh: &RayHit8, is_light: Mask8) -> F8 {
-    let ids = sh.light.to_array();
-    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
-    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
-    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
-    let inv_pmf = scene.emitters.inv_pmf_x8(sh.light, is_light);
-    let t = F8::new(rh.ray.tfar);
-    let cos_l = ln.dot(sh.wo);
-    let p = t * t / (area * cos_l * inv_pmf);
-    is_light.select(p, F8::ZERO)
 }
 
 /// Solid-angle pdf of NEE at a light hit for a light chosen with probability `pmf` (per lane):

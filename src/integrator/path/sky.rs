@@ -17,9 +17,10 @@ use super::wave::{Columns, Pack};
 /// First sampler dimension of the sky's next events (one per vertex, after every vertex's own).
 pub const DIM_SKY_BASE: u32 = DIM_PATH_BASE + 4 * MAX_VERTICES_UNBOUNDED;
 
-/// The sky's sampler dimension at vertex `v`, when the scene has a sky.
+/// The sky's sampler dimension at vertex `v`, when the scene has a sky (a light dimension: drawn
+/// from the light sampler's table).
 pub(super) fn sky_dim(it: &Integrator, sky: Option<&Sky>, v: u32) -> Option<PathDim> {
-    sky.map(|_| it.path_set.path_dim(it.spp, DIM_SKY_BASE + (v - 1), it.seed))
+    sky.map(|_| it.light_table.path_dim(it.spp, DIM_SKY_BASE + (v - 1), it.seed))
 }
 
 /// Sky radiance, weighted by the next-event mode, brought by the rays of vertex `v` that left the
@@ -47,7 +48,7 @@ impl Bounce<'_> {
     ) {
         let (Some(sky), Some(dim)) = (self.scene.sky.as_ref(), self.dsky.as_ref()) else { return };
         let it = self.it;
-        let (u, w) = it.path_point(dim, vx.pixel, vx.s);
+        let (u, w) = it.path_point(dim, true, vx.pixel, vx.s);
         let (wi_l, pdf) = sky.sample_x8(u, w, shade);
         let wi = frame.to_world(wi_l);
         let lit = shade & wi_l.z.simd_gt(F8::ZERO) & pdf.simd_gt(F8::ZERO) & leaves(wi);
