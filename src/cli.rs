@@ -7,8 +7,34 @@ use strata::sampler::SamplerKind;
 use strata::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
 use strata::session::{self, RenderOptions};
 
+/// Help headings of the render flags.
+const SCENE: &str = "Scene and camera";
+const SAMPLING: &str = "Sampling";
+const LIGHTS: &str = "Lights";
+const INTEGRATOR: &str = "Integrator";
+const OUTPUT: &str = "Output";
+const CHECKPOINTS: &str = "Checkpoints";
+const LIMITS: &str = "Limits";
+
+/// The conventions every subcommand follows, printed under `strata --help`.
+const CONVENTIONS: &str = "Conventions:
+  Budgets: --time-budget (alias --wall-budget) is wall-clock seconds; compare's --budget (alias
+    --cpu-budget) is CPU seconds of the worker threads. A flag counting seconds says which.
+  Outputs: -o/--out takes a stem (OUT.exr and OUT.png); a given .exr or .png extension is dropped.
+    --json FILE writes the subcommand's JSON (render: statistics; profile: the profile; compare:
+    the rows; rays: --json alone prints it instead of the table, --json=FILE writes it).
+  Spellings: centre and center are both accepted; --nthreads is --threads; --outfile is --out.
+  Numbers: counts are whole numbers (spp >= 1); a negative value is refused with what is allowed.
+  A subcommand refuses the flags it does not use (rays and profile write no image).";
+
 #[derive(Parser)]
-#[command(name = "strata", version, about = "SIMD packet ray tracer on Embree 4 for sampling experiments")]
+#[command(
+    name = "strata",
+    version,
+    about = "SIMD packet ray tracer on Embree 4 for sampling experiments",
+    after_help = CONVENTIONS,
+    allow_negative_numbers = true
+)]
 pub(crate) struct Cli {
     #[command(subcommand)]
     pub(crate) cmd: Cmd,
@@ -17,17 +43,20 @@ pub(crate) struct Cli {
 #[derive(Subcommand)]
 pub(crate) enum Cmd {
     /// Render a CSE168 .test scene (or the built-in Cornell box) to OUT.exr and OUT.png.
-    Render(RenderArgs),
+    #[command(allow_negative_numbers = true)]
+    Render(RenderCmd),
     /// Render a high-spp reference: linear EXR with a per-pixel variance layer (and a PNG), with
-    /// progress and ETA. Same flags as `render`; give --spp and -o. Unbiased by default:
+    /// progress and ETA. Same flags as `render`; --spp is required. Unbiased by default:
     /// --first-sample jittered unless given.
-    Reference(RenderArgs),
+    #[command(allow_negative_numbers = true)]
+    Reference(RenderCmd),
     /// Compare sampling techniques against a reference: K independent runs per variant at equal spp
     /// (--spp-ladder) or equal time (--budget); writes rows.csv/json, runs.csv/json (one row per
     /// run), table.md, error.svg and report.html (flip-book, error maps, plots). The reference must
     /// be of the same scene, size and camera. Variants default to --first-sample jittered.
     /// Seconds are the worker threads' CPU seconds; the sampler's ns/sample and share of the render
     /// come from the phase profiler, which every run has on.
+    #[command(allow_negative_numbers = true)]
     Compare {
         /// Scene file (.test); omitted: the built-in Cornell box.
         scene: Option<PathBuf>,
@@ -49,10 +78,10 @@ pub(crate) enum Cmd {
         #[arg(long, short = 'q')]
         quiet: bool,
         /// Independent runs per variant (seeds differ), at least 2.
-        #[arg(long, default_value_t = 4)]
+        #[arg(long, default_value_t = 4, value_parser = parse_count::<usize>)]
         runs: usize,
         /// Equal time: CPU seconds of the worker threads per run (passes of one sample until spent).
-        #[arg(long, conflicts_with = "spp_ladder")]
+        #[arg(long, visible_alias = "cpu-budget", value_name = "CPU_SECONDS", conflicts_with = "spp_ladder", value_parser = parse_seconds)]
         budget: Option<f64>,
         /// Equal spp: comma-separated spp values, e.g. 1,2,4,8.
         #[arg(long, value_delimiter = ',')]
@@ -61,11 +90,14 @@ pub(crate) enum Cmd {
         #[arg(long, value_parser = parse_size)]
         size: Option<(u32, u32)>,
         /// Worker threads (0 = all cores).
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, visible_alias = "nthreads", default_value_t = 0, value_parser = parse_count::<usize>)]
         threads: usize,
         /// Output folder.
-        #[arg(long, default_value = "compare")]
+        #[arg(long, short = 'o', default_value = "compare")]
         out: PathBuf,
+        /// Also write the rows (as OUT/rows.json) to this file.
+        #[arg(long, value_name = "FILE")]
+        json: Option<PathBuf>,
         /// Write each variant's phase profile over all its runs (the keys of `strata profile
         /// --json`, plus `variant`) as a JSON list to this file.
         #[arg(long, value_name = "FILE")]
@@ -77,6 +109,7 @@ pub(crate) enum Cmd {
     /// Merge the part files of `render --samples A..B` shards (checkpoints) into OUT.exr and
     /// OUT.png, bit-identical to one render of the whole range; refuses parts of another render,
     /// unfinished parts, overlaps and gaps.
+    #[command(allow_negative_numbers = true)]
     Merge {
         /// Part files (.ckpt), any order.
         #[arg(required = true)]
@@ -94,16 +127,18 @@ pub(crate) enum Cmd {
     },
     /// Write a procedural OBJ+MTL mesh (bumpy torus on a floor under an emissive patch) of at least
     /// --triangles triangles, for throughput runs: OUT.obj and OUT.mtl.
+    #[command(allow_negative_numbers = true)]
     GenMesh {
         /// Output OBJ path (the MTL is written beside it).
         out: PathBuf,
         /// Minimum number of triangles of the torus.
-        #[arg(long, default_value_t = 1_000_000)]
+        #[arg(long, default_value_t = 1_000_000, value_parser = parse_count::<usize>)]
         triangles: usize,
     },
     /// Regenerate the seed experiments (direct lighting light samplers; path tracing pixel
     /// stratification, cosine, BRDF sampling) into DIR: results.md/json, report.html (flip-books,
     /// error maps, tables, plots), SVG plots.
+    #[command(allow_negative_numbers = true)]
     Experiments {
         /// Output folder.
         #[arg(long, default_value = "docs/experiments")]
@@ -112,22 +147,22 @@ pub(crate) enum Cmd {
         #[arg(long)]
         corpus: Option<PathBuf>,
         /// Independent runs per variant (K).
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = 16, value_parser = parse_count::<usize>)]
         runs: usize,
         /// Image width (heights keep each scene's aspect).
-        #[arg(long, default_value_t = 160)]
+        #[arg(long, default_value_t = 160, value_parser = parse_positive::<u32>)]
         width: u32,
         /// Light samples of each half of the direct-lighting reference.
-        #[arg(long, default_value_t = 4096)]
+        #[arg(long, default_value_t = 4096, value_parser = parse_positive::<u32>)]
         ref_light_samples: u32,
         /// spp of the path-tracing references.
-        #[arg(long, default_value_t = 1024)]
+        #[arg(long, default_value_t = 1024, value_parser = parse_positive::<u32>)]
         ref_spp: u32,
         /// Worker threads (0 = all cores).
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, visible_alias = "nthreads", default_value_t = 0, value_parser = parse_count::<usize>)]
         threads: usize,
         /// report.html shows the images box-downsampled by this factor (keeps it small).
-        #[arg(long, default_value_t = 2)]
+        #[arg(long, default_value_t = 2, value_parser = parse_positive::<u32>)]
         sheet_factor: u32,
     },
     /// Measure a point set (a file: UTK text, UTK .bin, .npy; or a registry sampler NAME): per set
@@ -170,17 +205,20 @@ pub(crate) enum Cmd {
         options: Vec<String>,
     },
     /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
+    #[command(allow_negative_numbers = true)]
     Rays {
         #[command(flatten)]
         args: RenderArgs,
-        /// Print JSON instead of a table.
-        #[arg(long)]
-        json: bool,
+        /// `--json`: print the rates as JSON instead of a table; `--json=FILE`: write them there
+        /// (and print the table).
+        #[arg(long, value_name = "FILE", num_args = 0..=1, require_equals = true, default_missing_value = "-")]
+        json: Option<PathBuf>,
     },
     /// Break the worker threads' time into phases (sampler by dimension group, emitter sampling,
     /// Embree intersect/occluded, user geometry, hit gather, BSDF sampling and eval, MIS,
     /// accumulation, film, other) with % of render, ns per sample and ns per ray; the overhead is
     /// measured by rendering the same job unprofiled, interleaved.
+    #[command(allow_negative_numbers = true)]
     Profile {
         #[command(flatten)]
         args: RenderArgs,
@@ -191,9 +229,38 @@ pub(crate) enum Cmd {
         #[arg(long = "svg", value_name = "FILE")]
         svg_file: Option<PathBuf>,
         /// Renders per mode (profiling off and on, interleaved); the fastest of each counts.
-        #[arg(long, default_value_t = strata::session::profile::REPEATS)]
+        #[arg(long, default_value_t = strata::session::profile::REPEATS, value_parser = parse_positive::<usize>)]
         repeats: usize,
     },
+    /// Print this command-line reference as Markdown (docs/cli.md is its output; a test fails
+    /// when that file is stale).
+    #[command(hide = true)]
+    HelpMarkdown,
+    /// Check that a command line parses and passes the subcommand's refusals, without running it
+    /// (the README's and docs' commands are tested so). Exit status 0 and `ok`, or the error.
+    #[command(hide = true)]
+    ParseCheck {
+        /// The command line after `strata`.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+}
+
+/// `render` and `reference`: the render flags, and `--json FILE` (the statistics, as `--stats`).
+#[derive(clap::Args)]
+pub(crate) struct RenderCmd {
+    #[command(flatten)]
+    pub(crate) args: RenderArgs,
+    /// Write statistics as JSON to this file (the same as --stats).
+    #[arg(long, value_name = "FILE", help_heading = OUTPUT, conflicts_with = "stats")]
+    pub(crate) json: Option<PathBuf>,
+}
+
+impl RenderCmd {
+    /// The render flags, `--json` folded into `--stats`.
+    pub(crate) fn into_args(self) -> RenderArgs {
+        RenderArgs { stats: self.args.stats.or(self.json), ..self.args }
+    }
 }
 
 #[derive(clap::Args)]
@@ -201,31 +268,45 @@ pub(crate) struct RenderArgs {
     /// Scene file (.test, or .obj for a whole-scene OBJ); omitted: the built-in Cornell box.
     pub(crate) scene: Option<PathBuf>,
     /// Camera "ex ey ez cx cy cz ux uy uz fovy" (the format's camera arguments), replacing the
-    /// scene's (for an .obj, the default one framing its bounds).
-    #[arg(long, value_parser = session::parse_camera, allow_hyphen_values = true)]
+    /// scene's (for an .obj, the automatic one, which is printed as a --camera line to edit).
+    #[arg(long, help_heading = SCENE, value_parser = session::parse_camera, allow_hyphen_values = true)]
     pub(crate) camera: Option<strata::scene::desc::CameraDesc>,
-    /// Samples per pixel (default: the scene's spp).
-    #[arg(long)]
-    pub(crate) spp: Option<u32>,
+    /// Up axis of an OBJ scene's automatic camera: x, y or z (default: guessed from the bounds,
+    /// z when they are flat in z, else y; announced on stderr with the camera).
+    #[arg(long, help_heading = SCENE, value_parser = parse_up)]
+    pub(crate) up: Option<strata::scene::obj::frame::UpAxis>,
     /// Image size WxH, keeping the camera (default: the scene's size).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, help_heading = SCENE, value_parser = parse_size)]
     pub(crate) size: Option<(u32, u32)>,
+    /// Samples per pixel, at least 1 (default: the scene's spp).
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_positive::<u32>)]
+    pub(crate) spp: Option<u32>,
     /// Base seed of every sample stream.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, help_heading = SAMPLING, default_value_t = 0, value_parser = parse_count::<u64>)]
     pub(crate) seed: u64,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
-    pub(crate) threads: usize,
     // Every sampling dimension's layout; the help lists the sampler registry.
-    #[arg(long, value_parser = parse_sampler, help = format!(
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_sampler, help = format!(
         "Sampler of every dimension (pixel, light point and choice, lobe, direction, roulette): {} \
          (default stratified; --pixel-sampler and --light-sampler override their dimensions), or \
          file:PATH[?options] (a point-set file, as --light-sampler)",
         SamplerKind::help_list()
     ))]
     pub(crate) sampler: Option<SamplerKind>,
+    // Pixel sample layout; the help lists the sampler registry.
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_sampler, help = format!(
+        "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
+         puts the sample at the pixel centre), or file:PATH[?options] (a point-set file, as --light-sampler)",
+        SamplerKind::help_list()
+    ))]
+    pub(crate) pixel_sampler: Option<SamplerKind>,
+    /// Pixel sample 0: centre (or center; through the pixel centre like the CSE168 course code;
+    /// default for .test scenes; O(1/spp) bias, see docs/fidelity.md) or jittered (strata's
+    /// unbiased stratified layout; default for .obj scenes). spp 1 with centre is the course's
+    /// deterministic image.
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_first_sample)]
+    pub(crate) first_sample: Option<strata::integrator::FirstSample>,
     // Light sample layout; the help lists the sampler registry.
-    #[arg(long, value_parser = parse_sampler, help = format!(
+    #[arg(long, help_heading = LIGHTS, value_parser = parse_sampler, help = format!(
         "Light sample layout (light point and choice, in direct and the path tracer): {}, or \
          file:PATH[?scramble=shift|owen|xor|none&sets=hash|pixel&pad=NAME] (a point-set file: UTK text, \
          UTK .bin or .npy; see docs/POINTSETS.md)",
@@ -235,104 +316,119 @@ pub(crate) struct RenderArgs {
     /// Where a one-light choice (--light-selection uniform, power, spatial) takes its number from:
     /// reuse (the light point's first coordinate, remapped, as Mitsuba does; default) or dimension
     /// (a sampler dimension of its own).
-    #[arg(long, value_name = "MODE")]
+    #[arg(long, help_heading = LIGHTS, value_name = "MODE")]
     pub(crate) light_choice: Option<strata::integrator::LightChoice>,
-    /// Light samples per light (default: the scene's lightsamples).
-    #[arg(long)]
+    /// Light samples per light, at least 1 (default: the scene's lightsamples).
+    #[arg(long, help_heading = LIGHTS, value_parser = parse_positive::<u32>)]
     pub(crate) light_samples: Option<u32>,
-    // Pixel sample layout; the help lists the sampler registry.
-    #[arg(long, value_parser = parse_sampler, help = format!(
-        "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
-         puts the sample at the pixel centre), or file:PATH[?options] (a point-set file, as --light-sampler)",
-        SamplerKind::help_list()
-    ))]
-    pub(crate) pixel_sampler: Option<SamplerKind>,
+    /// Path tracer NEE light selection: all (every light, `lightsamples` points each; the CSE168
+    /// convention, default for .test scenes), uniform (one light, the historical path-tracer choice;
+    /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
+    #[arg(long, help_heading = LIGHTS, value_name = "NAME")]
+    pub(crate) light_selection: Option<strata::integrator::LightSelection>,
+    /// A constant environment light ("sky") of this radiance, R or R,G,B (path tracer; sampled
+    /// at every vertex besides the area lights, NEE and MIS like any light; escaped camera rays
+    /// see it as the background).
+    #[arg(long, help_heading = LIGHTS, value_name = "RADIANCE", value_parser = parse_sky)]
+    pub(crate) sky: Option<glam::Vec3>,
+    /// Keep an OBJ scene without emitters unlit (by default an area light is added: above and
+    /// behind the camera, or under the ceiling when the camera is inside; announced on stderr).
+    #[arg(long, help_heading = LIGHTS)]
+    pub(crate) no_default_light: bool,
+    /// --resume a checkpoint written by another build of strata (refused by default: samples may
+    /// differ between builds).
+    #[arg(long, help_heading = CHECKPOINTS)]
+    pub(crate) allow_other_build: bool,
     /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
-    #[arg(long, value_parser = parse_integrator)]
+    #[arg(long, help_heading = INTEGRATOR, value_parser = parse_integrator)]
     pub(crate) integrator: Option<IntegratorKind>,
     /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
-    #[arg(long, value_parser = parse_importance_sampling)]
+    #[arg(long, help_heading = INTEGRATOR, value_parser = parse_importance_sampling)]
     pub(crate) importance_sampling: Option<ImportanceSampling>,
     /// Path tracer next event estimation: off, on, mis (default: the scene's nexteventestimation).
-    #[arg(long, value_parser = parse_nee)]
+    #[arg(long, help_heading = INTEGRATOR, value_parser = parse_nee)]
     pub(crate) nee: Option<Nee>,
     /// Path tracer Russian roulette: on, off (default: the scene's russianroulette).
-    #[arg(long, value_parser = parse_on_off)]
+    #[arg(long, help_heading = INTEGRATOR, value_parser = parse_on_off)]
     pub(crate) russian_roulette: Option<bool>,
-    /// Maximum depth, -1 = unbounded (default: the scene's maxdepth).
-    #[arg(long, allow_negative_numbers = true)]
+    /// Maximum depth: -1 (unbounded) or a depth >= 0 (default: the scene's maxdepth).
+    #[arg(long, help_heading = INTEGRATOR, value_parser = parse_max_depth)]
     pub(crate) max_depth: Option<i32>,
-    /// Output stem: writes OUT.exr and OUT.png (default: the scene's output name).
-    #[arg(short = 'o', long = "out")]
+    /// Path tracer only, opt-in and BIASED: scale each pixel sample down so its largest RGB channel is
+    /// at most MAX (trades fireflies for a darker, inconsistent estimate; off by default).
+    #[arg(long, help_heading = INTEGRATOR, value_name = "MAX", value_parser = parse_clamp)]
+    pub(crate) clamp: Option<f32>,
+    /// Shading kernel: `auto` runs the one compiled for the scene's features (see `features` and
+    /// `kernel` in --stats), `general` the one with every feature compiled in. Same image either way.
+    #[arg(long, help_heading = INTEGRATOR, default_value = "auto", value_parser = ["auto", "general"])]
+    pub(crate) kernel: String,
+    /// Output stem: writes OUT.exr and OUT.png; `-o out.exr` means the stem `out` (default: the
+    /// scene's output name).
+    #[arg(short = 'o', long = "out", visible_alias = "outfile", help_heading = OUTPUT)]
     pub(crate) out: Option<PathBuf>,
-    /// Write statistics as JSON to this file.
-    #[arg(long)]
+    /// Write statistics as JSON to this file (render and reference: `--json FILE` is the same).
+    #[arg(long, value_name = "FILE", help_heading = OUTPUT)]
     pub(crate) stats: Option<PathBuf>,
     /// Profile the render's phases (as `strata profile`, without its unprofiled re-render) and write
     /// the profile JSON to this file; the image is bit-identical either way.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", help_heading = OUTPUT)]
     pub(crate) profile: Option<PathBuf>,
+    /// 8-bit PNG values: truncate (the CSE168 course's writer, floor(255 c); default for .test scenes)
+    /// or round (default for .obj scenes). The EXR is linear and not affected.
+    #[arg(long, help_heading = OUTPUT, value_parser = parse_quantize)]
+    pub(crate) quantize: Option<strata::film::Quantize>,
     /// Print nothing on success.
-    #[arg(long, short = 'q')]
+    #[arg(long, short = 'q', help_heading = OUTPUT)]
     pub(crate) quiet: bool,
-    /// Shading kernel: `auto` runs the one compiled for the scene's features (see `features` and
-    /// `kernel` in --stats), `general` the one with every feature compiled in. Same image either way.
-    #[arg(long, default_value = "auto", value_parser = ["auto", "general"])]
-    pub(crate) kernel: String,
-    /// Path tracer only, opt-in and BIASED: scale each pixel sample down so its largest RGB channel is
-    /// at most MAX (trades fireflies for a darker, inconsistent estimate; off by default).
-    #[arg(long, value_name = "MAX", value_parser = parse_clamp)]
-    pub(crate) clamp: Option<f32>,
     /// Write the accumulated state here (atomically) every --checkpoint-every seconds and at the
     /// end; resume it with --resume. Default with --samples or on Ctrl-C: OUT.ckpt.
-    #[arg(long)]
+    #[arg(long, help_heading = CHECKPOINTS)]
     pub(crate) checkpoint: Option<PathBuf>,
-    /// Seconds between checkpoints (0: after every pass).
-    #[arg(long, default_value_t = session::DEFAULT_CHECKPOINT_EVERY)]
-    pub(crate) checkpoint_every: f64,
+    /// Wall-clock seconds between checkpoints (0: after every pass; default 300).
+    #[arg(long, value_name = "SECONDS", help_heading = CHECKPOINTS, value_parser = parse_interval)]
+    pub(crate) checkpoint_every: Option<f64>,
     /// Continue the render held in this checkpoint (refused if the scene or an option differs);
     /// it keeps being checkpointed there unless --checkpoint says otherwise.
-    #[arg(long)]
+    #[arg(long, help_heading = CHECKPOINTS)]
     pub(crate) resume: Option<PathBuf>,
     /// Render only sample indices A..B (0 <= A < B <= spp) of every pixel: a part for `strata merge`.
-    #[arg(long, value_parser = parse_range)]
+    #[arg(long, help_heading = CHECKPOINTS, value_parser = parse_range)]
     pub(crate) samples: Option<(u32, u32)>,
-    /// Render whole passes until this many seconds are spent and record the spp reached
-    /// (progressive samplers continue their sequence across passes; a sampler that needs its
-    /// count in advance is refused; --spp, if given, caps the samples).
-    #[arg(long)]
+    /// Worker threads (0 = all cores).
+    #[arg(long, visible_alias = "nthreads", help_heading = LIMITS, default_value_t = 0, value_parser = parse_count::<usize>)]
+    pub(crate) threads: usize,
+    /// Render whole passes until this many wall-clock seconds are spent and record the spp
+    /// reached (progressive samplers continue their sequence across passes; a sampler that needs
+    /// its count in advance is refused; --spp, if given, caps the samples).
+    #[arg(long, visible_alias = "wall-budget", value_name = "WALL_SECONDS", help_heading = LIMITS, value_parser = parse_seconds)]
     pub(crate) time_budget: Option<f64>,
     /// Raise or lower a resource cap, NAME=VALUE (repeatable): max_pixels, max_side, max_vertices,
     /// max_primitives, max_spp, max_depth, max_light_samples, max_transform_depth, max_threads,
     /// max_memory (bytes the render may use; default 80% of physical memory or the cgroup's limit),
     /// max_file_bytes (size of a scene, OBJ or MTL file).
-    #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_limit)]
+    #[arg(long = "limit", value_name = "NAME=VALUE", help_heading = LIMITS, value_parser = parse_limit)]
     pub(crate) limits: Vec<String>,
-    /// 8-bit PNG values: truncate (the CSE168 course's writer, floor(255 c); default for .test scenes)
-    /// or round (default for .obj scenes). The EXR is linear and not affected.
-    #[arg(long, value_parser = parse_quantize)]
-    pub(crate) quantize: Option<strata::film::Quantize>,
-    /// Pixel sample 0: centre (through the pixel centre like the CSE168 course code; default for .test
-    /// scenes; O(1/spp) bias, see README) or jittered (strata's unbiased stratified layout; default for
-    /// .obj scenes). spp 1 with centre is the course's deterministic image.
-    #[arg(long, value_parser = parse_first_sample)]
-    pub(crate) first_sample: Option<strata::integrator::FirstSample>,
-    /// Path tracer NEE light selection: all (every light, `lightsamples` points each; the CSE168
-    /// convention, default for .test scenes), uniform (one light, the historical path-tracer choice;
-    /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
-    #[arg(long, value_name = "NAME")]
-    pub(crate) light_selection: Option<strata::integrator::LightSelection>,
-    /// Keep an OBJ scene without emitters unlit (by default an area light is added above and
-    /// behind the camera, announced on stderr).
-    #[arg(long)]
-    pub(crate) no_default_light: bool,
-    /// --resume a checkpoint written by another build of strata (refused by default: samples may
-    /// differ between builds).
-    #[arg(long)]
-    pub(crate) allow_other_build: bool,
 }
 
 impl RenderArgs {
+    /// The flags given that write nothing in `rays` and `profile` (which render no image), as
+    /// they are spelled.
+    pub(crate) fn unused_by_measurements(&self) -> Vec<&'static str> {
+        [
+            (self.out.is_some(), "-o/--out"),
+            (self.stats.is_some(), "--stats"),
+            (self.quantize.is_some(), "--quantize"),
+            (self.checkpoint.is_some(), "--checkpoint"),
+            (self.checkpoint_every.is_some(), "--checkpoint-every"),
+            (self.resume.is_some(), "--resume"),
+            (self.samples.is_some(), "--samples"),
+            (self.time_budget.is_some(), "--time-budget"),
+        ]
+        .into_iter()
+        .filter_map(|(given, flag)| given.then_some(flag))
+        .collect()
+    }
+
     pub(crate) fn options(self) -> RenderOptions {
         RenderOptions {
             scene: self.scene,
@@ -354,7 +450,7 @@ impl RenderArgs {
             general_kernel: self.kernel == "general",
             clamp: self.clamp,
             checkpoint: self.checkpoint,
-            checkpoint_every: Some(self.checkpoint_every),
+            checkpoint_every: Some(self.checkpoint_every.unwrap_or(session::DEFAULT_CHECKPOINT_EVERY)),
             resume: self.resume,
             samples: self.samples,
             time_budget: self.time_budget,
@@ -370,6 +466,8 @@ impl RenderArgs {
             light_selection: self.light_selection,
             no_default_light: self.no_default_light,
             allow_other_build: self.allow_other_build,
+            up: self.up,
+            sky: self.sky,
             rendering: None,
         }
     }
@@ -445,4 +543,95 @@ pub(crate) fn parse_on_off(s: &str) -> Result<bool, String> {
 
 pub(crate) fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, String> {
     ImportanceSampling::parse(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+}
+
+pub(crate) fn parse_up(s: &str) -> Result<strata::scene::obj::frame::UpAxis, String> {
+    strata::scene::obj::frame::UpAxis::parse(s).ok_or_else(|| format!("expected x, y or z, got `{s}`"))
+}
+
+/// `R` or `R,G,B` (or `R G B`): finite radiances >= 0.
+pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, String> {
+    let bad = || format!("expected a radiance R or R,G,B of finite numbers >= 0, got `{s}`");
+    let v: Vec<f32> = s
+        .split([',', ' '])
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse::<f32>().map_err(|_| bad()))
+        .collect::<Result<_, _>>()?;
+    let v = match v.as_slice() {
+        [r] => glam::Vec3::splat(*r),
+        [r, g, b] => glam::Vec3::new(*r, *g, *b),
+        _ => return Err(bad()),
+    };
+    if v.is_finite() && v.min_element() >= 0.0 {
+        Ok(v)
+    } else {
+        Err(bad())
+    }
+}
+
+/// A whole number >= 0 (counts, seeds, thread counts: 0 often means "all"), refused with what is
+/// allowed when negative or malformed.
+pub(crate) fn parse_count<T: std::str::FromStr>(s: &str) -> Result<T, String> {
+    s.trim().parse::<T>().map_err(|_| format!("expected a whole number >= 0, got `{s}`"))
+}
+
+/// A whole number >= 1 (spp, light samples, sizes), refused with what is allowed otherwise.
+pub(crate) fn parse_positive<T: std::str::FromStr + PartialOrd + Default>(s: &str) -> Result<T, String> {
+    match s.trim().parse::<T>() {
+        Ok(v) if v > T::default() => Ok(v),
+        _ => Err(format!("expected a whole number >= 1, got `{s}`")),
+    }
+}
+
+/// Seconds of a budget: a positive finite number.
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("expected a positive number of seconds, got `{s}`")),
+    }
+}
+
+/// `--max-depth`: -1 (unbounded) or a depth >= 0 (the upper cap is `--limit max_depth`'s).
+pub(crate) fn parse_max_depth(s: &str) -> Result<i32, String> {
+    match s.trim().parse::<i32>() {
+        Ok(v) if v >= -1 => Ok(v),
+        _ => Err(format!("expected -1 (unbounded) or a depth >= 0, got `{s}`")),
+    }
+}
+
+/// Seconds between checkpoints: a finite number >= 0.
+pub(crate) fn parse_interval(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("expected a number of seconds >= 0, got `{s}`")),
+    }
+}
+
+/// The command-line reference as Markdown: every visible subcommand's `--help`, as clap renders it.
+pub(crate) fn help_markdown() -> String {
+    use clap::CommandFactory;
+    let mut cmd = Cli::command();
+    cmd.build();
+    let mut md = String::from(
+        "# strata command-line reference\n\n\
+         Generated from the command line's own definitions by `strata help-markdown` (hidden); \
+         `tests/docs.rs` fails when this file is stale. Regenerate it with\n\
+         `cargo run --release -- help-markdown > docs/cli.md`.\n\n",
+    );
+    let top = cmd.clone();
+    md.push_str("Subcommands:");
+    let visible = |s: &&clap::Command| !s.is_hide_set() && s.get_name() != "help";
+    for sub in top.get_subcommands().filter(visible) {
+        md.push_str(&format!(" [`{0}`](#strata-{0}),", sub.get_name()));
+    }
+    md.pop();
+    md.push_str(".\n\n## strata\n\n```text\n");
+    md.push_str(&cmd.render_long_help().to_string());
+    md.push_str("```\n");
+    for sub in top.get_subcommands().filter(visible) {
+        let name = sub.get_name().to_string();
+        let mut s = sub.clone().bin_name(format!("strata {name}"));
+        md.push_str(&format!("\n## strata {name}\n\n```text\n{}```\n", s.render_long_help()));
+    }
+    md
 }

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 pub fn render_options(args: &[String]) -> Result<RenderOptions, String> {
     let argv = ["strata", "render"].into_iter().map(String::from).chain(args.iter().cloned());
     match Cli::try_parse_from(argv).map_err(|e| e.to_string())?.cmd {
-        Cmd::Render(a) => Ok(a.options()),
+        Cmd::Render(a) => Ok(a.into_args().options()),
         _ => unreachable!("parsed as render"),
     }
 }
@@ -90,6 +90,7 @@ pub fn compare_args(args: &[String]) -> Result<CompareArgs, String> {
             out,
             profile,
             profile_svg,
+            ..
         } => Ok(CompareArgs {
             scene,
             reference,

@@ -1,6 +1,6 @@
 //! `strata` command line.
 
-use clap::Parser;
+use clap::{CommandFactory, Parser};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -40,8 +40,21 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     let is_reference = matches!(cli.cmd, Cmd::Reference(_));
+    refuse_unused_flags(&cli.cmd);
     let result = match cli.cmd {
-        Cmd::Render(args) | Cmd::Reference(args) => {
+        Cmd::HelpMarkdown => {
+            print!("{}", cli::help_markdown());
+            Ok(())
+        }
+        Cmd::ParseCheck { args } => {
+            let argv = std::iter::once("strata".to_string()).chain(args);
+            let parsed = Cli::try_parse_from(argv).unwrap_or_else(|e| e.exit());
+            refuse_unused_flags(&parsed.cmd);
+            println!("ok");
+            Ok(())
+        }
+        Cmd::Render(cmd) | Cmd::Reference(cmd) => {
+            let args = cmd.into_args();
             let quiet = args.quiet;
             let mut opts = args.options();
             if is_reference {
@@ -100,14 +113,16 @@ fn main() -> ExitCode {
             })
         }
         // The library's copy of this grammar parses the same arguments into `CompareArgs`.
-        Cmd::Compare { .. } => {
-            strata::frontend::compare_args(&std::env::args().skip(2).collect::<Vec<_>>()).and_then(|args| {
-                strata::frontend::run_compare(&args).map(|o| {
+        Cmd::Compare { ref json, .. } => {
+            let json = json.clone();
+            let early = json.as_ref().map_or(Ok(()), |f| session::checks::check_output_file(f));
+            early.map_err(|e| e.to_string()).and_then(|()| strata::frontend::compare_args(&std::env::args().skip(2).collect::<Vec<_>>())).and_then(|args| {
+                strata::frontend::run_compare(&args).and_then(|o| {
                     println!("{}", o.markdown);
                     println!("written to {}/ (report.html, rows.csv, rows.json, runs.csv, runs.json, table.md, error.svg)", args.out.display());
+                    copy_rows_json(&args.out, json.as_deref())
                 })
             })
-        }
         }
         Cmd::GenMesh { out, triangles } => gen_mesh(&out, triangles),
         Cmd::Experiments { out, corpus, runs, width, ref_light_samples, ref_spp, threads, sheet_factor } => {
@@ -132,13 +147,22 @@ fn main() -> ExitCode {
             run_pointset(target, out, export, [sets, points, dim, width, trials], seed, max_freq, &options)
         }
         Cmd::Rays { args, json } => {
-            session::run_rays(&args.options()).map_err(|e| e.to_string()).map(|(rates, name)| {
-                if json {
-                    println!("{}", serde_json::to_string_pretty(&rates).unwrap_or_default());
-                } else {
-                    println!("{}", session::rates_table(&name, &rates));
-                }
-            })
+            let json_file = json.as_ref().filter(|f| f.as_os_str() != "-");
+            let early = json_file.map_or(Ok(()), |f| session::checks::check_output_file(f));
+            early.and_then(|()| session::run_rays(&args.options())).map_err(|e| e.to_string()).and_then(
+                |(rates, name)| {
+                    let text = serde_json::to_string_pretty(&rates).map_err(|e| e.to_string())?;
+                    match (&json, json_file) {
+                        (Some(_), None) => println!("{text}"),
+                        (_, Some(f)) => {
+                            session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
+                            println!("{}", session::rates_table(&name, &rates));
+                        }
+                        (None, None) => println!("{}", session::rates_table(&name, &rates)),
+                    }
+                    Ok(())
+                },
+            )
         }
         Cmd::Profile { args, json_file, svg_file, repeats } => {
             let quiet = args.quiet;
@@ -174,6 +198,45 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Refuses, as a usage error (exit status 2), what the parsed command line asks for but the
+/// subcommand would ignore: `reference` without `--spp`; `rays` and `profile` with flags that only
+/// a render writing an image uses (and `rays` with `--profile`).
+fn refuse_unused_flags(cmd: &Cmd) {
+    let (name, args) = match cmd {
+        Cmd::Reference(cmd) if cmd.args.spp.is_none() => usage_error(
+            "reference",
+            "`strata reference` needs --spp N (a reference is a high-spp render, e.g. --spp 4096)".into(),
+        ),
+        Cmd::Rays { args, .. } => ("rays", args),
+        Cmd::Profile { args, .. } => ("profile", args),
+        _ => return,
+    };
+    let mut unused = args.unused_by_measurements();
+    if name == "rays" && args.profile.is_some() {
+        unused.push("--profile");
+    }
+    if let Some(flag) = unused.first() {
+        usage_error(
+            name,
+            format!("`strata {name}` does not use {flag}: it measures and writes no image or checkpoint; remove it"),
+        );
+    }
+}
+
+/// Prints a clap usage error for subcommand `name` and exits with status 2.
+fn usage_error(name: &str, msg: String) -> ! {
+    let mut cmd = Cli::command();
+    let sub = cmd.find_subcommand_mut(name).map(|s| s.clone()).unwrap_or(cmd);
+    sub.bin_name(format!("strata {name}")).error(clap::error::ErrorKind::ArgumentConflict, msg).exit()
+}
+
+/// `compare --json FILE`: the rows (`OUT/rows.json`) written there too.
+fn copy_rows_json(out: &std::path::Path, json: Option<&std::path::Path>) -> Result<(), String> {
+    let Some(f) = json else { return Ok(()) };
+    let text = std::fs::read_to_string(out.join("rows.json")).map_err(|e| format!("{}: {e}", out.display()))?;
+    session::profile::write_text(f, &text).map_err(|e| e.to_string())
 }
 
 /// A signal before the pass loop starts (scene loading, BVH build, thread start) exits at once

@@ -3,6 +3,7 @@
 mod common;
 
 use common::{strata, tmpdir};
+use std::path::Path;
 
 #[test]
 fn render_default_scene_writes_exr_png_and_stats() {
@@ -148,7 +149,7 @@ fn path_tracer_flags_override_the_scene_and_reject_unknown_names() {
     for (flag, value, msg) in [
         ("--nee", "always", "unknown next event estimation `always`"),
         ("--russian-roulette", "yes", "expected on or off"),
-        ("--max-depth", "-2", "--max-depth -2 is outside"),
+        ("--max-depth", "-2", "expected -1 (unbounded) or a depth >= 0, got `-2`"),
     ] {
         let bad = strata().args(["render", "--size", "8x8", flag, value]).output().unwrap();
         assert!(!bad.status.success(), "{flag} {value}");
@@ -190,4 +191,141 @@ fn profile_prints_phases_and_writes_json() {
     let sum: f64 = phases.iter().map(|p| p["seconds"].as_f64().unwrap()).sum();
     let total = j["total_seconds"].as_f64().unwrap();
     assert!((sum / total - 1.0).abs() < 0.02, "phases {sum} of {total}");
+}
+
+// ---- One command-line grammar: one test per refusal, and the aliases. ----
+
+/// Runs strata with `args`; asserts a usage error (exit status 2) whose stderr contains `msg`.
+fn refused(args: &[&str], msg: &str) {
+    let r = strata().args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(msg), "{args:?}: {err}");
+}
+
+const NO_IMAGE: &str = "measures and writes no image or checkpoint";
+
+#[test]
+fn rays_refuses_an_output_stem() {
+    refused(&["rays", "-o", "x"], &format!("`strata rays` does not use -o/--out: it {NO_IMAGE}"));
+}
+
+#[test]
+fn rays_refuses_a_checkpoint() {
+    refused(&["rays", "--checkpoint", "x.ckpt"], "`strata rays` does not use --checkpoint");
+}
+
+#[test]
+fn rays_refuses_a_time_budget() {
+    refused(&["rays", "--time-budget", "3"], "`strata rays` does not use --time-budget");
+}
+
+#[test]
+fn rays_refuses_a_sample_range() {
+    refused(&["rays", "--samples", "0..4"], "`strata rays` does not use --samples");
+}
+
+#[test]
+fn profile_refuses_an_output_stem() {
+    refused(&["profile", "--out", "x"], &format!("`strata profile` does not use -o/--out: it {NO_IMAGE}"));
+}
+
+#[test]
+fn profile_refuses_a_checkpoint() {
+    refused(&["profile", "--checkpoint", "x.ckpt"], "`strata profile` does not use --checkpoint");
+}
+
+#[test]
+fn profile_refuses_a_time_budget() {
+    refused(&["profile", "--time-budget", "3"], "`strata profile` does not use --time-budget");
+}
+
+#[test]
+fn profile_refuses_a_sample_range() {
+    refused(&["profile", "--samples", "0..4"], "`strata profile` does not use --samples");
+}
+
+#[test]
+fn reference_without_spp_is_an_error() {
+    let d = tmpdir("ref-nospp");
+    let out = d.join("ref");
+    refused(&["reference", "-o", out.to_str().unwrap()], "`strata reference` needs --spp N");
+    assert!(!d.join("ref.exr").exists() && !Path::new("cornell.exr").exists());
+}
+
+#[test]
+fn a_negative_spp_says_what_is_allowed() {
+    refused(&["render", "--spp", "-1"], "invalid value '-1' for '--spp <SPP>': expected a whole number >= 1");
+}
+
+#[test]
+fn a_negative_count_says_what_is_allowed() {
+    refused(&["render", "--threads", "-2"], "expected a whole number >= 0, got `-2`");
+    refused(&["render", "--seed", "-3"], "expected a whole number >= 0, got `-3`");
+    refused(&["render", "--light-samples", "-1"], "expected a whole number >= 1, got `-1`");
+}
+
+#[test]
+fn a_negative_max_depth_says_what_is_allowed() {
+    refused(&["render", "--max-depth", "-5"], "expected -1 (unbounded) or a depth >= 0, got `-5`");
+}
+
+#[test]
+fn a_negative_budget_says_what_is_allowed() {
+    refused(&["render", "--time-budget", "-1"], "expected a positive number of seconds, got `-1`");
+    refused(&["compare", "--reference", "r.exr", "--variant", "a=", "--budget", "-1"], "expected a positive number");
+}
+
+/// Aliases that keep every existing flag: `--nthreads`, `--outfile`, `-o NAME.exr`, `--json` for
+/// `--stats`, `--wall-budget` and `--cpu-budget`, centre/center, `rays --json` as a switch or with
+/// `=FILE`.
+#[test]
+fn aliases_and_spellings_are_accepted() {
+    let d = tmpdir("aliases");
+    let stats = d.join("stats.json");
+    let r = strata()
+        .args(["render", "--nthreads", "2", "--spp", "1", "--size", "8x8", "-q", "--first-sample", "center"])
+        .args(["--pixel-sampler", "grid-centre", "--json"])
+        .arg(&stats)
+        .arg("--outfile")
+        .arg(d.join("img.exr"))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    // `--outfile img.exr` is the stem `img`: img.exr and img.png, no img.exr.exr.
+    assert!(d.join("img.exr").is_file() && d.join("img.png").is_file() && !d.join("img.exr.exr").exists());
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
+    assert_eq!(j["threads"], 2, "{j}");
+    // The budgets say which seconds they count.
+    let help = String::from_utf8_lossy(&strata().args(["render", "--help"]).output().unwrap().stdout).into_owned();
+    assert!(help.contains("--time-budget <WALL_SECONDS>") && help.contains("[alias: --wall-budget]"), "{help}");
+    let help = String::from_utf8_lossy(&strata().args(["compare", "--help"]).output().unwrap().stdout).into_owned();
+    assert!(help.contains("--budget <CPU_SECONDS>") && help.contains("--cpu-budget"), "{help}");
+    // rays: `--json` alone prints JSON (as before), `--json=FILE` writes it and prints the table.
+    let rays_json = d.join("rays.json");
+    let r = strata()
+        .args(["rays", "--size", "16x16", "--spp", "1"])
+        .arg(format!("--json={}", rays_json.display()))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(String::from_utf8_lossy(&r.stdout).contains("renderer / raw"));
+    let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&rays_json).unwrap()).unwrap();
+    assert_eq!(j["camera_rays"], 16 * 16);
+}
+
+/// The render flags are grouped under headings.
+#[test]
+fn render_help_groups_flags_under_headings() {
+    let help = String::from_utf8_lossy(&strata().args(["render", "--help"]).output().unwrap().stdout).into_owned();
+    let mut at = 0;
+    for heading in ["Scene and camera:", "Sampling:", "Lights:", "Integrator:", "Output:", "Checkpoints:", "Limits:"] {
+        let i = help.find(heading).unwrap_or_else(|| panic!("no {heading} in {help}"));
+        assert!(i > at, "{heading} out of order");
+        at = i;
+    }
+    let lights = &help[help.find("Lights:").unwrap()..help.find("Integrator:").unwrap()];
+    for flag in ["--light-sampler", "--light-samples", "--light-selection", "--sky", "--no-default-light"] {
+        assert!(lights.contains(flag), "{flag} not under Lights: {lights}");
+    }
 }

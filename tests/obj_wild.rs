@@ -73,7 +73,12 @@ const TABLE: &[(&str, Expect)] = &[
         RendersWithWarnings(&["CornellBox-Original.obj:12: mtllib 'scenes/CornellBox-Original.mtl' not found"]),
     ),
     ("cornell-original/CornellBox-Original.obj", Renders),
-    ("cornell-tinyobj/cornell_box.obj", Renders),
+    (
+        "cornell-tinyobj/cornell_box.obj",
+        RendersWithWarnings(&[
+            "cornell_box.mtl:22: material 'light': Ka above 1 and no Ke: read as emission Ke 20 20 20",
+        ]),
+    ),
     (
         "cornell-water-lab/CornellBox-Water.obj",
         RendersWithWarnings(&[
@@ -141,6 +146,7 @@ const TABLE: &[(&str, Expect)] = &[
         RendersWithWarnings(&[
             "issue-161-inconsistent-f.obj:13: texture coordinates (vt, 4",
             "issue-161-inconsistent-f.obj:19: usemtl 'cube': no such",
+            "cube.mtl:22: material 'light': Ka above 1 and no Ke",
         ]),
     ),
     ("tinyobj-issues/issue-235-usemtl-then-o.obj", Renders),
@@ -377,4 +383,107 @@ fn cli_renders_representative_files() {
     let err = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(1), "{err}");
     assert!(err.contains("test-nan.obj:12: 'v' argument 1: expected a finite number, got 'nan'"), "{err}");
+}
+
+/// The wild corpus (needs `../shared/corpora/obj-wild`; CI always has it, so a missing corpus
+/// fails here rather than skipping).
+fn corpus_required() -> PathBuf {
+    corpus().expect("the OBJ corpus ../shared/corpora/obj-wild is required")
+}
+
+/// The automatic camera of the scenes the README's gallery shows, asserted from the camera chosen
+/// (not from pixels): the up axis guessed from the bounds, the interiors seen from inside, the
+/// Cornell boxes looked into through their open side and filling the frame, the objects from
+/// outside and not from above.
+#[test]
+fn wild_scenes_get_the_up_axis_and_the_view_they_need() {
+    use strata::scene::obj::frame::{frame_scene, UpAxis, View};
+    let dir = corpus_required();
+    for (rel, up, view) in [
+        ("scan-stanford-bunny/stanford-bunny.obj", UpAxis::Y, View::Exterior),
+        ("sponza-dabrovic-2005/sponza.obj", UpAxis::Y, View::Interior),
+        ("crytek-sponza-truncated/sponza.obj", UpAxis::Y, View::Interior),
+        ("sibenik-blender/sibenik.obj", UpAxis::Y, View::Interior),
+        ("regr01-house/regr01.obj", UpAxis::Z, View::Exterior),
+        ("cornell-original/CornellBox-Original.obj", UpAxis::Y, View::Opening),
+        ("cornell-tinyobj/cornell_box.obj", UpAxis::Y, View::Opening),
+    ] {
+        let (desc, _) = obj::scene_from_obj_with_warnings(&dir.join(rel), &Limits::default()).unwrap();
+        let f = frame_scene(&desc, None, 4.0 / 3.0).unwrap();
+        assert_eq!((f.up, f.up_guessed, f.view), (up, true, view), "{rel}: {f:?}");
+        let c = f.camera;
+        assert_eq!(c.up, up.vec(), "{rel}");
+        let tris = desc.triangles.iter().map(|t| t.v).chain(desc.emissive_triangles.iter().map(|t| t.v));
+        let (lo, hi) = obj::bounds(tris.flatten()).unwrap();
+        let inside = c.eye.cmpge(lo).all() && c.eye.cmple(hi).all();
+        let dir_ = (c.center - c.eye).normalize();
+        let elevation = dir_.dot(-up.vec()).asin().to_degrees();
+        match view {
+            View::Interior => {
+                assert!(inside, "{rel}: eye {} outside {lo}..{hi}", c.eye);
+                assert!(elevation.abs() < 1.0, "{rel}: looks level, not {elevation} degrees down");
+                assert!(f.interior_light.is_some(), "{rel}");
+            }
+            View::Exterior => {
+                assert!(!inside, "{rel}");
+                // Seen from the front, slightly above (the z-up house was seen from straight above).
+                assert!((10.0..30.0).contains(&elevation), "{rel}: {elevation} degrees down");
+            }
+            View::Opening => {
+                assert!(!inside && elevation.abs() < 1.0, "{rel}");
+                // Fills the frame: the open side's rectangle spans the full height of the image
+                // (its top and bottom edges at the edges of the 45-degree field).
+                let u = up.index();
+                let d = (c.eye - 0.5 * (lo + hi)).abs();
+                let k = if d.x > d.z { 0 } else { 2 };
+                let near = if c.eye[k] > hi[k] { hi[k] } else { lo[k] };
+                let half = 0.5 * (hi[u] - lo[u]);
+                let tan = half / (c.eye[k] - near).abs();
+                assert!((tan - 22.5f32.to_radians().tan()).abs() < 0.01, "{rel}: tan {tan}");
+            }
+        }
+    }
+    // The tinyobj box is open at -z (its classic camera stands at z = -800).
+    let (desc, _) =
+        obj::scene_from_obj_with_warnings(&dir.join("cornell-tinyobj/cornell_box.obj"), &Limits::default()).unwrap();
+    assert!(desc.camera.unwrap().eye.z < 0.0);
+    // And it is lit: its 'light' (Ka 20 20 20, no Ke) is an emitter.
+    assert_eq!(desc.emissive_triangles.len(), 2);
+}
+
+/// The CLI announces the up axis and prints the automatic camera as a `--camera` line: pasting
+/// it renders the same image; `--up` is obeyed and said to be.
+#[test]
+fn the_printed_camera_renders_the_same_image() {
+    let dir = corpus_required();
+    let out = tmpdir("objwild-camera");
+    let scene = dir.join("cornell-original/CornellBox-Original.obj");
+    let run = |extra: &[&str], stem: &str| {
+        let r = strata()
+            .arg("render")
+            .arg(&scene)
+            .args(["--spp", "2", "--size", "32x24", "--threads", "2", "-o"])
+            .arg(out.join(stem))
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        String::from_utf8_lossy(&r.stderr).into_owned()
+    };
+    let err = run(&[], "auto");
+    assert!(
+        err.contains("up axis y (guessed from its bounds; set it with --up x|y|z); looking in through the open side"),
+        "{err}"
+    );
+    let line = err.lines().find_map(|l| l.split_once("automatic camera, to edit: --camera \"")).expect(&err).1;
+    let cam = line.trim_end_matches('"');
+    run(&["--camera", cam], "pasted");
+    assert_eq!(std::fs::read(out.join("auto.png")).unwrap(), std::fs::read(out.join("pasted.png")).unwrap());
+    let pixels = |stem: &str| strata::film::read_exr(&out.join(format!("{stem}.exr"))).unwrap().rgb;
+    assert!(pixels("auto") == pixels("pasted"), "the pasted camera renders the same EXR pixels");
+    let err = run(&["--up", "z"], "zup");
+    assert!(err.contains("up axis z (from --up)"), "{err}");
+    let r = strata().arg("render").arg(&scene).args(["--up", "w"]).output().unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("expected x, y or z, got `w`"));
 }

@@ -1,5 +1,6 @@
 //! Lights: every area light (quad lights and emissive triangles) with light selection and point
-//! sampling, and exact polygonal irradiance.
+//! sampling, exact polygonal irradiance, and the constant environment light ([`sky`]).
 pub mod emitters;
 pub mod polygonal;
 pub mod select;
+pub mod sky;

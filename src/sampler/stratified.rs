@@ -32,7 +32,7 @@ pub(super) const JITTERED: super::SamplerInfo = super::SamplerInfo::new(
 
 /// Its registry entry as strata cell centres (see [`super::SAMPLERS`]).
 pub(super) const CENTRES: super::SamplerInfo =
-    super::SamplerInfo::new("grid-center", &["grid", "center"], "strata cell centres", &Stratified { jitter: false })
+    super::SamplerInfo::new("grid-center", &["grid", "center", "grid-centre", "centre"], "strata cell centres", &Stratified { jitter: false })
         .biased()
         .needs_count();
 

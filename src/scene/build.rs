@@ -88,6 +88,8 @@ pub struct Scene {
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
+    /// the constant environment light (`--sky`), if any
+    pub sky: Option<crate::light::sky::Sky>,
     /// materials (desc materials, then one black material per light)
     pub materials: Vec<Material>,
     /// per triangle: material index
@@ -297,11 +299,13 @@ impl Scene {
             bvh: if high { "high" } else { "medium" },
             spheres: if embree_spheres { "embree" } else { "strata" },
         };
+        let sky = desc.sky.map(crate::light::sky::Sky::new);
         Ok(Self {
             desc,
             camera,
             lights,
             emitters,
+            sky,
             materials,
             tri_material,
             tri_normal,

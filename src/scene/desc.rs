@@ -196,6 +196,8 @@ pub struct SceneDesc {
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
     pub directional_lights: Vec<DirectionalLightDesc>,
+    /// constant environment light's radiance (`--sky`; path tracer only), None: black background
+    pub sky: Option<Vec3>,
 }
 
 impl SceneDesc {
@@ -249,6 +251,11 @@ impl SceneDesc {
             t.v.iter().for_each(|&v| h.vec3(v));
             h.vec3(t.radiance);
         }
+        // Only when present, so that the hash of a scene without a sky is unchanged.
+        if let Some(sky) = self.sky {
+            h.word(0x736b_7900);
+            h.vec3(sky);
+        }
         // Only when present, so that the hash of a scene without normals is unchanged.
         if !self.triangle_normals.is_empty() {
             h.word(self.triangle_normals.len() as u32);
@@ -284,6 +291,7 @@ impl Default for SceneDesc {
             triangle_normals: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
+            sky: None,
         }
     }
 }

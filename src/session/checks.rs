@@ -170,12 +170,17 @@ pub fn has_emitter(desc: &SceneDesc) -> bool {
         || desc.materials.iter().any(|m| m.emission.max_element() > 0.0)
 }
 
-/// Adds the default light of an unlit OBJ scene: a square area light of twice the model's
+/// Adds the default light of an unlit OBJ scene: `interior_light` if given (a closed interior's,
+/// from [`crate::scene::obj::frame::Framing`]), else a square area light of twice the model's
 /// bounding radius per side, above and behind the camera, facing the model's centre, with a
 /// radiance giving an irradiance of about pi (a white diffuse surface facing it looks white).
-/// Returns false (and adds nothing) if the scene has no camera or no geometry.
-pub fn add_default_light(desc: &mut SceneDesc) -> bool {
-    let (Some(cam), Some((lo, hi))) = (desc.camera, scene_bounds(desc)) else { return false };
+/// Returns what it added, None (and adds nothing) if the scene has no camera or no geometry.
+pub fn add_default_light(desc: &mut SceneDesc, interior_light: Option<QuadLightDesc>) -> Option<&'static str> {
+    if let Some(light) = interior_light {
+        desc.quad_lights.push(light);
+        return Some("a default area light under the ceiling (the camera is inside)");
+    }
+    let (Some(cam), Some((lo, hi))) = (desc.camera, scene_bounds(desc)) else { return None };
     let center = 0.5 * (lo + hi);
     let r = (0.5 * (hi - lo).length()).max(1e-3);
     let back = (cam.eye - cam.center).normalize_or(Vec3::Z);
@@ -194,7 +199,7 @@ pub fn add_default_light(desc: &mut SceneDesc) -> bool {
     let d2 = (center - pos).length_squared();
     let radiance = Vec3::splat(std::f32::consts::PI * d2 / (side * side));
     desc.quad_lights.push(QuadLightDesc { a, ab, ac, radiance });
-    true
+    Some("a default area light")
 }
 
 /// Bounds of the triangles and sphere centres of `desc`.

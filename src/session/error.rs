@@ -53,6 +53,12 @@ pub enum SessionError {
         hint: String,
     },
     /// `--max-depth` outside its range.
+    #[error("--sky needs the path tracer (the scene's integrator is {integrator}); add --integrator pathtracer")]
+    /// A sky with an integrator that does not trace paths.
+    SkyNeedsPathTracer {
+        /// the integrator's name
+        integrator: &'static str,
+    },
     #[error("--max-depth {depth} is outside -1..={max} ({hint})")]
     MaxDepth {
         /// depth asked

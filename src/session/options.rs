@@ -90,6 +90,10 @@ pub struct RenderOptions {
     pub no_default_light: bool,
     /// `--allow-other-build`: resume a checkpoint written by another build of strata
     pub allow_other_build: bool,
+    /// `--up x|y|z`: the up axis of an OBJ scene's automatic camera (default: guessed from its bounds)
+    pub up: Option<crate::scene::obj::frame::UpAxis>,
+    /// `--sky R[,G,B]`: a constant environment light of this radiance (path tracer)
+    pub sky: Option<glam::Vec3>,
     /// set while the pass loop runs (a signal then stops after the pass and checkpoints; outside
     /// it the binary exits at once with code 130)
     pub rendering: Option<Arc<AtomicBool>>,

@@ -1,6 +1,7 @@
 //! Progress of a render session on stderr: on a terminal an `indicatif` bar updated as tiles
-//! finish (spp done, Mrays/s, ETA; or the time budget left), otherwise a plain line every few
-//! seconds and at the end; nothing when disabled.
+//! finish (spp done, elapsed wall time, Mrays/s once the first pass has measured it, ETA; or the
+//! time budget left), otherwise a plain line every few seconds and at the end; nothing when
+//! disabled.
 
 use crate::render::RenderStats;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -62,15 +63,22 @@ impl Progress {
         (self.session > 0).then(|| self.seconds / self.session as f64)
     }
 
-    fn mrays(&self) -> f64 {
-        self.rays as f64 / self.seconds.max(1e-12) / 1e6
+    /// The rate, once a pass has measured it.
+    fn mrays(&self) -> Option<f64> {
+        (self.session > 0 && self.seconds > 0.0).then(|| self.rays as f64 / self.seconds / 1e6)
     }
 
+    /// `done` spp of the target, elapsed wall seconds, the rate once measured (said to come before
+    /// the first pass ends), and the budget left.
     fn message(&self, done: u64, elapsed: f64) -> String {
-        let mrays = self.mrays();
+        let rate = self.mrays().map_or("rate after the first pass".to_string(), |m| format!("{m:.2} Mrays/s"));
         match self.budget {
-            Some(b) => format!("{done} spp, {mrays:.2} Mrays/s, {:.1} s of {b} s budget left", (b - elapsed).max(0.0)),
-            None => format!("{done}/{} spp, {mrays:.2} Mrays/s", self.total),
+            Some(b) => format!(
+                "{done} spp, {} elapsed, {rate}, {:.1} s of {b} s budget left",
+                clock(elapsed),
+                (b - elapsed).max(0.0)
+            ),
+            None => format!("{done}/{} spp, {} elapsed, {rate}", self.total, clock(elapsed)),
         }
     }
 
@@ -144,5 +152,36 @@ impl Progress {
         if let Some(bar) = &self.bar {
             bar.finish();
         }
+    }
+}
+
+/// Wall time as `12.3 s`, `4 min 05 s` or `2 h 03 min`.
+fn clock(seconds: f64) -> String {
+    let s = seconds.max(0.0);
+    if s < 60.0 {
+        format!("{s:.1} s")
+    } else if s < 3600.0 {
+        format!("{} min {:02} s", (s / 60.0) as u64, (s % 60.0) as u64)
+    } else {
+        format!("{} h {:02} min", (s / 3600.0) as u64, ((s % 3600.0) / 60.0) as u64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rate_shows_only_once_measured_and_elapsed_time_always() {
+        let mut p = Progress::new(true, &(0..16), 0, None, 4);
+        let first = p.message(0, 0.4);
+        assert!(first.contains("0.4 s elapsed") && !first.contains("Mrays/s"), "{first}");
+        let mut st = RenderStats { seconds: 2.0, ..Default::default() };
+        st.counters.camera = 4_000_000;
+        p.pass(1, &st, 2.5);
+        let later = p.message(1, 2.5);
+        assert!(later.contains("2.5 s elapsed") && later.contains("2.00 Mrays/s"), "{later}");
+        assert_eq!(clock(125.0), "2 min 05 s");
+        assert_eq!(clock(7380.0), "2 h 03 min");
     }
 }

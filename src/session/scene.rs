@@ -68,15 +68,36 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
         }
         desc.max_depth = d;
     }
-    if matches!(&opts.scene, Some(p) if is_obj(p)) && !opts.no_default_light && !super::checks::has_emitter(&desc) {
-        let name = opts.scene.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
-        if super::checks::add_default_light(&mut desc) {
-            eprintln!(
-                "strata: note: {name} has no light; added a default area light (disable with --no-default-light)"
-            );
+    let obj = matches!(&opts.scene, Some(p) if is_obj(p));
+    let name = opts.scene.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
+    let interior_light = if obj && opts.camera.is_none() { frame_obj(&mut desc, opts, &name) } else { None };
+    if let Some(sky) = opts.sky {
+        desc.sky = Some(sky);
+    }
+    if obj && !opts.no_default_light && !super::checks::has_emitter(&desc) && desc.sky.is_none() {
+        if let Some(what) = super::checks::add_default_light(&mut desc, interior_light) {
+            eprintln!("strata: note: {name} has no light; added {what} (disable with --no-default-light)");
         }
     }
+    if desc.sky.is_some() && desc.integrator != crate::scene::desc::IntegratorKind::PathTracer {
+        return Err(SessionError::SkyNeedsPathTracer { integrator: desc.integrator.name() });
+    }
     Ok(desc)
+}
+
+/// Puts the automatic camera of a whole-scene OBJ ([`crate::scene::obj::frame`]) in `desc`, for
+/// its image size and `--up`, and announces the up axis and the camera on stderr (with progress).
+/// Returns the light to add to a closed interior if it has none.
+fn frame_obj(desc: &mut SceneDesc, opts: &RenderOptions, name: &str) -> Option<crate::scene::desc::QuadLightDesc> {
+    let aspect = desc.width as f32 / desc.height as f32;
+    let f = crate::scene::obj::frame::frame_scene(desc, opts.up, aspect)?;
+    desc.camera = Some(f.camera);
+    if opts.progress {
+        let how = if f.up_guessed { "guessed from its bounds; set it with --up x|y|z" } else { "from --up" };
+        eprintln!("strata: note: {name}: up axis {} ({how}); {}", f.up.name(), f.view.name());
+        eprintln!("strata: note: automatic camera, to edit: {}", f.camera_arg());
+    }
+    f.interior_light
 }
 
 /// A scene path naming a Wavefront OBJ (extension `.obj`, any case) rather than a `.test` file.

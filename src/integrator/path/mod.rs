@@ -34,7 +34,10 @@ use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 use wave::{add_lanes, bits, Columns, Pack};
 
+mod sky;
 mod wave;
+
+pub use sky::DIM_SKY_BASE;
 
 /// First sampler dimension of the path tracer's vertices.
 pub const DIM_PATH_BASE: u32 = 64;
@@ -181,13 +184,19 @@ impl Integrator {
                 let table = if j < 2 { &self.light_table } else { &self.path_set };
                 table.path_dim(self.spp, dims + j as u32, self.seed)
             });
-            let mut b = Bounce { it: self, scene, v, max_v, dk: &dk, keep_prev, next, next_prev, shadow };
+            let dsky = sky::sky_dim(self, scene.sky.as_ref(), v);
+            let mut b = Bounce { it: self, scene, v, max_v, dk: &dk, dsky, keep_prev, next, next_prev, shadow };
             for (ci, (r, traced)) in rh.iter().enumerate() {
                 // A packet without a traced lane hits nothing: no emission, no continuation.
                 if traced.none() {
                     continue;
                 }
                 scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
+                let missed = *traced & !sh.valid;
+                if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
+                    let le = sky::escaped(self, sky, v, paths.get(PDF, ci), missed);
+                    add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
+                }
                 if sh.valid.none() {
                     continue;
                 }
@@ -254,6 +263,8 @@ struct Bounce<'a> {
     v: u32,
     max_v: u32,
     dk: &'a [PathDim; 4],
+    /// the sky's dimension of this vertex (with a sky)
+    dsky: Option<PathDim>,
     keep_prev: bool,
     next: &'a mut Columns<PATH_COLS>,
     next_prev: &'a mut Columns<6>,
@@ -307,7 +318,7 @@ impl Bounce<'_> {
         let is_light = F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
         // Shading frame: the normal faces wo, so wo.z > 0 in local coordinates.
         let shade = sh.valid & !is_light;
-        let nee_here = nee != Nee::Off && n_lights > 0 && v < max_v;
+        let nee_here = nee != Nee::Off && (n_lights > 0 || scene.sky.is_some()) && v < max_v;
         let bounce_here = match nee {
             Nee::On => v + 1 < max_v,
             _ => v < max_v,
@@ -330,6 +341,9 @@ impl Bounce<'_> {
         let own_choice = picks && it.light_choice == LightChoice::Dimension;
 
         if nee_here {
+            self.sky_next_event::<L>(vx, &frame, wo, &mat, o, shade, leaves);
+        }
+        if nee_here && n_lights > 0 {
             let u_choice = if own_choice { it.path_point(&self.dk[1], true, pixel, s).0 } else { F8::ZERO };
             let (u, w) = it.path_point(&self.dk[0], true, pixel, s);
             let shadow = &mut *self.shadow;

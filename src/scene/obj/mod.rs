@@ -43,6 +43,7 @@
 //! Nothing here panics on bad input (a panic inside `tobj` would be caught and reported).
 
 mod faces;
+pub mod frame;
 mod mtl;
 mod place;
 mod procedural;

@@ -22,14 +22,39 @@ pub(super) fn load_mtl(path: &Path, max: u64, warnings: &mut Vec<ObjWarning>) ->
     let (materials, _) = loaded.map_err(|e| err(path, 0, format!("malformed material library ({e})")))?;
     Ok(materials
         .into_iter()
-        .map(|m| MtlMaterial {
-            name: if m.name == UNNAMED { String::new() } else { m.name },
-            kd: m.diffuse.map(Vec3::from_array),
-            ks: m.specular.map(Vec3::from_array),
-            ns: m.shininess,
-            ke: m.emissive.map(Vec3::from_array),
+        .map(|m| {
+            let ke = m.emissive.map(Vec3::from_array).or_else(|| {
+                let ka = m.ambient.map(Vec3::from_array).filter(|ka| ka.max_element() > 1.0)?;
+                let line = ka_line(&text, &m.name);
+                warnings.push(warn(
+                    path,
+                    line,
+                    format!("material '{}': Ka above 1 and no Ke: read as emission Ke {} {} {} (the pre-Ke convention of Embree's Cornell box)", short(&m.name), ka.x, ka.y, ka.z),
+                ));
+                Some(ka)
+            });
+            MtlMaterial {
+                name: if m.name == UNNAMED { String::new() } else { m.name },
+                kd: m.diffuse.map(Vec3::from_array),
+                ks: m.specular.map(Vec3::from_array),
+                ns: m.shininess,
+                ke,
+            }
         })
         .collect())
+}
+
+/// Line of the `Ka` of material `name` in MTL text (0 if not found).
+fn ka_line(text: &str, name: &str) -> usize {
+    let mut current = false;
+    for (line, cmd, args) in commands(text) {
+        match cmd {
+            "newmtl" => current = args.join(" ") == name,
+            "Ka" if current => return line,
+            _ => {}
+        }
+    }
+    0
 }
 
 /// Stands for an empty `newmtl` name while `tobj` reads the MTL (it refuses empty names).

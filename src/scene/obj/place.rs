@@ -26,8 +26,8 @@ pub fn frame_camera(lo: Vec3, hi: Vec3, fovy_deg: f32) -> CameraDesc {
 }
 
 /// A whole scene from one OBJ: its triangles (materials as in the module docs, current material
-/// [`whole_scene_material`]), a camera from [`frame_camera`] at 45 degrees (replace it with
-/// `--camera`), 640x480, 16 spp, gamma 2.2, `pathtracer` with `nexteventestimation mis`,
+/// [`whole_scene_material`]), the automatic camera of [`super::frame::frame_scene`] for 640x480 and
+/// the guessed up axis (replace it with `--camera`), 640x480, 16 spp, gamma 2.2, `pathtracer` with `nexteventestimation mis`,
 /// `importancesampling brdf`, `maxdepth 5`, output named after the file.
 /// Prints the warnings to stderr (see [`scene_from_obj_with_warnings`]).
 pub fn scene_from_obj(path: &Path, limits: &Limits) -> Result<SceneDesc, SceneError> {
@@ -50,8 +50,6 @@ pub fn scene_from_obj_with_warnings(path: &Path, limits: &Limits) -> Result<(Sce
         output: path.file_stem().map(|s| format!("{}.png", s.to_string_lossy())),
         ..SceneDesc::default()
     };
-    let (lo, hi) = mesh.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
-    desc.camera = Some(frame_camera(lo, hi, 45.0));
     if mesh.faces.len() > limits.max_primitives {
         return Err(err(path, 0, format!("more than {} triangles (--max-primitives)", limits.max_primitives)));
     }
@@ -70,6 +68,8 @@ pub fn scene_from_obj_with_warnings(path: &Path, limits: &Limits) -> Result<(Sce
         }))
     })
     .map_err(|m| m.at(path, 0))?;
+    let aspect = desc.width as f32 / desc.height as f32;
+    desc.camera = super::frame::frame_scene(&desc, None, aspect).map(|f| f.camera);
     Ok((desc, warnings))
 }
 
