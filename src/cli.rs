@@ -335,10 +335,6 @@ pub(crate) struct RenderArgs {
     /// behind the camera, or under the ceiling when the camera is inside; announced on stderr).
     #[arg(long, help_heading = LIGHTS)]
     pub(crate) no_default_light: bool,
-    /// --resume a checkpoint written by another build of strata (refused by default: samples may
-    /// differ between builds).
-    #[arg(long, help_heading = CHECKPOINTS)]
-    pub(crate) allow_other_build: bool,
     /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
     #[arg(long, help_heading = INTEGRATOR, value_parser = parse_integrator)]
     pub(crate) integrator: Option<IntegratorKind>,
@@ -394,6 +390,10 @@ pub(crate) struct RenderArgs {
     /// Render only sample indices A..B (0 <= A < B <= spp) of every pixel: a part for `strata merge`.
     #[arg(long, help_heading = CHECKPOINTS, value_parser = parse_range)]
     pub(crate) samples: Option<(u32, u32)>,
+    /// --resume a checkpoint written by another build of strata (refused by default: samples may
+    /// differ between builds).
+    #[arg(long, help_heading = CHECKPOINTS)]
+    pub(crate) allow_other_build: bool,
     /// Worker threads (0 = all cores).
     #[arg(long, visible_alias = "nthreads", help_heading = LIMITS, default_value_t = 0, value_parser = parse_count::<usize>)]
     pub(crate) threads: usize,

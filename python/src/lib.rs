@@ -147,6 +147,26 @@ fn relmse(a: &Bound<'_, PyBytes>, b: &Bound<'_, PyBytes>) -> PyResult<f64> {
     strata::report::rel_mse(&rgb(a.as_bytes()), &rgb(b.as_bytes())).map_err(err)
 }
 
+/// Mean FLIP (LDR, as `strata compare`'s FLIP column) of a linear RGB f32 image against a linear
+/// reference (bytes of `width` x `height` pixels), and the per-pixel FLIP map as f32 bytes.
+#[pyfunction]
+fn flip(
+    py: Python<'_>,
+    a: &Bound<'_, PyBytes>,
+    b: &Bound<'_, PyBytes>,
+    width: u32,
+    height: u32,
+) -> PyResult<(f64, Py<PyBytes>)> {
+    let (img, reference) = (rgb(a.as_bytes()), rgb(b.as_bytes()));
+    let n = width as usize * height as usize;
+    if img.len() != n || reference.len() != n {
+        return Err(err(format!("flip: expected {width} x {height} pixels in both images")));
+    }
+    let map = strata::report::flip::flip_map(&reference, &img, width, height);
+    let bytes: Vec<u8> = map.iter().flat_map(|v| v.to_le_bytes()).collect();
+    Ok((strata::report::flip::mean(&map), PyBytes::new(py, &bytes).unbind()))
+}
+
 /// Reads an EXR as `strata render`/`reference` write it: (RGB f32 bytes, variance f32 bytes or
 /// None, width, height, metadata as (key, value) pairs).
 #[pyfunction]
@@ -177,6 +197,7 @@ fn _strata(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check_points, m)?)?;
     m.add_function(wrap_pyfunction!(mse, m)?)?;
     m.add_function(wrap_pyfunction!(relmse, m)?)?;
+    m.add_function(wrap_pyfunction!(flip, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())

@@ -27,3 +27,14 @@ def rmse(img, ref):
 def relmse(img, ref):
     """Relative MSE in pbrt's form, mean of (img - ref)^2 / (ref + 0.01)^2, as ``strata compare``."""
     return _strata.relmse(*_pair(img, ref))
+
+
+def flip(img, ref, return_map=False):
+    """Mean FLIP (Andersson et al. 2020, LDR: both linear images go to 8-bit sRGB first), as the
+    FLIP column of ``strata compare``; with ``return_map=True`` also the H x W per-pixel map."""
+    a, b = _pair(img, ref)
+    h, w = np.shape(img)[:2]
+    mean, m = _strata.flip(a, b, w, h)
+    if return_map:
+        return mean, np.frombuffer(m, dtype="<f4").reshape(h, w)
+    return mean

@@ -151,6 +151,12 @@ def test_compare_accepts_point_arrays_and_metrics_match_compare(tmp_path):
     assert strata.metrics.mse(refimg, refimg) == 0.0
     with pytest.raises(ValueError):
         strata.metrics.rmse(img, refimg[:8])
+    # FLIP: the same code as compare's FLIP column; zero for identical images, a per-pixel map whose
+    # mean is the number returned.
+    assert strata.metrics.flip(refimg, refimg) == 0.0
+    mean, fmap = strata.metrics.flip(img, refimg, return_map=True)
+    assert fmap.shape == (16, 16) and 0.0 < mean < 1.0
+    assert mean == pytest.approx(float(np.mean(fmap.astype(np.float64))), rel=1e-9)
 
 
 def test_example_runs_at_a_small_size(tmp_path):
