@@ -96,7 +96,7 @@ fn non_finite_samples_warn_and_negative_radiance_is_refused() {
     fs::remove_dir_all(&dir).ok();
 }
 
-/// `--spp 0` and `--light-samples 0` are errors, as in scene files (before: silently 1); a render
+/// `--spp 0` and `--light-samples 0` are usage errors, as in scene files (before: silently 1); a render
 /// whose time budget ends before the first sample is an error and keeps the old outputs (before:
 /// a black 0-spp image, exit 0).
 #[test]
@@ -108,7 +108,9 @@ fn zero_samples_are_errors_that_keep_old_outputs() {
     let before = (fs::read(dir.join("z.png")).unwrap(), fs::read(dir.join("z.exr")).unwrap());
     for (flag, v) in [("--spp", "0"), ("--light-samples", "0")] {
         let r = strata(&dir, &base.iter().copied().chain([flag, v]).collect::<Vec<_>>(), 30);
-        assert!(r.code == Some(1) && r.err.contains(&format!("{flag} 0: expected at least 1")), "{}", r.err);
+        // A usage error (clap's exit status 2) that names the flag, the value and what is allowed.
+        let named = r.err.contains(&format!("'0' for '{flag}")) && r.err.contains("whole number >= 1");
+        assert!(r.code == Some(2) && named, "{}", r.err);
     }
     let r = strata(&dir, &base.iter().copied().chain(["--time-budget", "1e-9"]).collect::<Vec<_>>(), 30);
     assert_eq!(r.code, Some(1), "{}", r.err);
