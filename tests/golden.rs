@@ -16,8 +16,14 @@
 //! without BRDF lobes (cornellSimple, cornellNEE, cornellRR, cornellMIS with cosine) and the other
 //! integrators kept their bits. Pinning Embree to AVX2 (issue 25: the same pixels on every
 //! x86-64-v3 node; before, an AVX-512 node ran Embree's AVX-512 kernels) then moved 20 of 21 cases;
-//! with `STRATA_EMBREE_CONFIG=isa=avx512` the previous table passed unchanged. History: `git log -p tests/golden.rs`. Print the current table with
-//! `STRATA_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture`.
+//! with `STRATA_EMBREE_CONFIG=isa=avx512` the previous table passed unchanged. On a second
+//! AVX-512 machine (an AMD EPYC) the AVX2 renders moved again (20 of 21) while `isa=avx512`
+//! reproduced the first machine's AVX-512 table exactly: Embree's AVX2 kernels start from
+//! `vrcpps`/`vrsqrtps`, whose bits are implementation-specific, its AVX-512 kernels from the
+//! exactly specified `vrcp14ps`/`vrsqrt14ps`. So the table has one AVX2 column per kind of CPU
+//! (told apart by `strata::accel::approx_id`, which is part of a render's identity) and one
+//! AVX-512 column checked on every AVX-512 CPU. History: `git log -p tests/golden.rs`. Print
+//! the current table with `STRATA_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture`.
 
 mod common;
 
@@ -42,66 +48,146 @@ fn pixel_hash(path: &std::path::Path) -> u64 {
     h
 }
 
-/// (name, scene relative to the corpus or "scenes/...", extra flags, expected hash).
-const CASES: &[(&str, &str, &str, u64)] = &[
-    ("builtin-direct-halton", "", "--light-sampler halton", 0xdb5645b074ca302d),
-    ("hw1-scene5-whitted", "hw1/scene5.test", "", 0x5dd4d79b0b0f9afb),
-    ("hw1-scene7-whitted", "hw1/scene7.test", "--spp 2", 0xa6f4baf4d8806240),
-    ("hw2-analytic", "hw2/analytic.test", "", 0xe89ec812899be839),
-    ("hw2-direct9-stratified", "hw2/direct9.test", "--light-sampler stratified", 0x8781bdf881f51540),
+/// The kinds of CPU the AVX2 column of [`CASES`] was recorded on, by their `embree_approx` id
+/// (`strata::accel::approx_id("avx2")`: a fingerprint of the CPU's `vrcpps`/`vrsqrtps`, which
+/// Embree's AVX2 kernels use and whose bits are implementation-specific). The first machine's id
+/// was not recorded; its table is what CI reproduced on 2026-12-03.
+const AVX2_KINDS: [&str; 2] = ["(first recording machine, id not recorded)", THIS_KIND];
+/// The id of the AMD EPYC (AVX-512) machine that recorded the second AVX2 column.
+const THIS_KIND: &str = "rcpps-80b65207868234cd";
+
+/// (name, scene relative to the corpus or "scenes/...", extra flags, hash under the default
+/// `isa=avx2` per kind of CPU in [`AVX2_KINDS`], hash under `isa=avx512`). The AVX-512 column is
+/// the same on every AVX-512 CPU (`vrcp14ps`/`vrsqrt14ps` are exactly specified): recorded on
+/// the first machine before the AVX2 pin and reproduced on the second.
+#[allow(clippy::type_complexity)]
+const CASES: &[(&str, &str, &str, [u64; 2], u64)] = &[
+    (
+        "builtin-direct-halton",
+        "",
+        "--light-sampler halton",
+        [0xdb5645b074ca302d, 0xc8d26cdee91f4e00],
+        0x1cf31e4952ac222d,
+    ),
+    ("hw1-scene5-whitted", "hw1/scene5.test", "", [0x5dd4d79b0b0f9afb, 0x5dd4d79b0b0f9afb], 0x5dd4d79b0b0f9afb),
+    ("hw1-scene7-whitted", "hw1/scene7.test", "--spp 2", [0xa6f4baf4d8806240, 0xf38a46fee5033fd0], 0x1adb70ff9c052cd7),
+    ("hw2-analytic", "hw2/analytic.test", "", [0xe89ec812899be839, 0x98ef34ea7134b70a], 0xfe710cd6cb8d94d9),
+    (
+        "hw2-direct9-stratified",
+        "hw2/direct9.test",
+        "--light-sampler stratified",
+        [0x8781bdf881f51540, 0xb8b1aee49d559290],
+        0x4041c3a1f5e0abae,
+    ),
     (
         "hw2-sphere-independent",
         "hw2/sphere.test",
         "--light-sampler independent --pixel-sampler independent",
-        0xa6192bcde4faeee7,
+        [0xa6192bcde4faeee7, 0xb0f83e562479a62f],
+        0x33efc4fcb13d17ba,
     ),
-    ("hw2-dragon-grid", "hw2/dragon.test", "--light-sampler grid-center", 0x12ae96170c173acd),
-    ("hw3-cornellSimple-hemi", "hw3/cornellSimple.test", "--spp 4", 0x068cfefbdb873e67),
-    ("hw3-cornellNEE-sobol", "hw3/cornellNEE.test", "--spp 4 --pixel-sampler sobol", 0xa3a75eaa3a2aad5d),
-    ("hw3-cornellRR", "hw3/cornellRR.test", "--spp 4", 0xb41825ffd9aedc97),
-    ("hw4-cornellBRDF-pmj", "hw4/cornellBRDF.test", "--spp 4 --pixel-sampler pmj02", 0x1a53e5e02dec9e85),
-    ("hw4-ggx-mis", "hw4/ggx.test", "--spp 4", 0x98f1a205e7c003aa),
-    ("hw4-mis", "hw4/mis.test", "--spp 4", 0xefbb9b21ef3e7e16),
+    (
+        "hw2-dragon-grid",
+        "hw2/dragon.test",
+        "--light-sampler grid-center",
+        [0x12ae96170c173acd, 0x49f8dabf77a9781b],
+        0x70fa4b8eaa6a9c2a,
+    ),
+    (
+        "hw3-cornellSimple-hemi",
+        "hw3/cornellSimple.test",
+        "--spp 4",
+        [0x068cfefbdb873e67, 0x799b025021a2b0e2],
+        0x799b025021a2b0e2,
+    ),
+    (
+        "hw3-cornellNEE-sobol",
+        "hw3/cornellNEE.test",
+        "--spp 4 --pixel-sampler sobol",
+        [0xa3a75eaa3a2aad5d, 0xcad7b4126b4a2bf7],
+        0x4387c4fc92d531fe,
+    ),
+    ("hw3-cornellRR", "hw3/cornellRR.test", "--spp 4", [0xb41825ffd9aedc97, 0xe92d4c922c1d868c], 0x1fbe1a104c02a06d),
+    (
+        "hw4-cornellBRDF-pmj",
+        "hw4/cornellBRDF.test",
+        "--spp 4 --pixel-sampler pmj02",
+        [0x1a53e5e02dec9e85, 0xee3ce62799001815],
+        0x73e6494ecb042ecb,
+    ),
+    ("hw4-ggx-mis", "hw4/ggx.test", "--spp 4", [0x98f1a205e7c003aa, 0x219c6f91b7a4737e], 0xceac54e92fa1119d),
+    ("hw4-mis", "hw4/mis.test", "--spp 4", [0xefbb9b21ef3e7e16, 0x9922a8b0588aadd8], 0xa4775dff5a2a95fd),
     (
         "hw4-cornellMIS-nee-on",
         "hw4/cornellMIS.test",
         "--spp 4 --nee on --importance-sampling cosine",
-        0xfa1f66fb9fc420e0,
+        [0xfa1f66fb9fc420e0, 0xad22a8a73108dcef],
+        0x69f6dd3ad3d89c61,
     ),
-    ("obj-cornell-emissive", "scenes/cornell_obj.test", "--spp 4", 0x8fee491b87977369),
+    (
+        "obj-cornell-emissive",
+        "scenes/cornell_obj.test",
+        "--spp 4",
+        [0x8fee491b87977369, 0xd8067b43619cbdaa],
+        0x59e789d327c9f068,
+    ),
     (
         "builtin-path-clamp",
         "scenes/cornell_diffuse_path.test",
         "--spp 4 --clamp 2 --kernel general",
-        0x08315f05d88164f6,
+        [0x08315f05d88164f6, 0x5e7e404386d9afef],
+        0x35327aa1e7dc25f0,
     ),
-    ("builtin-direct-halton-jittered", "", "--light-sampler halton --first-sample jittered", 0xe7d6501822bcef68),
+    (
+        "builtin-direct-halton-jittered",
+        "",
+        "--light-sampler halton --first-sample jittered",
+        [0xe7d6501822bcef68, 0x0d2c6b072a3f6bbe],
+        0x11f511b5bdea2370,
+    ),
     (
         "hw1-scene7-whitted-jittered",
         "hw1/scene7.test",
         "--spp 2 --first-sample jittered --quantize round",
-        0xb8315789573ec5d4,
+        [0xb8315789573ec5d4, 0x6e08fb2d40d24b90],
+        0x4fe55c176700caea,
     ),
     (
         "hw3-cornellNEE-sobol-jittered",
         "hw3/cornellNEE.test",
         "--spp 4 --pixel-sampler sobol --first-sample jittered",
-        0x1a05de859cf91e89,
+        [0x1a05de859cf91e89, 0x85f0aa3a628df9e0],
+        0xda6c8f50e35fc908,
     ),
-    ("hw4-mis-jittered", "hw4/mis.test", "--spp 4 --first-sample jittered", 0x8b7b6da4beb60612),
-    ("hw4-mis-uniform", "hw4/mis.test", "--spp 4 --light-selection uniform", 0xcd117e80c434d76a),
+    (
+        "hw4-mis-jittered",
+        "hw4/mis.test",
+        "--spp 4 --first-sample jittered",
+        [0x8b7b6da4beb60612, 0x1097d0aa194ff9a3],
+        0x1e831137691e70b9,
+    ),
+    (
+        "hw4-mis-uniform",
+        "hw4/mis.test",
+        "--spp 4 --light-selection uniform",
+        [0xcd117e80c434d76a, 0x1d6231de11cbd3a5],
+        0x8df70fff6626cb02,
+    ),
 ];
 
-#[test]
-fn golden_images_are_bit_identical() {
-    let Some(corpus) = corpus() else { return };
-    let print = std::env::var_os("STRATA_GOLDEN_PRINT").is_some();
-    let d = tmpdir("golden");
-    let mut bad = Vec::new();
-    for &(name, scene, flags, want) in CASES {
+/// Renders every case with `STRATA_EMBREE_CONFIG` set to `config` (None: unset, the default)
+/// and returns (name, hash) per case.
+fn render_all(corpus: &std::path::Path, config: Option<&str>, tag: &str) -> Vec<(&'static str, u64)> {
+    let d = tmpdir(&format!("golden-{tag}"));
+    let mut got = Vec::new();
+    for &(name, scene, flags, ..) in CASES {
         let out = d.join(name);
         let mut cmd = strata();
         cmd.arg("render");
+        match config {
+            Some(c) => cmd.env("STRATA_EMBREE_CONFIG", c),
+            None => cmd.env_remove("STRATA_EMBREE_CONFIG"),
+        };
         if let Some(s) = scene.strip_prefix("scenes/") {
             cmd.arg(PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes")).join(s));
         } else if !scene.is_empty() {
@@ -111,14 +197,48 @@ fn golden_images_are_bit_identical() {
         cmd.args(flags.split_whitespace());
         let r = cmd.arg("-o").arg(&out).output().unwrap();
         assert!(r.status.success(), "{name}: {}", String::from_utf8_lossy(&r.stderr));
-        let got = pixel_hash(&out.with_extension("exr"));
-        if print {
-            println!("    (\"{name}\", \"{scene}\", \"{flags}\", 0x{got:016x}),");
-        }
-        if got != want {
-            bad.push(format!("{name}: 0x{got:016x}, recorded 0x{want:016x}"));
-        }
+        got.push((name, pixel_hash(&out.with_extension("exr"))));
     }
     std::fs::remove_dir_all(&d).ok();
+    got
+}
+
+/// The default renders (Embree's AVX2 kernels) match the AVX2 column of this kind of CPU (or,
+/// for an unrecorded id, of some recorded kind), and on an AVX-512 CPU the `isa=avx512` renders
+/// match the AVX-512 column.
+#[test]
+fn golden_images_are_bit_identical() {
+    let Some(corpus) = corpus() else { return };
+    let print = std::env::var_os("STRATA_GOLDEN_PRINT").is_some();
+    let id = strata::accel::approx_id("avx2");
+    let avx2 = render_all(&corpus, None, "avx2");
+    let avx512 = strata::accel::cpu_has_avx512().then(|| render_all(&corpus, Some("isa=avx512"), "avx512"));
+    if print {
+        println!("this CPU's AVX2 id: {id}");
+        for (i, &(name, scene, flags, ..)) in CASES.iter().enumerate() {
+            let w = avx512.as_ref().map_or(0, |a| a[i].1);
+            println!("    (\"{name}\", \"{scene}\", \"{flags}\", [.., 0x{:016x}], 0x{w:016x}),", avx2[i].1);
+        }
+    }
+    let mut bad = Vec::new();
+    // The kind whose column to hold the AVX2 renders to: this CPU's if recorded, else the first
+    // recorded kind they match (an unrecorded CPU matching none fails, naming its id).
+    let kinds: Vec<usize> = match AVX2_KINDS.iter().position(|k| *k == id) {
+        Some(k) => vec![k],
+        None => (0..AVX2_KINDS.len()).collect(),
+    };
+    let matches = |k: usize| CASES.iter().zip(&avx2).all(|(c, g)| c.3[k] == g.1);
+    match kinds.iter().copied().find(|&k| matches(k)) {
+        Some(k) => println!("AVX2 renders match the column of {} (this CPU: {id})", AVX2_KINDS[k]),
+        None => {
+            let k = kinds[0];
+            for (c, g) in CASES.iter().zip(&avx2).filter(|(c, g)| c.3[k] != g.1) {
+                bad.push(format!("{} (avx2, {id}): 0x{:016x}, recorded 0x{:016x}", c.0, g.1, c.3[k]));
+            }
+        }
+    }
+    for (c, g) in CASES.iter().zip(avx512.iter().flatten()).filter(|(c, g)| c.4 != g.1) {
+        bad.push(format!("{} (avx512): 0x{:016x}, recorded 0x{:016x}", c.0, g.1, c.4));
+    }
     assert!(bad.is_empty(), "images changed:\n{}", bad.join("\n"));
 }

@@ -27,6 +27,7 @@
 //! `ftz.rs` the FTZ/DAZ switch; `alloc.rs` the counting allocator for tests.
 
 pub mod alloc;
+pub mod approx;
 mod device;
 pub mod ellipsoid;
 mod ffi;
@@ -38,6 +39,7 @@ mod sphere_points_tests;
 mod tests;
 mod user_geometry;
 
+pub use approx::approx_id;
 pub use device::{cpu_has_avx512, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
 pub use ftz::{set_ftz_daz, timestamp};

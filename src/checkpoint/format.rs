@@ -222,6 +222,14 @@ mod tests {
         let m = a.mismatch(&b, "this render").unwrap();
         assert!(m.contains("build b1") && m.contains("build b2") && m.contains("--allow-other-build"), "{m}");
         assert_eq!(a.mismatch_allowing(&b, "this render", true), None);
+        // Parts from CPUs whose approximate reciprocals differ (Embree's AVX2 kernels) are
+        // refused, saying why and what renders alike everywhere.
+        let mut b = a.clone();
+        let mut a2 = a.clone();
+        a2.options.insert("embree_approx".into(), serde_json::json!("rcpps-80b65207868234cd"));
+        b.options.insert("embree_approx".into(), serde_json::json!("rcpps-0123456789abcdef"));
+        let m = a2.mismatch(&b, "this render").unwrap();
+        assert!(m.contains("embree_approx") && m.contains("vrcpps") && m.contains("isa=avx512"), "{m}");
         // Timing, ranges and parts are not identity.
         let mut b = a.clone();
         (b.cpu_seconds, b.target, b.parts) = (9.0, [0, 8], vec!["p".into()]);

@@ -95,7 +95,15 @@ impl Header {
                 format!("{k} {} ({label}: {})", show(self.options.get(k)), show(want.options.get(k)))
             })
             .collect();
-        (!diffs.is_empty()).then(|| format!("it was rendered with other options: {}", diffs.join(", ")))
+        let approx = self.options.get("embree_approx") != want.options.get("embree_approx");
+        let hint = if approx {
+            "; this CPU's approximate reciprocals (vrcpps, used by Embree's AVX2 kernels) differ from the \
+             other's, so their pixels can differ: render every part with STRATA_EMBREE_CONFIG=isa=avx512 \
+             where all nodes have AVX-512 (exactly specified), or on one kind of CPU"
+        } else {
+            ""
+        };
+        (!diffs.is_empty()).then(|| format!("it was rendered with other options: {}{hint}", diffs.join(", ")))
     }
 }
 
@@ -105,11 +113,13 @@ pub const BUILD: &str = env!("STRATA_BUILD");
 pub const COMMIT: &str = env!("STRATA_COMMIT");
 
 /// The identity keys of the intersection backend ([`crate::scene::build::Backend`]): Embree's
-/// instruction set and version, the BVH quality and the sphere intersector.
-fn backend_options(scene: &Scene) -> [(&'static str, serde_json::Value); 4] {
+/// instruction set, the reciprocal approximations its kernels use on this CPU, its version, the
+/// BVH quality and the sphere intersector.
+fn backend_options(scene: &Scene) -> [(&'static str, serde_json::Value); 5] {
     let b = &scene.backend;
     [
         ("embree_isa", json!(b.isa)),
+        ("embree_approx", json!(b.approx)),
         ("embree_version", json!(b.embree)),
         ("bvh", json!(b.bvh)),
         ("spheres", json!(b.spheres)),
@@ -181,6 +191,7 @@ pub fn header_metadata(h: &Header) -> Metadata {
         ("strata.build".into(), h.strata_build.clone()),
         ("strata.commit".into(), h.strata_commit.clone()),
         ("strata.embree_isa".into(), opt("embree_isa")),
+        ("strata.embree_approx".into(), opt("embree_approx")),
         ("strata.embree_version".into(), opt("embree_version")),
         ("strata.scene".into(), h.scene.clone()),
         ("strata.scene_hash".into(), h.scene_hash.clone()),

@@ -146,6 +146,9 @@ pub struct Backend {
     pub isa: &'static str,
     /// the Embree library's version
     pub embree: String,
+    /// the reciprocal approximations its kernels use on this CPU ([`crate::accel::approx_id`]):
+    /// `exact` for AVX-512, else a fingerprint of this CPU's `vrcpps`/`vrsqrtps`
+    pub approx: String,
     /// `high` or `medium` quality BVH (by triangle count, or `STRATA_BVH`)
     pub bvh: &'static str,
     /// `strata` (the user geometry) or `embree` (`STRATA_SPHERES=embree`: Embree's sphere points)
@@ -296,6 +299,7 @@ impl Scene {
         let backend = Backend {
             isa: device.isa(),
             embree: device.version(),
+            approx: crate::accel::approx_id(device.isa()),
             bvh: if high { "high" } else { "medium" },
             spheres: if embree_spheres { "embree" } else { "strata" },
         };
