@@ -119,38 +119,25 @@ fn centre_swap(s: u32, n: u32) -> u32 {
 }
 
 impl Camera<'_> {
-    /// Camera rays of packet `pk` for pixel sample `s`: origins and unit directions.
+    /// Point `k` of the pixel set for the pixels of `pk` (sample 0, dimension [`DIM_CAMERA`]):
+    /// the jitter of pixel sample `k`. Integrators draw it through their sample handle
+    /// (`integrator::samples`), which profiles and logs the call.
     #[inline]
-    pub fn rays(&self, pk: &PixelPacket, s: u32) -> (Vec3x8, Vec3x8) {
-        self.rays_with(pk, s, |k| {
-            crate::sampler::replay::pixel_point(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(k));
-            self.pixel_set.point_x8(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(k), self.seed)
-        })
+    pub fn point(&self, pk: &PixelPacket, k: u32) -> (F8, F8) {
+        self.pixel_set.point_x8(pk.pixel, U8::splat(0), DIM_CAMERA, U8::splat(k), self.seed)
+    }
+
+    /// The pixel-sample stream of the pixels of `pk` (sample 0, dimension [`DIM_CAMERA`]): the
+    /// per-pixel hashing of [`Camera::point`] done once for a batch of samples; point k of the
+    /// stream equals `point(pk, k)` bit for bit.
+    #[inline]
+    pub fn stream(&self, pk: &PixelPacket) -> Stream<U8> {
+        self.pixel_set.stream_x8(pk.pixel, U8::splat(0), DIM_CAMERA, self.seed)
     }
 
     /// Whether pixel sample `s` draws from the pixel sampler (sample 0 through the centre does not).
     pub fn draws(&self, s: u32) -> bool {
         !(self.centre() && s == 0)
-    }
-
-    /// The pixel-sample streams of the packets `pks` (sample 0, dimension [`DIM_CAMERA`]; one per
-    /// packet, in order) into `out`, for [`Camera::rays_in`]: the per-pixel hashing done once for
-    /// a batch of samples.
-    pub fn streams(&self, pks: &[PixelPacket], out: &mut Vec<Stream<U8>>) {
-        let _p = crate::profile::scope(crate::profile::Phase::SamplerPixel);
-        out.clear();
-        out.extend(pks.iter().map(|pk| self.pixel_set.stream_x8(pk.pixel, U8::splat(0), DIM_CAMERA, self.seed)));
-        crate::sampler::replay::camera_streams(pks.iter().map(|pk| pk.pixel), U8::splat(0), DIM_CAMERA);
-    }
-
-    /// [`Camera::rays`] of packet `i` of the packets whose streams [`Camera::streams`] made
-    /// (`pk` is that packet, `stream` its stream): the same rays, bit for bit.
-    #[inline]
-    pub fn rays_in(&self, pk: &PixelPacket, i: u32, stream: &Stream<U8>, s: u32) -> (Vec3x8, Vec3x8) {
-        self.rays_with(pk, s, |k| {
-            crate::sampler::replay::camera_point(i, k);
-            stream.point(k)
-        })
     }
 
     /// Sample 0 goes through the pixel centre.
@@ -159,10 +146,11 @@ impl Camera<'_> {
         self.first_sample == FirstSample::Centre && self.pixel_set.kind() != SamplerKind::GRID_CENTER
     }
 
-    /// The rays of packet `pk` for pixel sample `s`, with `point(k)` the pixel set's point k of
-    /// the packet's pixels (sample 0, dimension [`DIM_CAMERA`]).
+    /// The rays of packet `pk` for pixel sample `s` (origins and unit directions), with `point(k)`
+    /// the pixel set's point k of the packet's pixels ([`Camera::point`], or a point of
+    /// [`Camera::stream`]); not called for a sample that does not draw ([`Camera::draws`]).
     #[inline]
-    fn rays_with(&self, pk: &PixelPacket, s: u32, point: impl FnOnce(u32) -> (F8, F8)) -> (Vec3x8, Vec3x8) {
+    pub fn rays_with(&self, pk: &PixelPacket, s: u32, point: impl FnOnce(u32) -> (F8, F8)) -> (Vec3x8, Vec3x8) {
         let centre = self.centre();
         let (jx, jy) = if centre && s == 0 {
             (F8::splat(0.5), F8::splat(0.5))
@@ -170,7 +158,6 @@ impl Camera<'_> {
             // Stratified: the sample whose stratum holds the centre takes sample 0's stratum.
             let stratified = self.pixel_set.kind() == SamplerKind::STRATIFIED;
             let k = if centre && stratified { centre_swap(s, self.pixel_set.n()) } else { s };
-            let _p = crate::profile::leaf(crate::profile::Phase::SamplerPixel);
             point(k)
         };
         let dir = self.lens.dirs8(pk.x + jx, pk.y + jy);

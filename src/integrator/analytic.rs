@@ -1,7 +1,14 @@
 //! `analyticdirect` (hw2): exact polygonal irradiance from every area light, without visibility.
 
+use super::context::TileCtx;
+use super::estimator::Estimator;
+use super::primary::{self, Wave};
+use super::samples::{Dim, CAMERA};
+use super::settings::Integrator;
+use crate::bsdf::LobeSet;
 use crate::light::polygonal::polygon_phi_x8;
 use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::desc::IntegratorKind;
 use crate::simd::{Vec3x8, F8, U8};
 use std::f32::consts::PI;
 
@@ -18,4 +25,27 @@ pub fn radiance(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
         l_out += sh.kd.mul_elem(Vec3x8::splat(light.radiance)).scale(e * F8::splat(1.0 / PI));
     }
     l_out
+}
+
+/// The `analyticdirect` integrator: the camera-hit wavefront, shaded by [`radiance`].
+pub struct Analytic;
+
+impl Estimator for Analytic {
+    const KIND: IntegratorKind = IntegratorKind::AnalyticDirect;
+    const DIMS: &'static [Dim] = &[CAMERA];
+    type Scratch = Wave;
+
+    fn tile<L: LobeSet>(
+        _: &Integrator,
+        ctx: &mut TileCtx,
+        wave: &mut Wave,
+        samples: std::ops::Range<u32>,
+        out: &mut Vec<Vec3x8>,
+    ) {
+        primary::tile(ctx, wave, samples, out, |ctx, hits, _, out| {
+            for (o, sh) in out.iter_mut().zip(hits) {
+                *o += radiance(ctx.scene, sh);
+            }
+        });
+    }
 }

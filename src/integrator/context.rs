@@ -1,15 +1,15 @@
-//! The tile context: what one integrator call over a tile works with. It owns (by reference) the
-//! scene, the camera, the tile's packets, the per-thread scratch buffers and a [`Tracer`], the one
-//! place where rays reach Embree: every `intersect`/`occluded` call is counted in [`Counters`] and,
-//! when a [`RayLog`] is attached (`strata rays`), logged as traced.
+//! The tile context: what one integrator call over a tile works with. It holds (by reference) the
+//! scene, the tile's packets, the sample handle [`Samples`] (the one place numbers are drawn) and
+//! a [`Tracer`], the one place where rays reach Embree: every `intersect`/`occluded` call is
+//! counted in [`Counters`] and, when a [`RayLog`] is attached (`strata rays`), logged as traced.
 
-use super::path::PathScratch;
+use super::samples::Samples;
 use super::stats::{Counters, RayKind, RayLog};
 use crate::accel::{Ray8, RayHit8};
-use crate::camera::{Camera, PixelPacket};
-use crate::sampler::Stream;
+use crate::bsdf::Material8;
+use crate::camera::PixelPacket;
 use crate::scene::build::{Scene, SurfaceHit8};
-use crate::simd::{Mask8, Vec3x8, F8, U8};
+use crate::simd::{Mask8, Vec3x8, F8};
 
 /// Embree calls with their counting and logging, written once.
 pub struct Tracer<'a> {
@@ -70,38 +70,16 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// Per-thread buffers of the tile wavefront, reused across samples and tiles.
-#[derive(Default)]
-pub struct Scratch {
-    pub(super) rh: Vec<(RayHit8, Mask8)>,
-    pub(super) hits: Vec<SurfaceHit8>,
-    pub(super) shade: Vec<Mask8>,
-    pub(super) eps: Vec<F8>,
-    pub(super) acc: Vec<Vec3x8>,
-    pub(super) shadow: Vec<(Ray8, Mask8)>,
-    pub(super) contrib: Vec<Vec3x8>,
-    pub(super) owner: Vec<u32>,
-    pub(super) streams: Vec<Stream<U8>>,
-    /// `direct` with one light per sample: the light-choice streams
-    pub(super) choice_streams: Vec<Stream<U8>>,
-    /// the camera's pixel-sample streams of the tile's packets (direct-lighting integrators)
-    pub(super) cam_streams: Vec<Stream<U8>>,
-    pub(super) path: PathScratch,
-    pub(super) one: Vec<Vec3x8>,
-}
-
 /// Everything an integrator needs for one tile.
 pub struct TileCtx<'a> {
     /// the scene
     pub scene: &'a Scene,
-    /// primary ray generation
-    pub camera: Camera<'a>,
+    /// every number the integrator uses (camera jitter, light, path), profiled and logged
+    pub samples: Samples<'a>,
     /// the tile's packets
     pub pks: &'a [PixelPacket],
     /// Embree calls, counted and logged
     pub tracer: Tracer<'a>,
-    /// per-thread buffers
-    pub scratch: &'a mut Scratch,
 }
 
 impl TileCtx<'_> {
@@ -122,4 +100,10 @@ impl TileCtx<'_> {
 #[inline]
 pub(super) fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
     Vec3x8::new(m.select(v.x, F8::ZERO), m.select(v.y, F8::ZERO), m.select(v.z, F8::ZERO))
+}
+
+/// The material of a hit record.
+#[inline]
+pub(super) fn material(sh: &SurfaceHit8) -> Material8 {
+    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx }
 }

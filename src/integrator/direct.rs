@@ -3,7 +3,7 @@
 //! The emitters are visited in one loop, one sampling group at a time: each quad light is its own
 //! group (sampler dimension `DIM_LIGHT_BASE + index`, a point uniform in area), and the emissive
 //! triangles form one more group after the quads (dimension `DIM_LIGHT_BASE + #quads`; each sample
-//! picks a triangle by power and a point on it, see `light::emitters`). Each group adds the mean
+//! picks a triangle by power, `Integrator::triangle_sampler`, and a point on it). Each group adds the mean
 //! over the `lightsamples` samples of L f cos(th_i) cos(th_l) / (d^2 pdf_area) where the shadow ray
 //! is clear. A quad group's radiance and area are constant, so they scale its sum once at the end.
 //! f is the path tracer's material code (`bsdf::Material8::eval_pdf_k` in the local shading frame):
@@ -17,15 +17,71 @@
 //! `direct` does with one emitter sample. `uniform` is then truly 1/#lights (quads and triangles
 //! alike).
 
-use super::context::{masked, Scratch, TileCtx, Tracer};
-use super::{Integrator, DIM_LIGHT_BASE};
+use super::context::{masked, material, TileCtx, Tracer};
+use super::estimator::Estimator;
+use super::primary::{self, Wave};
+use super::samples::{Dim, Samples, Source, CAMERA};
+use super::settings::Integrator;
 use crate::accel::Ray8;
-use crate::bsdf::{LobeSet, Material8};
+use crate::bsdf::LobeSet;
 use crate::light::emitters::{Emitter, LightSample8};
 use crate::light::select::{LightChoice, LightSelection};
-use crate::sampler::PathDim;
+use crate::profile::Phase;
+use crate::sampler::{PathDim, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::desc::IntegratorKind;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
+
+/// First sampler dimension of light sampling (see [`LIGHT_POINT`]).
+pub const DIM_LIGHT_BASE: u32 = 16;
+
+/// The light point (2D, uniform in area): under `all` one dimension per sampling group (the
+/// quads, then the triangles); under a one-light selection the chosen light's, whose u also
+/// picks the light under `--light-choice reuse`.
+pub const LIGHT_POINT: Dim = Dim { name: "light point", first: DIM_LIGHT_BASE, stride: 1, source: Source::Light };
+/// The light choice (x), only under `--light-choice dimension` with several lights.
+pub const LIGHT_CHOICE: Dim = Dim { name: "light choice", first: DIM_LIGHT_BASE + 1, stride: 0, source: Source::Light };
+
+/// The `direct` integrator: the camera-hit wavefront, shaded by light sampling.
+pub struct Direct;
+
+/// `direct`'s per-thread buffers: the camera-hit wavefront and the light-sampling batches.
+#[derive(Default)]
+pub struct DirectScratch {
+    wave: Wave,
+    buf: Buffers,
+}
+
+/// Per-thread buffers of `direct`'s light sampling, reused across samples and tiles.
+#[derive(Default)]
+struct Buffers {
+    shade: Vec<Mask8>,
+    eps: Vec<F8>,
+    acc: Vec<Vec3x8>,
+    shadow: Vec<(Ray8, Mask8)>,
+    contrib: Vec<Vec3x8>,
+    owner: Vec<u32>,
+    streams: Vec<Stream<U8>>,
+    /// one light per sample, `--light-choice dimension`: the light-choice streams
+    choice_streams: Vec<Stream<U8>>,
+}
+
+impl Estimator for Direct {
+    const KIND: IntegratorKind = IntegratorKind::Direct;
+    const DIMS: &'static [Dim] = &[CAMERA, LIGHT_POINT, LIGHT_CHOICE];
+    type Scratch = DirectScratch;
+
+    fn tile<L: LobeSet>(
+        it: &Integrator,
+        ctx: &mut TileCtx,
+        sc: &mut DirectScratch,
+        samples: std::ops::Range<u32>,
+        out: &mut Vec<Vec3x8>,
+    ) {
+        let DirectScratch { wave, buf } = sc;
+        primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, s, out));
+    }
+}
 
 /// One sampling group of `direct`.
 #[derive(Clone, Copy)]
@@ -37,12 +93,22 @@ enum Group<'a> {
 }
 
 impl Group<'_> {
-    /// A point on the group's light(s) for the unit-square sample (u, v).
+    /// A point on the group's light(s) for the unit-square sample (u, v) at the hits `sh`, and
+    /// the `active` lanes that got one.
     #[inline]
-    fn sample(self, scene: &Scene, u: F8, v: F8, active: Mask8) -> LightSample8 {
+    fn sample(
+        self,
+        it: &Integrator,
+        scene: &Scene,
+        sh: &SurfaceHit8,
+        u: F8,
+        v: F8,
+        active: Mask8,
+    ) -> (LightSample8, Mask8) {
         match self {
-            Group::Quad(e) => e.sample_x8(u, v),
-            Group::Triangles => scene.emitters.sample_triangles_x8(u, v, active),
+            Group::Quad(e) => (e.sample_x8(u, v), active),
+            // The triangle chosen by power from u, u remapped within its interval (`reuse`).
+            Group::Triangles => it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, (u, v)),
         }
     }
 }
@@ -53,28 +119,31 @@ fn groups(scene: &Scene) -> impl Iterator<Item = Group<'_>> {
     quads.chain((scene.emitters.n_triangles() > 0).then_some(Group::Triangles))
 }
 
-/// Adds direct lighting at the camera hits of the tile (`ctx.scratch.hits`) for pixel sample `s`
-/// to `out`.
-pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
+/// Adds direct lighting at the camera hits `hits` of the tile for pixel sample `s` to `out`.
+fn shade<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    hits: &[SurfaceHit8],
+    sc: &mut Buffers,
+    s: u32,
+    out: &mut [Vec3x8],
+) {
     if it.light_selection != LightSelection::All {
-        return shade_one::<L>(it, ctx, s, out);
+        return shade_one::<L>(it, ctx, hits, sc, s, out);
     }
-    let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
+    let TileCtx { scene, pks, tracer, samples: smp } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
-    let sample_idx = U8::splat(s);
     let streams = it.light_streams();
-    shading_lanes(scene, sc);
+    shading_lanes(scene, hits, sc);
     for (gi, group) in groups(scene).enumerate() {
-        let dim = DIM_LIGHT_BASE + gi as u32;
-        let table = LightTable::new(it, dim, s);
+        let dim = LIGHT_POINT.at(gi as u32);
+        let table = LightTable::new(it, smp, dim, s);
         sc.acc.clear();
         sc.acc.resize(pks.len(), Vec3x8::ZERO);
         sc.streams.clear();
         if streams {
-            let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-            light_streams(it, pks, &sc.shade, sample_idx, dim, &mut sc.streams);
-            crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, dim);
+            smp.light_streams(pks, &sc.shade, s, dim, true, &mut sc.streams);
         }
         for k in 0..n_light {
             let point_k = it.light_set.point_k(k);
@@ -86,24 +155,22 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
             // is the j-th shading packet's.
             let mut j = 0;
             for i in 0..pks.len() {
-                let (sh, shade) = (&sc.hits[i], sc.shade[i]);
+                let (sh, shade) = (&hits[i], sc.shade[i]);
                 if shade.none() {
                     continue;
                 }
                 let (u, v) = if streams {
-                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(j, k);
-                    sc.streams[j as usize].point_k(&point_k)
+                    smp.light_stream_point(&sc.streams[j as usize], j, k, &point_k)
                 } else {
-                    table.point(it, pks[i].pixel, k)
+                    table.point(smp, pks[i].pixel, k)
                 };
                 j += 1;
-                let ls = {
+                let (ls, ok) = {
                     let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                    group.sample(scene, u, v, shade)
+                    group.sample(it, scene, sh, u, v, shade)
                 };
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-                let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, shade) else { continue };
+                let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
                 sc.contrib.push(match group {
                     Group::Quad(_) => f.scale(g),
                     Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
@@ -116,7 +183,7 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
                 sc.owner.push(i as u32);
             }
             // A quad's sum is scaled once below; the triangles' terms are complete.
-            let Scratch { shadow, contrib, owner, acc, .. } = &mut **sc;
+            let Buffers { shadow, contrib, owner, acc, .. } = &mut *sc;
             let target = if let Group::Quad(_) = group { &mut acc[..] } else { &mut *out };
             trace_shadow_batch(tracer, shadow, contrib, owner, target);
         }
@@ -129,32 +196,13 @@ pub(super) fn shade<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out:
     }
 }
 
-/// Per camera packet of the tile: `sc.shade`, the hit lanes to shade (lights shade nothing
-/// themselves: black, one-sided emitters), and `sc.eps`, the shadow-ray origin offsets.
-fn shading_lanes(scene: &Scene, sc: &mut Scratch) {
+/// Per camera packet of the tile: `sc.shade`, the hit lanes of `hits` to shade (lights shade
+/// nothing themselves: black, one-sided emitters), and `sc.eps`, the shadow-ray origin offsets.
+fn shading_lanes(scene: &Scene, hits: &[SurfaceHit8], sc: &mut Buffers) {
     sc.shade.clear();
-    sc.shade.extend(sc.hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
+    sc.shade.extend(hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
     sc.eps.clear();
-    sc.eps.extend(sc.hits.iter().map(|sh| scene.offset_eps(sh.p)));
-}
-
-/// The light streams of dimension `dim` for pixel sample `sample` of the packets of `pks` that
-/// have lanes to shade (`shade`), in packet order, into `out`.
-fn light_streams(
-    it: &Integrator,
-    pks: &[crate::camera::PixelPacket],
-    shade: &[Mask8],
-    sample: U8,
-    dim: u32,
-    out: &mut Vec<crate::sampler::Stream<U8>>,
-) {
-    let shading = pks.iter().zip(shade).filter(|(_, m)| m.any());
-    out.extend(shading.map(|(pk, _)| it.light_set.stream_x8(pk.pixel, sample, dim, it.seed)));
-}
-
-/// The pixels of the packets of `pks` that have lanes to shade (what [`light_streams`] draws for).
-fn shading_pixels<'a>(pks: &'a [crate::camera::PixelPacket], shade: &'a [Mask8]) -> impl Iterator<Item = U8> + 'a {
-    pks.iter().zip(shade).filter(|(_, m)| m.any()).map(|(pk, _)| pk.pixel)
+    sc.eps.extend(hits.iter().map(|sh| scene.offset_eps(sh.p)));
 }
 
 /// One light dimension of pixel sample `s` drawn from the integrator's light table, over all
@@ -167,29 +215,33 @@ struct LightTable {
 
 impl LightTable {
     /// Dimension `dim` for pixel sample `s`.
-    fn new(it: &Integrator, dim: u32, s: u32) -> Self {
+    fn new(it: &Integrator, smp: &Samples, dim: u32, s: u32) -> Self {
         let n = it.light_table.set().n();
-        Self { dim: it.light_table.path_dim(n, dim, it.seed), first: s.wrapping_mul(it.light_set.n()) }
+        Self { dim: smp.table_dim(true, n, dim), first: s.wrapping_mul(it.light_set.n()) }
     }
 
     /// Light sample `k` of the pixels `pixel`.
     #[inline]
-    fn point(&self, it: &Integrator, pixel: U8, k: u32) -> (F8, F8) {
-        let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
+    fn point(&self, smp: &Samples, pixel: U8, k: u32) -> (F8, F8) {
         let index = U8::splat(self.first.wrapping_add(k));
-        crate::sampler::replay::path_point(pixel, index, self.dim.dim(), true);
-        it.light_table.path_point_x8(&self.dim, pixel, index)
+        smp.table_point(&self.dim, true, Phase::SamplerLight, pixel, index)
     }
 }
 
 /// `direct` with one light per light sample, chosen by `it.light_sampler` (see the module docs).
 #[inline(never)]
-fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [Vec3x8]) {
-    let TileCtx { scene, pks, tracer, scratch: sc, .. } = ctx;
+fn shade_one<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    hits: &[SurfaceHit8],
+    sc: &mut Buffers,
+    s: u32,
+    out: &mut [Vec3x8],
+) {
+    let TileCtx { scene, pks, tracer, samples: smp } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
-    let sample_idx = U8::splat(s);
-    shading_lanes(scene, sc);
+    shading_lanes(scene, hits, sc);
     // One light chosen uniformly: the choice is light 0 with pmf 1 whatever its sample, so the
     // choice dimension is not drawn (every sample is a pure function of its own dimension: the
     // others are unchanged).
@@ -197,17 +249,14 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
     // The choice from a dimension of its own, or reused from the light point's u (Mitsuba's).
     let own_choice = !one_light && it.light_choice == LightChoice::Dimension;
     let streams = it.light_streams();
-    let (table, choice_table) = (LightTable::new(it, DIM_LIGHT_BASE, s), LightTable::new(it, DIM_LIGHT_BASE + 1, s));
+    let table = LightTable::new(it, smp, LIGHT_POINT.first, s);
+    let choice_table = LightTable::new(it, smp, LIGHT_CHOICE.first, s);
     sc.streams.clear();
     sc.choice_streams.clear();
     if streams {
-        let _p = crate::profile::scope(crate::profile::Phase::SamplerLight);
-        light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE, &mut sc.streams);
-        crate::sampler::replay::light_streams(shading_pixels(pks, &sc.shade), sample_idx, DIM_LIGHT_BASE);
+        smp.light_streams(pks, &sc.shade, s, LIGHT_POINT.first, true, &mut sc.streams);
         if own_choice {
-            light_streams(it, pks, &sc.shade, sample_idx, DIM_LIGHT_BASE + 1, &mut sc.choice_streams);
-            let choice = shading_pixels(pks, &sc.shade);
-            crate::sampler::replay::light_streams_append(choice, sample_idx, DIM_LIGHT_BASE + 1);
+            smp.light_streams(pks, &sc.shade, s, LIGHT_CHOICE.first, false, &mut sc.choice_streams);
         }
     }
     // Streams (and choice streams) j are the j-th shading packet's.
@@ -219,16 +268,14 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
         sc.owner.clear();
         let mut j = 0;
         for i in 0..pks.len() {
-            let (sh, shade) = (&sc.hits[i], sc.shade[i]);
+            let (sh, shade) = (&hits[i], sc.shade[i]);
             if shade.none() {
                 continue;
             }
             let (u, v) = if streams {
-                let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                crate::sampler::replay::light_point(j, k);
-                sc.streams[j as usize].point_k(&point_k)
+                smp.light_stream_point(&sc.streams[j as usize], j, k, &point_k)
             } else {
-                table.point(it, pks[i].pixel, k)
+                table.point(smp, pks[i].pixel, k)
             };
             let (ls, ok) = if one_light {
                 // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
@@ -236,11 +283,9 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
                 (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
             } else if own_choice {
                 let (uc, _) = if streams {
-                    let _p = crate::profile::leaf(crate::profile::Phase::SamplerLight);
-                    crate::sampler::replay::light_point(n_shading + j, k);
-                    sc.choice_streams[j as usize].point_k(&point_k)
+                    smp.light_stream_point(&sc.choice_streams[j as usize], n_shading + j, k, &point_k)
                 } else {
-                    choice_table.point(it, pks[i].pixel, k)
+                    choice_table.point(smp, pks[i].pixel, k)
                 };
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
@@ -258,7 +303,7 @@ fn shade_one<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, s: u32, out: &mut [
             sc.shadow.push((ray, lit));
             sc.owner.push(i as u32);
         }
-        let Scratch { shadow, contrib, owner, .. } = &mut **sc;
+        let Buffers { shadow, contrib, owner, .. } = &mut *sc;
         trace_shadow_batch(tracer, shadow, contrib, owner, out);
     }
 }
@@ -300,12 +345,6 @@ fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) ->
         material(sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
     };
     Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
-}
-
-/// The material of a hit record.
-#[inline]
-pub(super) fn material(sh: &SurfaceHit8) -> Material8 {
-    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx }
 }
 
 /// Traces a batch of shadow packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the

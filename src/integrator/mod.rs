@@ -1,211 +1,107 @@
-//! Integrators: radiance of the 4x2 packets of camera samples of a tile. They reach Embree only
-//! through the tile context's [`Tracer`] (one place that traces, counts and logs) and shade through
-//! `bsdf::Material8`.
+//! Integrators: radiance of the 4x2 packets of camera samples of a tile. The integrator is the
+//! plugin boundary: one trait ([`Estimator`]), one file per integrator that owns its scratch
+//! buffers and declares its sampler dimensions, and one line per integrator in [`INTEGRATORS`].
+//! They draw every number through the tile context's sample handle ([`Samples`]: profiled and
+//! logged for sampler replay), reach Embree only through its [`Tracer`] (traced, counted and
+//! logged) and shade through `bsdf::Material8`.
 //!
-//! One file per integrator: [`whitted`] (`raytracer`), [`analytic`] (`analyticdirect`), [`direct`]
-//! (`direct`) and [`path`] (`pathtracer`). The three direct-lighting integrators share the camera-hit
-//! wavefront of [`Integrator::radiance_tile`]; the path tracer runs its own wavefront. Kernels are
-//! monomorphized over a `bsdf::LobeSet` (see [`kernel`]).
+//! The integrators: [`whitted`] (`raytracer`), [`analytic`] (`analyticdirect`), [`direct`]
+//! (`direct`) and [`path`] (`pathtracer`). The three direct-lighting ones share the camera-hit
+//! wavefront of [`primary`]; the path tracer runs its own. Kernels are monomorphized over a
+//! `bsdf::LobeSet` (see [`kernel`]). Their settings: [`settings`].
 //!
 //! Directions: `wo` points to the viewer, `wi` to the light; pdfs per unit solid angle unless named
-//! `_area`. Dimensions given to the sampler: [`DIM_CAMERA`] for the pixel jitter, then
-//! [`DIM_LIGHT_BASE`] + light index for the light samples of `direct`.
+//! `_area`.
+//!
+//! Imports run one way: `mod.rs` (the registry) imports the integrators; they import
+//! `estimator`, `settings`, `samples`, `context`, `primary`, `stats` and `kernel`, never `mod.rs`
+//! or each other.
 
-use crate::accel::{Hits8, RayHit8};
-pub use crate::camera::FirstSample;
-use crate::camera::{Camera, PixelPacket};
-pub use crate::light::select::{LightChoice, LightSampler, LightSelection};
-use crate::sampler::{GridTable, PointSet, SamplerKind};
-use crate::scene::build::{Scene, SurfaceHit8};
-use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
-use crate::simd::{Vec3x8, F8};
-use context::masked;
-use kernel::Kernel;
+use crate::camera::PixelPacket;
+use crate::scene::build::Scene;
+use crate::scene::desc::IntegratorKind;
+use crate::simd::Vec3x8;
+use std::any::Any;
 
 pub mod analytic;
 pub mod context;
 pub mod direct;
+pub mod estimator;
 pub mod kernel;
 pub mod path;
+mod primary;
+pub mod samples;
+pub mod settings;
 pub mod stats;
 pub mod whitted;
 
-pub use crate::camera::DIM_CAMERA;
-pub use context::{Scratch, TileCtx, Tracer};
+pub use crate::camera::{FirstSample, DIM_CAMERA};
+pub use crate::light::select::{LightChoice, LightSampler, LightSelection};
+pub use context::{TileCtx, Tracer};
+pub use direct::DIM_LIGHT_BASE;
+pub use estimator::Estimator;
 pub use path::{PathScratch, DIM_PATH_BASE};
+pub use samples::{Dim, Samples, Source};
+pub use settings::{progressive_names, Integrator, NotProgressive, SamplerChoice};
 pub use stats::{Counters, RayKind, RayLog};
 
-/// First sampler dimension of light sampling; light `l` uses `DIM_LIGHT_BASE + l`.
-pub const DIM_LIGHT_BASE: u32 = 16;
-
-/// The samplers asked for (`--sampler`, `--pixel-sampler`, `--light-sampler`); `None` takes the
-/// default. `sampler` sets every dimension, the other two override theirs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SamplerChoice {
-    /// every dimension (`--sampler`)
-    pub sampler: Option<SamplerKind>,
-    /// the pixel (camera) dimension (`--pixel-sampler`)
-    pub pixel: Option<SamplerKind>,
-    /// the light dimensions: light point and light choice (`--light-sampler`)
-    pub light: Option<SamplerKind>,
-}
-
-/// An equal-time run asked for a layout that needs its sample count in advance.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "{flag} {name} needs the number of samples per pixel in advance, which an equal-time run does not know; \
-     progressive samplers: {progressive}"
-)]
-pub struct NotProgressive {
-    /// the flag that named it
-    pub flag: &'static str,
-    /// the sampler
-    pub name: &'static str,
-    /// the progressive samplers, comma-separated
-    pub progressive: String,
-}
-
-/// An integrator with its settings resolved from the scene and the command line.
-#[derive(Clone, Debug)]
-pub struct Integrator {
-    /// which estimator
+/// One registered integrator: its scene-format kind, its declared dimensions and its tile
+/// function (monomorphized for every compiled lobe set).
+pub struct Entry {
+    /// the integrator it runs
     pub kind: IntegratorKind,
-    /// samples per pixel (`u32::MAX` in equal-time runs: not known in advance)
-    pub spp: u32,
-    /// base seed
-    pub seed: u64,
-    /// what was asked for (the layouts below are resolved from it)
-    pub samplers: SamplerChoice,
-    /// pixel sample layout (over the spp samples of a pixel)
-    pub pixel_set: PointSet,
-    /// light sample layout, `n` = light samples per pixel sample (`direct`'s per-sample grid,
-    /// and the number of samples per light of `all`)
-    pub light_set: PointSet,
-    /// light dimensions drawn over all of a pixel's light samples (spp x N for `direct`, spp for
-    /// the path tracer): every light layout except a grid with N > 1 (see [`Integrator::light_streams`])
-    pub light_table: GridTable,
-    /// path tracer: layout of the other path dimensions (direction, lobe, roulette) over the spp
-    /// samples of a pixel
-    pub path_set: GridTable,
-    /// path tracer: next event estimation
-    pub nee: Nee,
-    /// path tracer: Russian roulette
-    pub russian_roulette: bool,
-    /// path tracer: direction sampling strategy
-    pub strategy: ImportanceSampling,
-    /// path tracer: maximum bounces (-1 = unbounded)
-    pub max_depth: i32,
-    /// the kernel that runs (specialized for the scene's features, or [`Kernel::GENERAL`])
-    pub kernel: Kernel,
-    /// path tracer, opt-in and biased: each pixel sample is scaled so its largest channel is at
-    /// most this radiance (None: no clamping, the unbiased default)
-    pub clamp: Option<f32>,
-    /// where pixel sample 0 goes ([`FirstSample`]; `new` gives `Jittered`)
-    pub first_sample: FirstSample,
-    /// how NEE chooses lights (`new` gives [`LightSelection::Uniform`]; see
-    /// [`Integrator::set_light_selection`])
-    pub light_selection: LightSelection,
-    /// where a one-light choice takes its number from (`--light-choice`; default reuse)
-    pub light_choice: LightChoice,
-    /// the light sampler of `light_selection` over the scene's emitters (shared by the threads)
-    pub light_sampler: std::sync::Arc<LightSampler>,
+    /// the sampler dimensions it draws
+    pub dims: &'static [Dim],
+    run: fn(&Integrator, &mut TileCtx, &mut Option<Box<dyn Any + Send>>, std::ops::Range<u32>, &mut Vec<Vec3x8>),
+}
+
+/// The registry entry of estimator `E`.
+const fn entry<E: Estimator + 'static>() -> Entry {
+    Entry { kind: E::KIND, dims: E::DIMS, run: run::<E> }
+}
+
+/// Runs `E` on a tile with its scratch from `slot` (made on first use), in the kernel compiled
+/// for the integrator's lobes.
+fn run<E: Estimator + 'static>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    slot: &mut Option<Box<dyn Any + Send>>,
+    samples: std::ops::Range<u32>,
+    out: &mut Vec<Vec3x8>,
+) {
+    let any = slot.get_or_insert_with(|| Box::new(E::Scratch::default()));
+    // A slot holds only its own entry's scratch: `Scratch` indexes slots by registry position.
+    let scratch = any.downcast_mut::<E::Scratch>().expect("a scratch slot holds its integrator's buffers");
+    kernel::with_lobe_set!(it.kernel.lobes, L => E::tile::<L>(it, ctx, scratch, samples, out))
+}
+
+/// Every integrator, one line each. A new integrator is its file, its line here and its
+/// `IntegratorKind` (the name the scene format and `--integrator` use).
+pub static INTEGRATORS: [Entry; 4] = [
+    entry::<whitted::Whitted>(),
+    entry::<analytic::Analytic>(),
+    entry::<direct::Direct>(),
+    entry::<path::PathTracer>(),
+];
+
+/// The registry position of `kind` (every kind is registered: tested).
+fn position(kind: IntegratorKind) -> usize {
+    INTEGRATORS.iter().position(|e| e.kind == kind).expect("every IntegratorKind is in INTEGRATORS")
+}
+
+/// The registry entry of `kind`.
+pub fn entry_of(kind: IntegratorKind) -> &'static Entry {
+    &INTEGRATORS[position(kind)]
+}
+
+/// Per-thread scratch buffers of the integrators (each integrator's own, made on first use),
+/// reused across tiles.
+#[derive(Default)]
+pub struct Scratch {
+    slots: Vec<Option<Box<dyn Any + Send>>>,
 }
 
 impl Integrator {
-    /// Settings from the scene, overridden by explicit choices. Defaults: stratified everywhere,
-    /// except `direct`'s light dimensions, which follow the scene's `lightstratify` (stratified
-    /// or independent).
-    pub fn new(scene: &Scene, spp: u32, seed: u64, samplers: SamplerChoice, light_samples: Option<u32>) -> Self {
-        let d = &scene.desc;
-        let n_light = light_samples.unwrap_or(d.light_samples).max(1);
-        let spp = spp.max(1);
-        let sets = Sets::resolve(d, samplers, spp, n_light);
-        Self {
-            kind: d.integrator,
-            spp,
-            seed,
-            samplers,
-            pixel_set: sets.pixel,
-            light_set: sets.light,
-            light_table: sets.light_table,
-            path_set: sets.path,
-            nee: d.nee,
-            russian_roulette: d.russian_roulette,
-            strategy: d.importance_sampling,
-            max_depth: d.max_depth,
-            kernel: Kernel::for_scene(scene),
-            clamp: None,
-            first_sample: FirstSample::Jittered,
-            light_selection: LightSelection::Uniform,
-            light_choice: LightChoice::Reuse,
-            light_sampler: std::sync::Arc::new(LightSampler::new(&scene.emitters.list, LightSelection::Uniform)),
-        }
-    }
-
-    /// Switches NEE's light selection to `selection`, building its sampler over `scene`'s emitters.
-    pub fn set_light_selection(&mut self, scene: &Scene, selection: LightSelection) {
-        self.light_selection = selection;
-        self.light_sampler = std::sync::Arc::new(LightSampler::new(&scene.emitters.list, selection));
-    }
-
-    /// `direct` draws its light points from per-pixel-sample streams of `light_set` (a grid layout
-    /// with N > 1 light samples: the course's jittered grid over the N samples of each pixel
-    /// sample); otherwise from `light_table`, over all spp x N light samples of the pixel.
-    pub fn light_streams(&self) -> bool {
-        self.light_set.kind().layout().cell_span(&self.light_set.shape(), 0).is_some() && self.light_set.n() > 1
-    }
-
-    /// The same integrator for `spp` samples per pixel: the per-pixel layouts are rebuilt for that
-    /// count.
-    pub fn resampled(&self, spp: u32) -> Self {
-        let mut it = self.clone();
-        it.spp = spp.max(1);
-        it.set_layouts(self.kinds());
-        it
-    }
-
-    /// The same integrator for an equal-time run, whose sample count is not known in advance
-    /// (`spp` becomes `u32::MAX`): every layout must be progressive (continue the sample index
-    /// across passes). A layout named on the command line that needs its count is refused with a
-    /// message naming the progressive ones; a default one becomes `sobol` (the stats say so).
-    pub fn equal_time(&self) -> Result<Self, NotProgressive> {
-        let c = self.samplers;
-        let named = [(c.pixel, "--pixel-sampler"), (c.light, "--light-sampler"), (c.sampler, "--sampler")];
-        for (kind, flag) in named.into_iter().filter_map(|(k, f)| Some((k?, f))) {
-            if !kind.info().progressive {
-                return Err(NotProgressive { flag, name: kind.name(), progressive: progressive_names() });
-            }
-        }
-        let keep = |k: SamplerKind| if k.info().progressive { k } else { SamplerKind::SOBOL };
-        let mut it = self.clone();
-        it.spp = u32::MAX;
-        it.set_layouts(self.kinds().map(keep));
-        Ok(it)
-    }
-
-    /// Rebuilds the layouts for `self.spp` with kinds [pixel, light, path].
-    fn set_layouts(&mut self, kinds: [SamplerKind; 3]) {
-        let sets = Sets::build(self.kind, kinds, self.spp, self.light_set.n(), self.pixel_set.shape().width());
-        (self.pixel_set, self.light_set, self.light_table, self.path_set) =
-            (sets.pixel, sets.light, sets.light_table, sets.path);
-    }
-
-    /// The resolved layouts: [pixel, light, other path dimensions].
-    pub fn kinds(&self) -> [SamplerKind; 3] {
-        [self.pixel_set.kind(), self.light_set.kind(), self.path_set.set().kind()]
-    }
-
-    /// The camera of this integrator on `scene` (its pixel sampler and seed).
-    pub fn camera<'a>(&'a self, scene: &'a Scene) -> Camera<'a> {
-        Camera { lens: &scene.camera, pixel_set: &self.pixel_set, seed: self.seed, first_sample: self.first_sample }
-    }
-
-    /// Camera rays of packet `pk` for pixel sample `s`: origins and unit directions.
-    #[inline]
-    pub fn camera_rays(&self, scene: &Scene, pk: &PixelPacket, s: u32) -> (Vec3x8, Vec3x8) {
-        self.camera(scene).rays(pk, s)
-    }
-
     /// Radiance of pixel samples `samples` for each packet of `pks` (a tile), into `out`,
     /// sample-major: `out[si * pks.len() + p]` is packet p at sample `samples.start + si`
     /// (inactive lanes zero). `log` records every packet traced.
@@ -220,108 +116,43 @@ impl Integrator {
         c: &mut Counters,
         log: Option<&mut RayLog>,
     ) {
-        let mut ctx =
-            TileCtx { scene, camera: self.camera(scene), pks, tracer: Tracer::new(scene, c, log), scratch: sc };
-        if self.kind == IntegratorKind::PathTracer {
-            // The kernel compiled for the scene's lobes (see `kernel`).
-            return kernel::with_lobe_set!(self.kernel.lobes, L => path::tile::<L>(self, &mut ctx, samples, out));
+        let samples_handle = Samples::new(self, self.camera(scene));
+        let mut ctx = TileCtx { scene, samples: samples_handle, pks, tracer: Tracer::new(scene, c, log) };
+        let i = position(self.kind);
+        if sc.slots.len() < INTEGRATORS.len() {
+            sc.slots.resize_with(INTEGRATORS.len(), || None);
         }
-        out.clear();
-        // The camera's pixel-sample streams, hashed once for the batch (if a sample draws).
-        ctx.scratch.cam_streams.clear();
-        if samples.clone().any(|s| ctx.camera.draws(s)) {
-            ctx.camera.streams(pks, &mut ctx.scratch.cam_streams);
+        (INTEGRATORS[i].run)(self, &mut ctx, &mut sc.slots[i], samples, out);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every scene-format integrator runs through exactly one registry entry.
+    #[test]
+    fn every_kind_is_registered_once() {
+        for (name, kind) in IntegratorKind::NAMES {
+            let n = INTEGRATORS.iter().filter(|e| e.kind == *kind).count();
+            assert_eq!(n, 1, "{name} is registered {n} times");
         }
-        let mut one = std::mem::take(&mut ctx.scratch.one);
-        for s in samples {
-            kernel::with_lobe_set!(self.kernel.lobes, L => self.camera_hits_and_shade::<L>(&mut ctx, s, &mut one));
-            out.extend_from_slice(&one);
-        }
-        ctx.scratch.one = one;
+        assert_eq!(INTEGRATORS.len(), IntegratorKind::NAMES.len());
     }
 
-    /// Radiance of pixel sample `s` for each packet of the tile (direct lighting integrators): the
-    /// tile is processed as a wavefront: all camera packets are traced, then gathered (emission
-    /// counted), then shaded by the integrator.
-    fn camera_hits_and_shade<L: crate::bsdf::LobeSet>(&self, ctx: &mut TileCtx, s: u32, out: &mut Vec<Vec3x8>) {
-        let n = ctx.pks.len();
-        out.clear();
-        let sc = &mut *ctx.scratch;
-        // Packets and records are written in place (the buffers keep their length across samples;
-        // Embree resets a packet's hit ids itself).
-        sc.rh.truncate(n);
-        sc.rh.resize(n, (RayHit8::default(), ctx.pks[0].active));
-        sc.hits.truncate(n);
-        sc.hits.resize(n, SurfaceHit8::MISS);
-        // Camera packets: coherent primary rays from 4x2 pixel blocks.
-        for (i, (pk, (rh, active))) in ctx.pks.iter().zip(sc.rh.iter_mut()).enumerate() {
-            let (org, dir) = match sc.cam_streams.get(i) {
-                Some(stream) => ctx.camera.rays_in(pk, i as u32, stream, s),
-                None => ctx.camera.rays(pk, s),
-            };
-            *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
-        }
-        ctx.tracer.intersect_all(&mut sc.rh, RayKind::Camera);
-        // Gather: hit records to SoA shading records; emission.
-        for ((rh, traced), sh) in sc.rh.iter().zip(sc.hits.iter_mut()) {
-            ctx.scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced), sh);
-            out.push(masked(sh.emitted + sh.le, sh.valid));
-        }
-        match self.kind {
-            IntegratorKind::AnalyticDirect => {
-                for (o, sh) in out.iter_mut().zip(&sc.hits) {
-                    *o += analytic::radiance(ctx.scene, sh);
-                }
+    /// `docs/ARCHITECTURE.md` lists every declared dimension of every integrator as a row
+    /// `| \`kind\` | name | first | stride | layout |`, and no dimension twice within one.
+    #[test]
+    fn declared_dimensions_are_documented() {
+        let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/ARCHITECTURE.md")).unwrap();
+        for e in &INTEGRATORS {
+            for (i, d) in e.dims.iter().enumerate() {
+                let row =
+                    format!("| `{}` | {} | {} | {} | {} |", e.kind.name(), d.name, d.first, d.stride, d.source.name());
+                assert!(doc.contains(&row), "docs/ARCHITECTURE.md lacks the row\n{row}");
+                let twice = e.dims[..i].iter().any(|o| o.first == d.first);
+                assert!(!twice, "{}: dimension {} declared twice", e.kind.name(), d.first);
             }
-            IntegratorKind::RayTracer => {
-                for (o, sh) in out.iter_mut().zip(&sc.hits) {
-                    *o += whitted::radiance(ctx.scene, self.max_depth, sh, &mut ctx.tracer);
-                }
-            }
-            _ => direct::shade::<L>(self, ctx, s, out),
-        }
-        debug_assert_eq!(out.len(), n);
-    }
-}
-
-/// The progressive samplers' names, comma-separated (for messages).
-pub fn progressive_names() -> String {
-    crate::sampler::SAMPLERS.iter().filter(|s| s.progressive).map(|s| s.name).collect::<Vec<_>>().join(", ")
-}
-
-/// The layouts of one integrator.
-struct Sets {
-    pixel: PointSet,
-    light: PointSet,
-    light_table: GridTable,
-    path: GridTable,
-}
-
-impl Sets {
-    /// The layouts `samplers` asks for (defaults filled in) for `spp` samples and `n_light` light
-    /// samples per pixel sample.
-    fn resolve(d: &crate::scene::desc::SceneDesc, samplers: SamplerChoice, spp: u32, n_light: u32) -> Self {
-        let base = samplers.sampler.unwrap_or(SamplerKind::STRATIFIED);
-        let light_default = if d.integrator == IntegratorKind::PathTracer || d.light_stratify {
-            base
-        } else {
-            samplers.sampler.unwrap_or(SamplerKind::INDEPENDENT)
-        };
-        let pixel = samplers.pixel.unwrap_or(base);
-        let light = samplers.light.unwrap_or(light_default);
-        Self::build(d.integrator, [pixel, light, base], spp, n_light, d.width)
-    }
-
-    /// The sets of kinds [pixel, light, path].
-    fn build(kind: IntegratorKind, [pixel, light, path]: [SamplerKind; 3], spp: u32, n_light: u32, width: u32) -> Self {
-        // The light table spans all of a pixel's light samples: spp x N for `direct`, spp for
-        // the path tracer (one light sample per vertex).
-        let per_pixel = if kind == IntegratorKind::PathTracer { spp } else { spp.saturating_mul(n_light) };
-        Self {
-            pixel: PointSet::for_image(pixel, spp, width),
-            light: PointSet::for_image(light, n_light, width),
-            light_table: GridTable::new(PointSet::for_image(light, per_pixel, width)),
-            path: GridTable::new(PointSet::for_image(path, spp, width)),
         }
     }
 }

@@ -7,14 +7,45 @@
 //! `maxdepth` is the maximum number of mirror bounces after the camera hit (negative: 64).
 //! Quad lights, if any, are visible emitters only (`le`). Packets keep dead lanes masked.
 
-use super::context::{masked, Tracer};
-use super::RayKind;
+use super::context::{masked, TileCtx, Tracer};
+use super::estimator::Estimator;
+use super::primary::{self, Wave};
+use super::samples::{Dim, CAMERA};
+use super::settings::Integrator;
+use super::stats::RayKind;
 use crate::accel::{Hits8, Ray8, RayHit8};
+use crate::bsdf::LobeSet;
 use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::desc::IntegratorKind;
 use crate::simd::{Mask8, Vec3x8, F8};
 
 /// Mirror bounces when `maxdepth` is negative (unbounded is not meaningful without roulette).
 const UNBOUNDED_DEPTH: i32 = 64;
+
+/// The `raytracer` integrator: the camera-hit wavefront, shaded by [`radiance`] (no sampler
+/// dimension besides the pixel jitter).
+pub struct Whitted;
+
+impl Estimator for Whitted {
+    const KIND: IntegratorKind = IntegratorKind::RayTracer;
+    const DIMS: &'static [Dim] = &[CAMERA];
+    type Scratch = Wave;
+
+    fn tile<L: LobeSet>(
+        it: &Integrator,
+        ctx: &mut TileCtx,
+        wave: &mut Wave,
+        samples: std::ops::Range<u32>,
+        out: &mut Vec<Vec3x8>,
+    ) {
+        primary::tile(ctx, wave, samples, out, |ctx, hits, _, out| {
+            let scene = ctx.scene;
+            for (o, sh) in out.iter_mut().zip(hits) {
+                *o += radiance(scene, it.max_depth, sh, &mut ctx.tracer);
+            }
+        });
+    }
+}
 
 /// Radiance added to the camera hit `sh0` (its emission `emitted + le` is already counted by the
 /// caller): local shading of the camera hit and every mirror bounce, weighted by the product of ks.

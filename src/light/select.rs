@@ -168,6 +168,8 @@ const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightSampler {
     selection: LightSelection,
+    /// index in the scene's emitter list of this sampler's light 0 (see [`LightSampler::over_range`])
+    first: u32,
     n: u32,
     inv_n: f32,
     /// `Power`: probability of each light
@@ -183,12 +185,31 @@ impl LightSampler {
     pub fn new(emitters: &[Emitter], selection: LightSelection) -> Self {
         let n = emitters.len() as u32;
         let inv_n = if n > 0 { 1.0 / n as f32 } else { 0.0 };
-        let mut s = Self { selection, n, inv_n, power_pmf: Vec::new(), alias: Vec::new(), tree: LightTree::default() };
+        let mut s = Self {
+            selection,
+            first: 0,
+            n,
+            inv_n,
+            power_pmf: Vec::new(),
+            alias: Vec::new(),
+            tree: LightTree::default(),
+        };
         match selection {
             LightSelection::Power => (s.power_pmf, s.alias) = build_alias(emitters),
             LightSelection::Spatial => s.tree = LightTree::build(emitters),
             LightSelection::All | LightSelection::Uniform => {}
         }
+        s
+    }
+
+    /// Sampler of `selection` over the emitters `range` of the scene's list `emitters` (e.g.
+    /// `direct`'s power choice among the emissive triangles under `all`). `sample`, `pmf` and
+    /// `sample_remap` number the lights from the range's start; the `sample_point` functions
+    /// place points on the right lights of the whole list. Not for MIS at a light hit, whose
+    /// light ids are the whole list's.
+    pub fn over_range(emitters: &[Emitter], range: std::ops::Range<usize>, selection: LightSelection) -> Self {
+        let mut s = Self::new(&emitters[range.clone()], selection);
+        s.first = range.start as u32;
         s
     }
 
@@ -300,7 +321,7 @@ impl LightSampler {
         };
         let ok = active & pmf.simd_gt(F8::ZERO);
         let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
-        (emitters.place_x8(idx, inv_pmf, rest, v), ok)
+        (emitters.place_x8(idx + U8::splat(self.first), inv_pmf, rest, v), ok)
     }
 
     /// Probability that [`LightSampler::sample`] picks light `i` at `(p, n)`: bit-identical to
@@ -341,7 +362,7 @@ impl LightSampler {
         let (idx, pmf) = self.sample_x8(u_choice, p, n, active);
         let ok = active & pmf.simd_gt(F8::ZERO);
         let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
-        (emitters.place_x8(idx, inv_pmf, u, v), ok)
+        (emitters.place_x8(idx + U8::splat(self.first), inv_pmf, u, v), ok)
     }
 
     /// Eight-lane [`LightSampler::sample`]: `(light, pmf)` per lane; lanes that are inactive or

@@ -4,9 +4,9 @@
 //! switched to another registered kind ([`ReplaySets::with_kind`]). `strata profile` times the
 //! replay on one thread (`session::replay`).
 //!
-//! The render's call sites report their calls here (`camera.rs`: [`pixel_point`], or
-//! [`camera_streams`] and [`camera_point`]; `direct.rs`:
-//! [`light_streams`], [`light_point`]; `path.rs`: [`path_point`]) and `render.rs` brackets each
+//! The render reports its calls here from one place, the integrators' sample handle
+//! (`integrator/samples.rs`: [`pixel_point`], or [`camera_streams`] and [`camera_point`];
+//! [`light_streams`], [`light_point`]; [`path_point`]), and `render.rs` brackets each
 //! tile with [`tile_begin`]/[`tile_end`]. Off (the default), each report is one relaxed atomic
 //! load; recording only observes, so images are bit-identical either way.
 //!
@@ -337,7 +337,7 @@ fn stream_point(op: u32, stream: u32, k: u32) {
 }
 
 /// Reports a fresh table of camera streams, `pixel_set.stream_x8(pixel, sample, dim, seed)` for
-/// each of `pixels` in order (the pixel jitter of a batch of samples, see `camera.rs`).
+/// each of `pixels` in order (the pixel jitter of a batch of samples, see `integrator/samples.rs`).
 #[inline]
 pub fn camera_streams(pixels: impl IntoIterator<Item = U8>, sample: U8, dim: u32) {
     if recording() {

@@ -19,16 +19,20 @@
 //! from dim 0's first coordinate); dim 3 only where roulette or the lobe pick needs it. A
 //! dimension not drawn changes no other.
 
-use super::context::{masked, TileCtx};
-use super::direct::material;
-use super::{Integrator, RayKind};
+use super::context::{masked, material, TileCtx};
+use super::estimator::Estimator;
+use super::samples::{Dim, Samples, Source, CAMERA};
+use super::settings::Integrator;
+use super::stats::RayKind;
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
 use crate::light::emitters::LightSample8;
 use crate::light::select::{LightChoice, LightSelection};
+use crate::profile::Phase;
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::desc::IntegratorKind;
 use crate::scene::desc::{ImportanceSampling, Nee};
 use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
@@ -43,6 +47,41 @@ pub use sky::DIM_SKY_BASE;
 pub const DIM_PATH_BASE: u32 = 64;
 /// Hard cap on path vertices when `maxdepth -1` (Russian roulette normally ends paths far sooner).
 pub const MAX_VERTICES_UNBOUNDED: u32 = 4096;
+// The sky's dimensions follow every vertex's own.
+const _: () = assert!(DIM_SKY_BASE == DIM_PATH_BASE + 4 * MAX_VERTICES_UNBOUNDED);
+
+/// The light point of vertex v (2D; under `--light-choice reuse` its u also picks the light).
+pub const LIGHT_POINT: Dim = Dim { name: "light point", first: DIM_PATH_BASE, stride: 4, source: Source::Light };
+/// The light choice of vertex v (x), only under `--light-choice dimension` with several lights.
+pub const LIGHT_CHOICE: Dim = Dim { name: "light choice", first: DIM_PATH_BASE + 1, stride: 4, source: Source::Light };
+/// The BSDF direction of vertex v (2D).
+pub const DIRECTION: Dim = Dim { name: "BSDF direction", first: DIM_PATH_BASE + 2, stride: 4, source: Source::Path };
+/// (Russian roulette, lobe choice) of vertex v, drawn only where one of them is used.
+pub const ROULETTE_LOBE: Dim =
+    Dim { name: "roulette, lobe choice", first: DIM_PATH_BASE + 3, stride: 4, source: Source::Path };
+/// The sky's next event at vertex v (2D direction), with a sky only.
+pub const SKY: Dim = Dim { name: "sky direction", first: DIM_SKY_BASE, stride: 1, source: Source::Light };
+
+/// The `pathtracer` integrator (see the module docs).
+pub struct PathTracer;
+
+impl Estimator for PathTracer {
+    const KIND: IntegratorKind = IntegratorKind::PathTracer;
+    const DIMS: &'static [Dim] = &[CAMERA, LIGHT_POINT, LIGHT_CHOICE, DIRECTION, ROULETTE_LOBE, SKY];
+    type Scratch = PathScratch;
+
+    /// All paths of all the samples form one wavefront, so packets stay full even when Russian
+    /// roulette thins the paths out.
+    fn tile<L: LobeSet>(
+        it: &Integrator,
+        ctx: &mut TileCtx,
+        scratch: &mut PathScratch,
+        samples: std::ops::Range<u32>,
+        out: &mut Vec<Vec3x8>,
+    ) {
+        path_tile::<L>(it, ctx, scratch, samples, out)
+    }
+}
 
 // Columns of a live path (`Columns<PATH_COLS>`): the index of (tile packet, lane) whose pixel
 // sample it is, `packet * 8 + lane` (u32::MAX: a placeholder lane, traced inactive); the linear
@@ -86,30 +125,6 @@ pub struct PathScratch {
     shadow_rays: Vec<(Ray8, Mask8)>,
 }
 
-impl Integrator {
-    /// 2D point of path dimension `d` for pixel samples `s`, from the light table (light point,
-    /// light choice) or the path table (the others); grid layouts shuffle their strata per
-    /// (pixel, dim).
-    #[inline(always)]
-    fn path_point(&self, d: &PathDim, light: bool, pixel: U8, s: U8) -> (F8, F8) {
-        let _p = crate::profile::leaf(crate::profile::Phase::SamplerPath);
-        crate::sampler::replay::path_point(pixel, s, d.dim(), light);
-        if light { &self.light_table } else { &self.path_set }.path_point_x8(d, pixel, s)
-    }
-}
-
-/// Radiance of pixel samples `samples` for each packet of the tile by path tracing, into `out`
-/// (sample-major: `out[si * pks.len() + p]`). All paths of all these samples form one wavefront,
-/// so packets stay full even when Russian roulette thins the paths out.
-pub(super) fn tile<L: LobeSet>(
-    it: &Integrator,
-    ctx: &mut TileCtx,
-    samples: std::ops::Range<u32>,
-    out: &mut Vec<Vec3x8>,
-) {
-    it.path_tile::<L>(ctx, samples, out)
-}
-
 /// Vertex of the path packet being shaded: where it is and what it carries.
 struct Vertex<'a> {
     sh: &'a SurfaceHit8,
@@ -120,136 +135,139 @@ struct Vertex<'a> {
     beta: Vec3x8,
 }
 
-impl Integrator {
-    fn path_tile<L: LobeSet>(&self, ctx: &mut TileCtx, samples: std::ops::Range<u32>, out: &mut Vec<Vec3x8>) {
-        let TileCtx { scene, camera, pks, tracer, scratch } = ctx;
-        let PathScratch { paths, next, prev, next_prev, rh, sh, radiance, shadow, shadow_rays } = &mut scratch.path;
-        let sh = &mut **sh.get_or_insert_with(|| Box::new(SurfaceHit8::MISS));
-        let max_v = if self.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { self.max_depth as u32 + 1 };
-        // The previous vertex is kept only for a point-dependent light choice's MIS weight.
-        let keep_prev = self.nee == Nee::Mis && self.light_sampler.depends_on_point();
-        let n_samples = samples.len();
-        radiance.clear();
-        radiance.resize(pks.len() * n_samples, Vec3x8::ZERO);
-        // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks); lanes
-        // outside the image travel as inactive placeholders in the first packets.
-        let n = pks.len() * n_samples;
-        paths.set_packets(n);
-        prev.set_packets(if keep_prev { n } else { 0 });
-        rh.truncate(n);
-        rh.resize(n, (RayHit8::default(), F8::ZERO));
-        let lane = U8::new([0, 1, 2, 3, 4, 5, 6, 7]);
-        for (si, s) in samples.enumerate() {
-            for (p, pk) in pks.iter().enumerate() {
-                let ci = si * pks.len() + p;
-                let (org, dir) = camera.rays(pk, s);
-                let (r, active) = &mut rh[ci];
-                *active = r.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
-                let slot = U8::splat(ci as u32 * 8) + lane;
-                paths.set(SLOT, ci, pk.active.select(bits(slot), bits(U8::MAX)));
-                paths.set(PIXEL, ci, bits(pk.pixel));
-                paths.set(SAMPLE, ci, bits(U8::splat(s)));
-                for c in 0..3 {
-                    paths.set(BETA + c, ci, F8::ONE);
-                }
-                paths.set(PDF, ci, F8::ZERO);
-                if keep_prev {
-                    for c in 0..6 {
-                        prev.set(c, ci, if c == PREV_N + 2 { F8::ONE } else { F8::ZERO });
-                    }
+/// Radiance of pixel samples `samples` of every packet of the tile by path tracing (see
+/// [`Estimator::tile`]).
+fn path_tile<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    scratch: &mut PathScratch,
+    samples: std::ops::Range<u32>,
+    out: &mut Vec<Vec3x8>,
+) {
+    let TileCtx { scene, samples: smp, pks, tracer } = ctx;
+    let PathScratch { paths, next, prev, next_prev, rh, sh, radiance, shadow, shadow_rays } = scratch;
+    let sh = &mut **sh.get_or_insert_with(|| Box::new(SurfaceHit8::MISS));
+    let max_v = if it.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { it.max_depth as u32 + 1 };
+    // The previous vertex is kept only for a point-dependent light choice's MIS weight.
+    let keep_prev = it.nee == Nee::Mis && it.light_sampler.depends_on_point();
+    let n_samples = samples.len();
+    radiance.clear();
+    radiance.resize(pks.len() * n_samples, Vec3x8::ZERO);
+    // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks); lanes
+    // outside the image travel as inactive placeholders in the first packets.
+    let n = pks.len() * n_samples;
+    paths.set_packets(n);
+    prev.set_packets(if keep_prev { n } else { 0 });
+    rh.truncate(n);
+    rh.resize(n, (RayHit8::default(), F8::ZERO));
+    let lane = U8::new([0, 1, 2, 3, 4, 5, 6, 7]);
+    for (si, s) in samples.enumerate() {
+        for (p, pk) in pks.iter().enumerate() {
+            let ci = si * pks.len() + p;
+            let (org, dir) = smp.camera_rays(pk, s);
+            let (r, active) = &mut rh[ci];
+            *active = r.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
+            let slot = U8::splat(ci as u32 * 8) + lane;
+            paths.set(SLOT, ci, pk.active.select(bits(slot), bits(U8::MAX)));
+            paths.set(PIXEL, ci, bits(pk.pixel));
+            paths.set(SAMPLE, ci, bits(U8::splat(s)));
+            for c in 0..3 {
+                paths.set(BETA + c, ci, F8::ONE);
+            }
+            paths.set(PDF, ci, F8::ZERO);
+            if keep_prev {
+                for c in 0..6 {
+                    prev.set(c, ci, if c == PREV_N + 2 { F8::ONE } else { F8::ZERO });
                 }
             }
         }
-        let mut v = 1u32;
-        while paths.len() > 0 && v <= max_v {
-            let n_packets = paths.packets();
-            if v > 1 {
-                // Full packets of 8 live paths, written in place (Embree resets a packet's hit
-                // ids itself).
-                rh.truncate(n_packets);
-                rh.resize(n_packets, (RayHit8::default(), F8::ZERO));
-                for (ci, (r, active)) in rh.iter_mut().enumerate() {
-                    let live = F8::from_bits(!paths.get_u(SLOT, ci).simd_eq(U8::MAX));
-                    let (o, d) = (paths.get3(O, ci), paths.get3(D, ci));
-                    *active = r.ray.set(o, d, F8::ZERO, F8::splat(f32::INFINITY), live);
-                }
-            }
-            tracer.intersect_all(rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
-            next.clear();
-            next_prev.clear();
-            shadow.clear();
-            let dims = DIM_PATH_BASE + 4 * (v - 1);
-            // Dims 0 and 1 (light point, light choice) are light dimensions, 2 and 3 the others.
-            let dk: [PathDim; 4] = std::array::from_fn(|j| {
-                let table = if j < 2 { &self.light_table } else { &self.path_set };
-                table.path_dim(self.spp, dims + j as u32, self.seed)
-            });
-            let dsky = sky::sky_dim(self, scene.sky.as_ref(), v);
-            let mut b = Bounce { it: self, scene, v, max_v, dk: &dk, dsky, keep_prev, next, next_prev, shadow };
-            for (ci, (r, traced)) in rh.iter().enumerate() {
-                // A packet without a traced lane hits nothing: no emission, no continuation.
-                if traced.none() {
-                    continue;
-                }
-                scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
-                let missed = *traced & !sh.valid;
-                if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
-                    let le = sky::escaped(self, sky, v, paths.get(PDF, ci), missed);
-                    add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
-                }
-                if sh.valid.none() {
-                    continue;
-                }
-                let vx = Vertex {
-                    sh,
-                    rh: r,
-                    slot: paths.get_u(SLOT, ci),
-                    pixel: paths.get_u(PIXEL, ci),
-                    s: paths.get_u(SAMPLE, ci),
-                    beta: paths.get3(BETA, ci),
-                };
-                let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
-                let le = b.emission(&vx, paths.get(PDF, ci), pp, pn);
-                add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
-                b.shade::<L>(&vx);
-            }
-            // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
-            shadow.fill_tail(S_SLOT, bits(U8::MAX));
-            let n_shadow = shadow.packets();
-            shadow_rays.truncate(n_shadow);
-            shadow_rays.resize(n_shadow, (Ray8::default(), F8::ZERO));
-            for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
-                let active = F8::from_bits(!shadow.get_u(S_SLOT, j).simd_eq(U8::MAX));
-                let (o, d) = (shadow.get3(S_O, j), shadow.get3(S_D, j));
-                *lit = ray.set(o, d, F8::ZERO, shadow.get(S_TFAR, j), active);
-            }
-            let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
-            for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
-                let occluded = tracer.occluded(ray, *lit);
-                add_lanes(radiance, shadow.get_u(S_SLOT, j), shadow.get3(S_C, j), *lit & !occluded);
-            }
-            drop(occluded_batch);
-            next.fill_tail(SLOT, bits(U8::MAX));
-            std::mem::swap(paths, next);
-            std::mem::swap(prev, next_prev);
-            v += 1;
-        }
-        // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
-        // non-finite samples are left as they are, for the film to count and drop.
-        if let Some(m) = self.clamp {
-            for r in radiance.iter_mut() {
-                let mut l = r.to_lanes();
-                for c in l.iter_mut() {
-                    let top = c.max_element();
-                    if top > m {
-                        *c *= m / top;
-                    }
-                }
-                *r = Vec3x8::from_lanes(l);
-            }
-        }
-        std::mem::swap(out, radiance);
     }
+    let mut v = 1u32;
+    while paths.len() > 0 && v <= max_v {
+        let n_packets = paths.packets();
+        if v > 1 {
+            // Full packets of 8 live paths, written in place (Embree resets a packet's hit
+            // ids itself).
+            rh.truncate(n_packets);
+            rh.resize(n_packets, (RayHit8::default(), F8::ZERO));
+            for (ci, (r, active)) in rh.iter_mut().enumerate() {
+                let live = F8::from_bits(!paths.get_u(SLOT, ci).simd_eq(U8::MAX));
+                let (o, d) = (paths.get3(O, ci), paths.get3(D, ci));
+                *active = r.ray.set(o, d, F8::ZERO, F8::splat(f32::INFINITY), live);
+            }
+        }
+        tracer.intersect_all(rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
+        next.clear();
+        next_prev.clear();
+        shadow.clear();
+        let dims = LIGHT_POINT.at(v - 1);
+        // Dims 0 and 1 (light point, light choice) are light dimensions, 2 and 3 the others.
+        let dk: [PathDim; 4] = std::array::from_fn(|j| smp.table_dim(j < 2, it.spp, dims + j as u32));
+        let dsky = scene.sky.as_ref().map(|_| smp.table_dim(true, it.spp, SKY.at(v - 1)));
+        let mut b = Bounce { it, smp, scene, v, max_v, dk: &dk, dsky, keep_prev, next, next_prev, shadow };
+        for (ci, (r, traced)) in rh.iter().enumerate() {
+            // A packet without a traced lane hits nothing: no emission, no continuation.
+            if traced.none() {
+                continue;
+            }
+            scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
+            let missed = *traced & !sh.valid;
+            if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
+                let le = sky::escaped(it, sky, v, paths.get(PDF, ci), missed);
+                add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
+            }
+            if sh.valid.none() {
+                continue;
+            }
+            let vx = Vertex {
+                sh,
+                rh: r,
+                slot: paths.get_u(SLOT, ci),
+                pixel: paths.get_u(PIXEL, ci),
+                s: paths.get_u(SAMPLE, ci),
+                beta: paths.get3(BETA, ci),
+            };
+            let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
+            let le = b.emission(&vx, paths.get(PDF, ci), pp, pn);
+            add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
+            b.shade::<L>(&vx);
+        }
+        // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
+        shadow.fill_tail(S_SLOT, bits(U8::MAX));
+        let n_shadow = shadow.packets();
+        shadow_rays.truncate(n_shadow);
+        shadow_rays.resize(n_shadow, (Ray8::default(), F8::ZERO));
+        for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
+            let active = F8::from_bits(!shadow.get_u(S_SLOT, j).simd_eq(U8::MAX));
+            let (o, d) = (shadow.get3(S_O, j), shadow.get3(S_D, j));
+            *lit = ray.set(o, d, F8::ZERO, shadow.get(S_TFAR, j), active);
+        }
+        let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
+        for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
+            let occluded = tracer.occluded(ray, *lit);
+            add_lanes(radiance, shadow.get_u(S_SLOT, j), shadow.get3(S_C, j), *lit & !occluded);
+        }
+        drop(occluded_batch);
+        next.fill_tail(SLOT, bits(U8::MAX));
+        std::mem::swap(paths, next);
+        std::mem::swap(prev, next_prev);
+        v += 1;
+    }
+    // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
+    // non-finite samples are left as they are, for the film to count and drop.
+    if let Some(m) = it.clamp {
+        for r in radiance.iter_mut() {
+            let mut l = r.to_lanes();
+            for c in l.iter_mut() {
+                let top = c.max_element();
+                if top > m {
+                    *c *= m / top;
+                }
+            }
+            *r = Vec3x8::from_lanes(l);
+        }
+    }
+    std::mem::swap(out, radiance);
 }
 
 /// +z in every lane.
@@ -259,6 +277,7 @@ const Z: Vec3x8 = Vec3x8 { x: F8::ZERO, y: F8::ZERO, z: F8::ONE };
 /// bounce's paths, this bounce's shadow rays).
 struct Bounce<'a> {
     it: &'a Integrator,
+    smp: &'a Samples<'a>,
     scene: &'a Scene,
     v: u32,
     max_v: u32,
@@ -344,8 +363,12 @@ impl Bounce<'_> {
             self.sky_next_event::<L>(vx, &frame, wo, &mat, o, shade, leaves);
         }
         if nee_here && n_lights > 0 {
-            let u_choice = if own_choice { it.path_point(&self.dk[1], true, pixel, s).0 } else { F8::ZERO };
-            let (u, w) = it.path_point(&self.dk[0], true, pixel, s);
+            let u_choice = if own_choice {
+                self.smp.table_point(&self.dk[1], true, Phase::SamplerPath, pixel, s).0
+            } else {
+                F8::ZERO
+            };
+            let (u, w) = self.smp.table_point(&self.dk[0], true, Phase::SamplerPath, pixel, s);
             let shadow = &mut *self.shadow;
             let mut push = |ls: &LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
                 let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
@@ -435,11 +458,11 @@ impl Bounce<'_> {
         if bounce_here {
             // (Russian roulette, lobe choice): drawn only where one of them is used.
             let (u_rr, u_lobe) = if it.russian_roulette || it.strategy == ImportanceSampling::Brdf {
-                it.path_point(&self.dk[3], false, pixel, s)
+                self.smp.table_point(&self.dk[3], false, Phase::SamplerPath, pixel, s)
             } else {
                 (F8::ZERO, F8::ZERO)
             };
-            let u2 = it.path_point(&self.dk[2], false, pixel, s);
+            let u2 = self.smp.table_point(&self.dk[2], false, Phase::SamplerPath, pixel, s);
             let (wi_l, pdf, f) = {
                 let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
                 mat.sample_k::<L>(it.strategy, wo, [u2.0, u2.1], u_lobe, shade)
@@ -468,6 +491,34 @@ impl Bounce<'_> {
                 }
             }
         }
+    }
+}
+
+impl Bounce<'_> {
+    /// The sky's next event at the shaded lanes `shade` of `vx` ([`sky::next_event`]), pushed as
+    /// a shadow ray to infinity from `o`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn sky_next_event<L: LobeSet>(
+        &mut self,
+        vx: &Vertex,
+        frame: &Frame8,
+        wo: Vec3x8,
+        mat: &crate::bsdf::Material8,
+        o: Vec3x8,
+        shade: Mask8,
+        leaves: impl Fn(Vec3x8) -> Mask8,
+    ) {
+        let (Some(sky), Some(dim)) = (self.scene.sky.as_ref(), self.dsky.as_ref()) else { return };
+        let uw = self.smp.table_point(dim, true, Phase::SamplerPath, vx.pixel, vx.s);
+        let Some((lit, wi, c)) = sky::next_event::<L>(self.it, sky, uw, frame, wo, mat, vx.beta, shade, leaves) else {
+            return;
+        };
+        let inf = F8::splat(f32::INFINITY);
+        let pack = Pack::of(lit);
+        let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, inf, c.x, c.y, c.z];
+        self.shadow.write(S_SLOT, &pack, &row);
+        self.shadow.advance(&pack);
     }
 }
 

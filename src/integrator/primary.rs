@@ -1,0 +1,72 @@
+//! The camera-hit wavefront shared by the direct-lighting integrators (`raytracer`,
+//! `analyticdirect`, `direct`): for each pixel sample, all camera packets of the tile are traced,
+//! then gathered (emission counted), then shaded by the integrator's closure.
+
+use super::context::{masked, TileCtx};
+use super::stats::RayKind;
+use crate::accel::{Hits8, RayHit8};
+use crate::sampler::Stream;
+use crate::scene::build::SurfaceHit8;
+use crate::simd::{Mask8, Vec3x8, F8, U8};
+
+/// Per-thread buffers of the camera-hit wavefront, reused across samples and tiles.
+#[derive(Default)]
+pub struct Wave {
+    rh: Vec<(RayHit8, Mask8)>,
+    hits: Vec<SurfaceHit8>,
+    cam_streams: Vec<Stream<U8>>,
+    one: Vec<Vec3x8>,
+}
+
+/// Radiance of pixel samples `samples` of the tile's packets into `out` (sample-major, as
+/// `Estimator::tile`): emission at the camera hits plus what `shade(ctx, hits, s, radiance)`
+/// adds to `radiance` (one entry per packet, holding the emission) at the hits of sample `s`.
+pub(super) fn tile(
+    ctx: &mut TileCtx,
+    wave: &mut Wave,
+    samples: std::ops::Range<u32>,
+    out: &mut Vec<Vec3x8>,
+    mut shade: impl FnMut(&mut TileCtx, &[SurfaceHit8], u32, &mut [Vec3x8]),
+) {
+    out.clear();
+    // The camera's pixel-sample streams, hashed once for the batch (if a sample draws).
+    wave.cam_streams.clear();
+    if samples.clone().any(|s| ctx.samples.camera_draws(s)) {
+        ctx.samples.camera_streams(ctx.pks, &mut wave.cam_streams);
+    }
+    let mut one = std::mem::take(&mut wave.one);
+    for s in samples {
+        camera_hits(ctx, wave, s, &mut one);
+        shade(ctx, &wave.hits, s, &mut one);
+        debug_assert_eq!(one.len(), ctx.pks.len());
+        out.extend_from_slice(&one);
+    }
+    wave.one = one;
+}
+
+/// The camera hits of pixel sample `s` of every packet into `wave.hits`, their emission into
+/// `out` (one entry per packet).
+fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>) {
+    let n = ctx.pks.len();
+    out.clear();
+    // Packets and records are written in place (the buffers keep their length across samples;
+    // Embree resets a packet's hit ids itself).
+    wave.rh.truncate(n);
+    wave.rh.resize(n, (RayHit8::default(), ctx.pks[0].active));
+    wave.hits.truncate(n);
+    wave.hits.resize(n, SurfaceHit8::MISS);
+    // Camera packets: coherent primary rays from 4x2 pixel blocks.
+    for (i, (pk, (rh, active))) in ctx.pks.iter().zip(wave.rh.iter_mut()).enumerate() {
+        let (org, dir) = match wave.cam_streams.get(i) {
+            Some(stream) => ctx.samples.camera_rays_in(pk, i as u32, stream, s),
+            None => ctx.samples.camera_rays(pk, s),
+        };
+        *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
+    }
+    ctx.tracer.intersect_all(&mut wave.rh, RayKind::Camera);
+    // Gather: hit records to SoA shading records; emission.
+    for ((rh, traced), sh) in wave.rh.iter().zip(wave.hits.iter_mut()) {
+        ctx.scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced), sh);
+        out.push(masked(sh.emitted + sh.le, sh.valid));
+    }
+}
