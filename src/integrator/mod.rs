@@ -45,6 +45,9 @@ pub use samples::{Dim, Samples, Source};
 pub use settings::{progressive_names, Integrator, NotProgressive, SamplerChoice};
 pub use stats::{Counters, RayKind, RayLog};
 
+/// An integrator's scratch slot: its `Estimator::Scratch`, made on first use.
+type Slot = Option<Box<dyn Any + Send>>;
+
 /// One registered integrator: its scene-format kind, its declared dimensions and its tile
 /// function (monomorphized for every compiled lobe set).
 pub struct Entry {
@@ -52,7 +55,7 @@ pub struct Entry {
     pub kind: IntegratorKind,
     /// the sampler dimensions it draws
     pub dims: &'static [Dim],
-    run: fn(&Integrator, &mut TileCtx, &mut Option<Box<dyn Any + Send>>, std::ops::Range<u32>, &mut Vec<Vec3x8>),
+    run: fn(&Integrator, &mut TileCtx, &mut Slot, std::ops::Range<u32>, &mut Vec<Vec3x8>),
 }
 
 /// The registry entry of estimator `E`.
@@ -65,7 +68,7 @@ const fn entry<E: Estimator + 'static>() -> Entry {
 fn run<E: Estimator + 'static>(
     it: &Integrator,
     ctx: &mut TileCtx,
-    slot: &mut Option<Box<dyn Any + Send>>,
+    slot: &mut Slot,
     samples: std::ops::Range<u32>,
     out: &mut Vec<Vec3x8>,
 ) {
@@ -98,7 +101,7 @@ pub fn entry_of(kind: IntegratorKind) -> &'static Entry {
 /// reused across tiles.
 #[derive(Default)]
 pub struct Scratch {
-    slots: Vec<Option<Box<dyn Any + Send>>>,
+    slots: Vec<Slot>,
 }
 
 impl Integrator {
