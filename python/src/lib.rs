@@ -20,7 +20,8 @@ use strata::session::{self, RenderOptions};
 create_exception!(_strata, StrataError, PyRuntimeError, "An error strata reports (the CLI's message).");
 
 fn err(e: impl ToString) -> PyErr {
-    StrataError::new_err(e.to_string())
+    // The CLI's message without the line end a clap error carries.
+    StrataError::new_err(e.to_string().trim_end().to_string())
 }
 
 /// f64 values from little-endian bytes.

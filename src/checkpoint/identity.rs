@@ -95,7 +95,8 @@ impl Header {
                 format!("{k} {} ({label}: {})", show(self.options.get(k)), show(want.options.get(k)))
             })
             .collect();
-        let approx = self.options.get("embree_approx") != want.options.get("embree_approx");
+        // Both parts ran Embree's AVX2 kernels, on CPUs whose approximations differ.
+        let approx = matches!((approx_of(self), approx_of(want)), (Some(a), Some(b)) if a != b);
         let hint = if approx {
             "; this CPU's approximate reciprocals (vrcpps, used by Embree's AVX2 kernels) differ from the \
              other's, so their pixels can differ: render every part with STRATA_EMBREE_CONFIG=isa=avx512 \
@@ -105,6 +106,11 @@ impl Header {
         };
         (!diffs.is_empty()).then(|| format!("it was rendered with other options: {}{hint}", diffs.join(", ")))
     }
+}
+
+/// A header's `embree_approx` when it is a `vrcpps` fingerprint (Embree's AVX2 kernels).
+fn approx_of(h: &Header) -> Option<&str> {
+    h.options.get("embree_approx").and_then(|v| v.as_str()).filter(|v| v.starts_with("rcpps-"))
 }
 
 /// The build of this binary (`STRATA_BUILD` from build.rs: a hash of what was compiled into it).
