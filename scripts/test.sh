@@ -26,7 +26,8 @@ if [ ${#args[@]} -eq 0 ]; then
   echo "test: cargo clippy --release --workspace --all-targets -- -D warnings" >&2
   cargo clippy --release --workspace --all-targets -- -D warnings
 fi
-cargo test --release ${args[@]+"${args[@]}"}
+# --no-fail-fast: one failing test binary does not hide the others' results (the exit status still fails).
+cargo test --release --no-fail-fast ${args[@]+"${args[@]}"}
 if [ ${#args[@]} -eq 0 ]; then
   # The Python module (scripts/setup.sh --python builds it into .venv), tested against the binary
   # cargo test just built.
