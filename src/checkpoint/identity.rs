@@ -147,7 +147,7 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("light_choice", json!(it.light_choice.name())),
         ("layout", json!(if time_budget { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
-        ("clamp", json!(it.clamp)),
+        ("clamp", json!(it.path.clamp)),
         ("first_sample", json!(it.first_sample.name())),
         ("light_selection", json!(it.light_selection.name())),
     ]

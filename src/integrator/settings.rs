@@ -4,11 +4,12 @@
 //! dispatches to the registered estimator.
 
 use super::kernel::Kernel;
+use super::path::settings::PathSettings;
 use crate::camera::{Camera, FirstSample};
 use crate::light::select::{LightChoice, LightSampler, LightSelection};
 use crate::sampler::{GridTable, PointSet, SamplerKind};
 use crate::scene::build::Scene;
-use crate::scene::desc::{ImportanceSampling, IntegratorKind, Nee};
+use crate::scene::desc::IntegratorKind;
 
 /// The samplers asked for (`--sampler`, `--pixel-sampler`, `--light-sampler`); `None` takes the
 /// default. `sampler` sets every dimension, the other two override theirs.
@@ -59,19 +60,12 @@ pub struct Integrator {
     /// path tracer: layout of the other path dimensions (direction, lobe, roulette) over the spp
     /// samples of a pixel
     pub path_set: GridTable,
-    /// path tracer: next event estimation
-    pub nee: Nee,
-    /// path tracer: Russian roulette
-    pub russian_roulette: bool,
-    /// path tracer: direction sampling strategy
-    pub strategy: ImportanceSampling,
-    /// path tracer: maximum bounces (-1 = unbounded)
+    /// the path tracer's own settings (NEE, roulette, strategy, clamp)
+    pub path: PathSettings,
+    /// `raytracer` and path tracer: maximum bounces (-1 = unbounded)
     pub max_depth: i32,
     /// the kernel that runs (specialized for the scene's features, or [`Kernel::GENERAL`])
     pub kernel: Kernel,
-    /// path tracer, opt-in and biased: each pixel sample is scaled so its largest channel is at
-    /// most this radiance (None: no clamping, the unbiased default)
-    pub clamp: Option<f32>,
     /// where pixel sample 0 goes ([`FirstSample`]; `new` gives `Jittered`)
     pub first_sample: FirstSample,
     /// how NEE chooses lights (`new` gives [`LightSelection::Uniform`]; see
@@ -103,12 +97,9 @@ impl Integrator {
             light_set: sets.light,
             light_table: sets.light_table,
             path_set: sets.path,
-            nee: d.nee,
-            russian_roulette: d.russian_roulette,
-            strategy: d.importance_sampling,
+            path: PathSettings::of(d),
             max_depth: d.max_depth,
             kernel: Kernel::for_scene(scene),
-            clamp: None,
             first_sample: FirstSample::Jittered,
             light_selection: LightSelection::Uniform,
             light_choice: LightChoice::Reuse,

@@ -167,7 +167,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
-    integrator.clamp = opts.clamp;
+    integrator.path.clamp = opts.clamp;
     integrator.first_sample = super::options::default_first_sample(opts);
     // `--light-selection`, else the scene's `lightselection`, else `all` for `direct` (its loop over
     // every light) and the default of the scene's kind for the path tracer.

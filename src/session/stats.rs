@@ -37,16 +37,16 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "occupancy_by_kind": { "bounce": c.bounce_occupancy(), "shadow": c.shadow_occupancy() },
         "mean_path_length": c.mean_path_length(),
         "max_depth": out.integrator.max_depth,
-        "nee": out.integrator.nee.name(),
-        "russian_roulette": out.integrator.russian_roulette,
-        "importance_sampling": out.integrator.strategy.name(),
+        "nee": out.integrator.path.nee.name(),
+        "russian_roulette": out.integrator.path.russian_roulette,
+        "importance_sampling": out.integrator.path.strategy.name(),
         "nonfinite_samples": c.nonfinite,
-        "clamp": out.integrator.clamp,
-        "biased": out.integrator.clamp.is_some(),
+        "clamp": out.integrator.path.clamp,
+        "biased": out.integrator.path.clamp.is_some(),
         "first_sample": out.integrator.first_sample.name(),
         "light_selection": out.integrator.light_selection.name(),
         "quantize": out.header.options.get("quantize"),
-        "features": features_json(&out.scene, d.integrator, out.integrator.nee, out.integrator.russian_roulette, out.integrator.strategy),
+        "features": features_json(&out.scene, d.integrator, out.integrator.path.nee, out.integrator.path.russian_roulette, out.integrator.path.strategy),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
     })
@@ -71,12 +71,12 @@ pub fn summary(out: &RenderOutput) -> String {
                 it.path_set.set().kind().name(),
                 it.pixel_set.kind().name(),
                 it.light_set.kind().name(),
-                it.nee.name(),
+                it.path.nee.name(),
                 it.light_selection.name(),
-                it.strategy.name(),
-                if it.russian_roulette { "on" } else { "off" },
+                it.path.strategy.name(),
+                if it.path.russian_roulette { "on" } else { "off" },
                 it.max_depth
-            ) + &it.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default()
+            ) + &it.path.clamp.map(|m| format!(", CLAMPED at {m}: biased")).unwrap_or_default()
         }
         _ => String::new(),
     };

@@ -38,6 +38,7 @@ use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 use wave::{add_lanes, bits, Columns, Pack};
 
+pub mod settings;
 mod sky;
 mod wave;
 
@@ -149,7 +150,7 @@ fn path_tile<L: LobeSet>(
     let sh = &mut **sh.get_or_insert_with(|| Box::new(SurfaceHit8::MISS));
     let max_v = if it.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { it.max_depth as u32 + 1 };
     // The previous vertex is kept only for a point-dependent light choice's MIS weight.
-    let keep_prev = it.nee == Nee::Mis && it.light_sampler.depends_on_point();
+    let keep_prev = it.path.nee == Nee::Mis && it.light_sampler.depends_on_point();
     let n_samples = samples.len();
     radiance.clear();
     radiance.resize(pks.len() * n_samples, Vec3x8::ZERO);
@@ -255,7 +256,7 @@ fn path_tile<L: LobeSet>(
     }
     // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
     // non-finite samples are left as they are, for the film to count and drop.
-    if let Some(m) = it.clamp {
+    if let Some(m) = it.path.clamp {
         for r in radiance.iter_mut() {
             let mut l = r.to_lanes();
             for c in l.iter_mut() {
@@ -304,7 +305,7 @@ impl Bounce<'_> {
         if is_light.none() {
             return le;
         }
-        let light_w = match it.nee {
+        let light_w = match it.path.nee {
             Nee::Off => F8::ONE,
             Nee::On => F8::splat(if v == 1 { 1.0 } else { 0.0 }),
             Nee::Mis if v == 1 => F8::ONE,
@@ -333,7 +334,7 @@ impl Bounce<'_> {
     #[inline]
     fn shade<L: LobeSet>(&mut self, vx: &Vertex) {
         let (it, scene, sh, v, max_v) = (self.it, self.scene, vx.sh, self.v, self.max_v);
-        let (nee, n_lights) = (it.nee, scene.emitters.len() as u32);
+        let (nee, n_lights) = (it.path.nee, scene.emitters.len() as u32);
         let is_light = F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
         // Shading frame: the normal faces wo, so wo.z > 0 in local coordinates.
         let shade = sh.valid & !is_light;
@@ -384,7 +385,7 @@ impl Bounce<'_> {
                 }
                 let (f, pdf_b) = {
                     let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-                    mat.eval_pdf_k::<L>(it.strategy, wo, frame.to_local(wi), lit)
+                    mat.eval_pdf_k::<L>(it.path.strategy, wo, frame.to_local(wi), lit)
                 };
                 // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
                 let mut g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
@@ -457,7 +458,7 @@ impl Bounce<'_> {
         // Continue the path: sample the BSDF, then Russian roulette.
         if bounce_here {
             // (Russian roulette, lobe choice): drawn only where one of them is used.
-            let (u_rr, u_lobe) = if it.russian_roulette || it.strategy == ImportanceSampling::Brdf {
+            let (u_rr, u_lobe) = if it.path.russian_roulette || it.path.strategy == ImportanceSampling::Brdf {
                 self.smp.table_point(&self.dk[3], false, Phase::SamplerPath, pixel, s)
             } else {
                 (F8::ZERO, F8::ZERO)
@@ -465,7 +466,7 @@ impl Bounce<'_> {
             let u2 = self.smp.table_point(&self.dk[2], false, Phase::SamplerPath, pixel, s);
             let (wi_l, pdf, f) = {
                 let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
-                mat.sample_k::<L>(it.strategy, wo, [u2.0, u2.1], u_lobe, shade)
+                mat.sample_k::<L>(it.path.strategy, wo, [u2.0, u2.1], u_lobe, shade)
             };
             let cos = wi_l.z;
             let wi = frame.to_world(wi_l);
@@ -473,7 +474,7 @@ impl Bounce<'_> {
                 shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO) & leaves(wi);
             let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
             let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
-            if it.russian_roulette {
+            if it.path.russian_roulette {
                 let q = nb.max_elem().min(F8::ONE);
                 alive &= u_rr.simd_lt(q);
                 nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));

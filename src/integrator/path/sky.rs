@@ -17,7 +17,7 @@ pub const DIM_SKY_BASE: u32 = 64 + 4 * 4096;
 /// scene (`missed`), their direction sampled with `pdf`.
 #[inline]
 pub(super) fn escaped(it: &Integrator, sky: &Sky, v: u32, pdf: F8, missed: Mask8) -> Vec3x8 {
-    sky.escaped_x8(it.nee != Nee::Off, it.nee == Nee::Mis, v, pdf, missed)
+    sky.escaped_x8(it.path.nee != Nee::Off, it.path.nee == Nee::Mis, v, pdf, missed)
 }
 
 /// The sky's next event at the shaded lanes `shade` of a vertex with throughput `beta`: one
@@ -45,9 +45,9 @@ pub(super) fn next_event<L: LobeSet>(
     }
     let (f, pdf_b) = {
         let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-        mat.eval_pdf_k::<L>(it.strategy, wo, wi_l, lit)
+        mat.eval_pdf_k::<L>(it.path.strategy, wo, wi_l, lit)
     };
-    let weight = Sky::nee_weight_x8(it.nee == Nee::Mis, pdf_b, lit);
+    let weight = Sky::nee_weight_x8(it.path.nee == Nee::Mis, pdf_b, lit);
     let g = lit.select(wi_l.z / pdf * weight, F8::ZERO);
     Some((lit, wi, beta.mul_elem(f).mul_elem(Vec3x8::splat(sky.radiance)).scale(g)))
 }
