@@ -80,7 +80,7 @@ fn run<E: Estimator + 'static>(
 
 /// Every integrator, one line each. A new integrator is its file, its line here and its
 /// `IntegratorKind` (the name the scene format and `--integrator` use).
-pub static INTEGRATORS: [Entry; 4] = [
+pub static INTEGRATORS: &[Entry] = &[
     entry::<whitted::Whitted>(),
     entry::<analytic::Analytic>(),
     entry::<direct::Direct>(),
@@ -90,11 +90,6 @@ pub static INTEGRATORS: [Entry; 4] = [
 /// The registry position of `kind` (every kind is registered: tested).
 fn position(kind: IntegratorKind) -> usize {
     INTEGRATORS.iter().position(|e| e.kind == kind).expect("every IntegratorKind is in INTEGRATORS")
-}
-
-/// The registry entry of `kind`.
-pub fn entry_of(kind: IntegratorKind) -> &'static Entry {
-    &INTEGRATORS[position(kind)]
 }
 
 /// Per-thread scratch buffers of the integrators (each integrator's own, made on first use),
@@ -148,7 +143,7 @@ mod tests {
     #[test]
     fn declared_dimensions_are_documented() {
         let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/ARCHITECTURE.md")).unwrap();
-        for e in &INTEGRATORS {
+        for e in INTEGRATORS {
             for (i, d) in e.dims.iter().enumerate() {
                 let row =
                     format!("| `{}` | {} | {} | {} | {} |", e.kind.name(), d.name, d.first, d.stride, d.source.name());

@@ -113,23 +113,6 @@ pub struct LightSample8 {
     pub light: U8,
 }
 
-/// Scalar twin of [`LightSample8`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LightSample {
-    /// the point, world space
-    pub y: Vec3,
-    /// unit emitting normal of the chosen light
-    pub normal: Vec3,
-    /// its radiance
-    pub radiance: Vec3,
-    /// its area
-    pub area: f32,
-    /// 1 / probability of having chosen it
-    pub inv_pmf: f32,
-    /// index into [`Emitters::list`]
-    pub light: u32,
-}
-
 /// The scene's area lights.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Emitters {
@@ -161,12 +144,6 @@ impl Emitters {
     /// Number of emissive triangles.
     pub fn n_triangles(&self) -> usize {
         self.list.len() - self.n_quads
-    }
-
-    /// Scalar twin of [`Emitters::place_x8`].
-    pub fn place(&self, i: u32, inv_pmf: f32, u: f32, v: f32) -> LightSample {
-        let e = &self.list[i as usize];
-        LightSample { y: e.point(u, v), normal: e.normal, radiance: e.radiance, area: e.area, inv_pmf, light: i }
     }
 
     /// The points `(u, v)` on lights `idx` (per lane), carrying `inv_pmf`.
@@ -277,8 +254,8 @@ mod tests {
         let mut count = [0f64; 4];
         for i in 0..n {
             for j in 0..n {
-                let s = e.place(0, 1.0, (i as f32 + 0.5) / n as f32, (j as f32 + 0.37) / n as f32);
-                let (x, y) = (s.y.x, s.y.y);
+                let y = e.list[0].point((i as f32 + 0.5) / n as f32, (j as f32 + 0.37) / n as f32);
+                let (x, y) = (y.x, y.y);
                 let k = if x > 0.5 {
                     1
                 } else if y > 0.5 {
