@@ -3,7 +3,7 @@
 //! light-selection mode, with error falling as samples grow), agreement of every light-selection
 //! mode when the sky lights a scene beside a quad light, and the CLI's refusals.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::{Path, PathBuf};

@@ -7,7 +7,7 @@
 //! low-discrepancy layout's, so the test is conservative). A layout whose light choice follows
 //! its light point within a pixel gives each pixel the wrong share of each light and fails.
 
-mod common;
+use crate::common;
 
 use strata::integrator::{FirstSample, LightSelection};
 use strata::sampler::{SamplerKind, SAMPLERS};

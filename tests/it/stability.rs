@@ -9,7 +9,7 @@
 //! of freedom within 5 standard deviations of 1, every |z| < 6, the image-wide mean within 5 sigma)
 //! would fail by chance with probability < 1e-6 for independent seeds.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::{Path, PathBuf};

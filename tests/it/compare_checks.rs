@@ -8,7 +8,7 @@
 //! Needs `../shared/cse168` (CI always has it: a missing corpus fails these tests).
 //! `STRATA_BIN` runs them against another build of `strata` (e.g. the one before this issue).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::{Command, Output};

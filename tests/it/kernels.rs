@@ -1,7 +1,7 @@
 //! Feature-specialized kernels: the kernel compiled for a scene's features must give the same
 //! image, bit for bit, as the general kernel (specialization changes speed, never results).
 
-mod common;
+use crate::common;
 
 use common::{corpus, opts};
 use std::path::PathBuf;

@@ -2,7 +2,7 @@
 //! quadrature, the sampled integrators against the exact one, stratification against random
 //! sampling, and thread-count determinism.
 
-mod common;
+use crate::common;
 
 use common::*;
 use strata::sampler::SamplerKind;

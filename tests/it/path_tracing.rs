@@ -3,7 +3,7 @@
 //! `maxdepth 1` + NEE = `direct` identity, no non-finite sample on the course's hw3/hw4 scenes, and
 //! full packets past the first bounce.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::PathBuf;

@@ -15,7 +15,7 @@
 //!
 //! Needs the CSE168 corpus in `../shared/cse168` (CI has it; a missing corpus fails).
 
-mod common;
+use crate::common;
 
 use common::{means, var_of_mean};
 use std::collections::HashMap;

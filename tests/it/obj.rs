@@ -3,7 +3,7 @@
 //! film's variance, fixed seeds) for `direct` and `pathtracer`, exact agreement for
 //! `analyticdirect`, whole-scene OBJ renders and the default camera framing.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::Vec3;

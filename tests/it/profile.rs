@@ -2,7 +2,7 @@
 //! each integrator, and profiling never changes the image; `--svg`, and `--profile` on `render`,
 //! `reference` and `compare`.
 
-mod common;
+use crate::common;
 
 use strata::film::Film;
 use strata::scene::desc::IntegratorKind;

@@ -3,7 +3,7 @@
 //! exact sphere normals renders much closer to the analytic sphere than faceted, and normals that
 //! point into the surface or graze it give no NaN, negative or broken pixels.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::{DVec3, Vec3};

@@ -2,7 +2,7 @@
 //! processes then merged, time budgets, and refusal of checkpoints or parts that do not belong.
 //! Every comparison is of bits: the PNG files byte for byte and the EXR pixels (RGB and variance).
 
-mod common;
+use crate::common;
 
 use common::{strata, tmpdir};
 use std::path::{Path, PathBuf};

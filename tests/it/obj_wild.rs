@@ -4,7 +4,7 @@
 //! Skipped, with the reason printed, when the corpus is absent. `STRATA_OBJ_WILD_DUMP=1` prints
 //! each file's actual outcome (to update the table).
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::{Path, PathBuf};

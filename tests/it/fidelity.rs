@@ -9,7 +9,7 @@
 //! from another build), and `STRATA_FIDELITY_FLAGS` adds render flags. The table is printed
 //! (`cargo test --release --test fidelity -- --nocapture`).
 
-mod common;
+use crate::common;
 
 use common::{corpus, strata, tmpdir};
 use std::path::{Path, PathBuf};

@@ -1,6 +1,6 @@
 //! The `strata` command line as other checks call it: flags, outputs, JSON keys, errors.
 
-mod common;
+use crate::common;
 
 use common::{strata, tmpdir};
 use std::path::Path;

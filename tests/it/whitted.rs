@@ -3,7 +3,7 @@
 //! (Blinn-Phong from a point and a directional light with shadow rays, ambient, emission, ks-weighted
 //! mirror recursion) pixel by pixel, including shadowed pixels and multi-bounce mirror pixels.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::DVec3;

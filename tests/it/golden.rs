@@ -25,7 +25,7 @@
 //! AVX-512 column checked on every AVX-512 CPU. History: `git log -p tests/golden.rs`. Print
 //! the current table with `STRATA_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture`.
 
-mod common;
+use crate::common;
 
 use common::{corpus, strata, tmpdir};
 use std::path::PathBuf;

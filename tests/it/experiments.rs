@@ -3,7 +3,7 @@
 //! and Halton light samples: less variance than random; every unbiased path-tracing variant's mean
 //! error within 4 standard errors of zero).
 
-mod common;
+use crate::common;
 
 #[test]
 fn tiny_experiments_write_tables_report_and_plots() {

@@ -5,7 +5,7 @@
 //!
 //! Needs `../shared/cse168` (CI always has it: a missing corpus fails this test).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

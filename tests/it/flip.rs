@@ -3,7 +3,7 @@
 //! FLIP of several image pairs within 1e-3. The pairs are written as 8-bit sRGB PNGs, which both
 //! sides read as LDR images.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use strata::report::flip;

@@ -4,7 +4,7 @@
 //! triangles next to quad lights; NEE with MIS agrees with NEE alone for every strategy (each
 //! strategy's own pmf in the MIS weights); and `strata compare` runs the strategies as variants.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::{Path, PathBuf};

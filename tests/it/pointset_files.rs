@@ -2,7 +2,7 @@
 //! the bit-identical image, the file's content is in the checkpoint identity, refusals reach the
 //! command line with file, set and point, and `strata pointset` exports and measures.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 //! command line's own definitions), every flag of every subcommand's `--help` is in it, and every
 //! `strata` command in the README's code blocks parses (and passes the subcommand's refusals).
 
-mod common;
+use crate::common;
 
 use common::{strata, tmpdir};
 use std::path::Path;
