@@ -71,19 +71,14 @@ fn check_error(e: &SceneError, text: &str, source: &Path) -> Result<(), TestCase
     Ok(())
 }
 
-/// The corpus (when present) and strata's own scenes, read once.
+/// The CSE168 corpus and strata's own scenes, read once.
 fn files() -> &'static [(PathBuf, String)] {
     static FILES: OnceLock<Vec<(PathBuf, String)>> = OnceLock::new();
     FILES.get_or_init(|| {
         let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-        let corpus =
-            std::env::var_os("STRATA_CSE168").map(PathBuf::from).unwrap_or_else(|| root.join("../shared/cse168"));
+        let corpus = common::corpus_required();
         let mut dirs = vec![root.join("scenes")];
-        if corpus.is_dir() {
-            dirs.extend(["hw1", "hw2", "hw3", "hw4"].map(|h| corpus.join(h)));
-        } else {
-            eprintln!("corpus not found at {} (set STRATA_CSE168): mutating scenes/*.test only", corpus.display());
-        }
+        dirs.extend(["hw1", "hw2", "hw3", "hw4"].map(|h| corpus.join(h)));
         let mut out = vec![];
         for d in dirs {
             let Ok(entries) = std::fs::read_dir(&d) else { continue };
@@ -538,14 +533,10 @@ fn unlit_obj_gets_a_default_light() {
     assert!(code == Some(0) && err.contains("no light; added a default area light"), "{err}");
     let (_, err) = run_within(&dir, &["render", "--spp", "1", "--size", "8x8", "-o", "c"], 60);
     assert!(!err.contains("default area light"), "{err}");
-    // The real-world unlit models of the issue (hold-out corpus, if present).
-    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/corpora/obj-wild");
+    // The real-world unlit models of the issue (the hold-out corpus).
+    let corpus = common::shared_required("STRATA_OBJ_WILD", "corpora/obj-wild", "SOURCES.md");
     for m in ["scan-stanford-bunny/stanford-bunny.obj", "sponza-dabrovic-2005/sponza.obj"] {
         let p = corpus.join(m);
-        if !p.exists() {
-            eprintln!("skipped: {} not found", p.display());
-            continue;
-        }
         let o = strata::session::RenderOptions { scene: Some(p), ..opts(false) };
         let lit = mean(o);
         assert!(lit > 0.05, "{m}: mean {lit} with the default light");
@@ -555,6 +546,8 @@ fn unlit_obj_gets_a_default_light() {
 
 // Issue 25 (the same pixels on every node, never a lost render, never a clobbered file): one
 // module per group of findings, sharing the runner in `hostile/run.rs`.
+#[path = "it/common.rs"]
+mod common;
 #[path = "hostile/cpus.rs"]
 mod cpus;
 #[path = "hostile/outputs.rs"]

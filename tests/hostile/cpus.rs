@@ -4,7 +4,8 @@
 //! merge or resume with the others; instruction sets below AVX2 and unknown Embree keys are
 //! refused (`isa=sse2` crashed in `rtcOccluded8` on `hw4/dragon.test`). Needs ../shared/cse168.
 
-use super::run::{corpus, exr, meta, scratch, strata, strata_env};
+use super::run::{exr, meta, scratch, strata, strata_env};
+use crate::common::corpus_required;
 
 const FLAGS: [&str; 6] = ["--size", "64x48", "--spp", "16", "--threads", "2"];
 
@@ -21,7 +22,7 @@ fn args<'a>(scene: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
 #[test]
 fn default_render_is_the_avx2_render() {
     let dir = scratch("isa-default");
-    let scene = corpus().join("hw4/cornellBRDF.test");
+    let scene = corpus_required().join("hw4/cornellBRDF.test");
     let s = scene.to_str().unwrap();
     let r = strata(&dir, &args(s, &["-o", "default"]), 120);
     assert_eq!(r.code, Some(0), "{}", r.err);
@@ -42,7 +43,7 @@ fn default_render_is_the_avx2_render() {
 #[test]
 fn shards_of_another_isa_or_sphere_intersector_are_refused() {
     let dir = scratch("isa-mix");
-    let scene = corpus().join("hw4/cornellBRDF.test");
+    let scene = corpus_required().join("hw4/cornellBRDF.test");
     let s = scene.to_str().unwrap();
     let part = |name: &str, range: &str, env: &[(&str, &str)]| {
         let r = strata_env(&dir, &args(s, &["--samples", range, "-o", name]), env, 120);
@@ -114,7 +115,7 @@ fn parts_of_another_build_need_allow_other_build() {
 #[test]
 fn embree_configs_below_avx2_or_unknown_are_refused() {
     let dir = scratch("isa-low");
-    let scene = corpus().join("hw4/dragon.test");
+    let scene = corpus_required().join("hw4/dragon.test");
     let s = scene.to_str().unwrap();
     for (cfg, says) in [
         ("isa=sse2", "below AVX2"),

@@ -66,15 +66,6 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// The CSE168 corpus (`../shared/cse168`): CI always has it, so a missing corpus fails the test.
-pub fn corpus() -> PathBuf {
-    let p = std::env::var_os("STRATA_CSE168")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168")));
-    assert!(p.join("hw4").is_dir(), "this test needs the CSE168 corpus at {} (../shared/cse168)", p.display());
-    p
-}
-
 /// The pixel channels of an EXR: (layer name, f32 bits).
 pub type Channels = Vec<(String, Vec<u32>)>;
 

@@ -5,22 +5,24 @@ use std::path::PathBuf;
 use strata::film::Film;
 use strata::session::RenderOptions;
 
-/// The CSE168 corpus beside the checkout (`../shared/cse168`), or None with a printed reason.
-pub fn corpus() -> Option<PathBuf> {
-    let p = std::env::var_os("STRATA_CSE168")
+/// A data set under `../shared` beside the checkout (or where the environment variable `var`
+/// points), recognised by the file or directory `marker` in it. CI always has `../shared`, so a
+/// missing data set fails the test with the path it looked at; no test skips for missing data.
+pub fn shared_required(var: &str, rel: &str, marker: &str) -> PathBuf {
+    let p = std::env::var_os(var)
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/cse168")));
-    if p.join("hw2").is_dir() {
-        Some(p)
-    } else {
-        eprintln!("skipped: CSE168 corpus not found at {} (set STRATA_CSE168)", p.display());
-        None
-    }
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared").join(rel));
+    assert!(
+        p.join(marker).exists(),
+        "this test needs {} (no {marker} there): CI has ../shared/{rel} beside the checkout; set {var} to point elsewhere",
+        p.display()
+    );
+    p
 }
 
-/// The CSE168 corpus, which CI always has: a missing corpus fails the test (with how to point at it).
+/// The CSE168 corpus (`../shared/cse168`, or `$STRATA_CSE168`); panics naming the path if missing.
 pub fn corpus_required() -> PathBuf {
-    corpus().unwrap_or_else(|| panic!("CSE168 corpus missing (CI has ../shared/cse168; set STRATA_CSE168)"))
+    shared_required("STRATA_CSE168", "cse168", "hw4")
 }
 
 /// Render options for `scene` at a small size.
@@ -72,10 +74,13 @@ pub fn strata() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
 }
 
-/// A fresh, empty scratch directory `strata-NAME-PID` under the system temp dir (names are unique
-/// within a test binary; the pid keeps binaries that run at once apart).
+/// A fresh, empty scratch directory `strata-NAME-PID-N` under the system temp dir (N counts the
+/// calls of this process: every integration test shares one binary, so two tests may pick the same
+/// name; the pid keeps processes that run at once apart).
 pub fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("strata-{name}-{}", std::process::id()));
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let d = std::env::temp_dir().join(format!("strata-{name}-{}-{n}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d

@@ -33,10 +33,6 @@ fn size(_scene: &std::path::Path) -> (u32, u32) {
 }
 const REF_SPP: u32 = 16384;
 
-fn corpus() -> PathBuf {
-    common::corpus().expect("the CSE168 corpus (../shared/cse168) is required")
-}
-
 /// One integrator configuration on one scene.
 #[derive(Clone)]
 struct Case {
@@ -52,7 +48,7 @@ struct Case {
 }
 
 fn cases() -> Vec<Case> {
-    let c = corpus();
+    let c = common::corpus_required();
     let direct = |name, scene: PathBuf, selection, reference| Case {
         name,
         scene,
@@ -265,7 +261,7 @@ fn low_discrepancy_samplers_beat_the_monte_carlo_rate() {
 /// that changes nothing for the integrator that runs is refused, saying why.
 #[test]
 fn every_sampler_flag_changes_the_path_tracer_and_useless_flags_are_refused() {
-    let scene = corpus().join("hw3/cornellNEE.test");
+    let scene = common::corpus_required().join("hw3/cornellNEE.test");
     let base = RenderOptions {
         scene: Some(scene.clone()),
         size: Some((24, 24)),

@@ -14,7 +14,7 @@ use strata::scene::parse::{parse_file, Limits};
 /// 400x400 midpoint quadrature of cos cos / d^2 over the one-sided light (not Arvo's formula).
 #[test]
 fn analyticdirect_matches_independent_quadrature() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     let path = c.join("hw2/analytic.test");
     let (w, h) = (160u32, 120u32);
     let mut o = opts(path.clone(), w, h, 1);
@@ -140,7 +140,7 @@ fn z_test(d: &[[f64; 3]], var: &[[f64; 3]], exact: &[[f64; 3]]) -> (f64, usize) 
 /// beyond |z| = 4 (false alarm per channel ~6e-5 before the conservative variance).
 #[test]
 fn direct_converges_to_analytic() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     for name in ["direct9", "direct3x3"] {
         let (d, var, exact) = direct_and_exact(c.join(format!("hw2/{name}.test")), 16, None);
         let (z, outliers) = z_test(&d, &var, &exact);
@@ -156,7 +156,7 @@ fn direct_converges_to_analytic() {
 /// Grid centres are deterministic (zero variance across runs) and Halton is unbiased too.
 #[test]
 fn stratified_beats_random_at_equal_samples() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     let mse = |sampler: SamplerKind| {
         let (d, _, exact) = direct_and_exact(c.join("hw2/direct9.test"), 16, Some(sampler));
         d.iter().zip(&exact).map(|(a, b)| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>()).sum::<f64>()
@@ -190,7 +190,7 @@ fn bit_identical_across_thread_counts() {
 /// Every hw2 scene renders at a small size with finite, non-trivial output.
 #[test]
 fn every_hw2_scene_renders() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     for name in ["analytic", "direct9", "direct3x3", "sphere", "cornell", "dragon"] {
         let mut o = opts(c.join(format!("hw2/{name}.test")), 64, 48, 1);
         o.light_samples = Some(4);

@@ -7,7 +7,7 @@ use crate::common;
 
 #[test]
 fn tiny_experiments_write_tables_report_and_plots() {
-    let Some(corpus) = common::corpus() else { return };
+    let corpus = common::corpus_required();
     let out = std::env::temp_dir().join(format!("strata-experiments-{}", std::process::id()));
     let cfg = strata::lab::experiments::Config {
         corpus,

@@ -11,7 +11,7 @@
 
 use crate::common;
 
-use common::{corpus, strata, tmpdir};
+use common::{corpus_required, strata, tmpdir};
 use std::path::{Path, PathBuf};
 
 /// hw1 scenes that must match the consensus on >= 99.9% of pixels (the others: >= 99%).
@@ -454,14 +454,8 @@ fn compare(images: &Path, scene: &'static str, files: &[&str], png: &Path) -> Ro
 
 #[test]
 fn strata_matches_the_course_images() {
-    let images = std::env::var_os("STRATA_CSE168_IMAGES")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpora/cse168-images")));
-    if !images.join("SOURCES.md").is_file() {
-        eprintln!("skipped: course images not found at {} (set STRATA_CSE168_IMAGES)", images.display());
-        return;
-    }
-    let Some(scenes) = corpus() else { return };
+    let images = common::shared_required("STRATA_CSE168_IMAGES", "corpora/cse168-images", "SOURCES.md");
+    let scenes = corpus_required();
     let given = std::env::var_os("STRATA_FIDELITY_RENDERS").map(PathBuf::from);
     let full = given.is_some() || std::env::var_os("STRATA_FIDELITY_FULL").is_some();
     let flags = std::env::var("STRATA_FIDELITY_FLAGS").unwrap_or_default();

@@ -22,12 +22,12 @@
 //! `vrcpps`/`vrsqrtps`, whose bits are implementation-specific, its AVX-512 kernels from the
 //! exactly specified `vrcp14ps`/`vrsqrt14ps`. So the table has one AVX2 column per kind of CPU
 //! (told apart by `strata::accel::approx_id`, which is part of a render's identity) and one
-//! AVX-512 column checked on every AVX-512 CPU. History: `git log -p tests/golden.rs`. Print
+//! AVX-512 column checked on every AVX-512 CPU. History: `git log --follow -p tests/it/golden.rs`. Print
 //! the current table with `STRATA_GOLDEN_PRINT=1 cargo test --release --test golden -- --nocapture`.
 
 use crate::common;
 
-use common::{corpus, strata, tmpdir};
+use common::{corpus_required, strata, tmpdir};
 use std::path::PathBuf;
 
 /// FNV-1a over the bits of every channel sample, in file channel order.
@@ -208,7 +208,7 @@ fn render_all(corpus: &std::path::Path, config: Option<&str>, tag: &str) -> Vec<
 /// match the AVX-512 column.
 #[test]
 fn golden_images_are_bit_identical() {
-    let Some(corpus) = corpus() else { return };
+    let corpus = corpus_required();
     let print = std::env::var_os("STRATA_GOLDEN_PRINT").is_some();
     let id = strata::accel::approx_id("avx2");
     let avx2 = render_all(&corpus, None, "avx2");

@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use common::{corpus, opts};
+use common::{corpus_required, opts};
 use std::path::PathBuf;
 use strata::session::{render_to_film, stats_json, RenderOptions};
 
@@ -40,7 +40,7 @@ fn own_scenes_specialized_equals_general_bit_for_bit() {
 
 #[test]
 fn course_scenes_specialized_equals_general_bit_for_bit() {
-    let Some(root) = corpus() else { return };
+    let root = corpus_required();
     for (scene, kernel) in [
         ("hw3/cornellNEE.test", "pathtracer<lobes=phong>"),
         ("hw3/cornellRR.test", "pathtracer<lobes=phong>"),
@@ -76,7 +76,7 @@ fn stats_report_features() {
 fn direct_on_ggx_and_phong_is_kernel_invariant_and_agrees_with_the_path_tracer() {
     use strata::integrator::LightSelection;
     use strata::scene::desc::{IntegratorKind, Nee};
-    let Some(root) = corpus() else { panic!("the CSE168 corpus (../shared/cse168) is required") };
+    let root = corpus_required();
     for (scene, kernel) in [("hw4/ggx.test", "direct<lobes=ggx>"), ("hw4/cornellBRDF.test", "direct<lobes=phong>")] {
         let o = RenderOptions {
             integrator: Some(IntegratorKind::Direct),

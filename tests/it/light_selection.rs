@@ -140,7 +140,7 @@ fn scene_dir() -> PathBuf {
 /// near-mirror panels, roughness 0.0005, is too heavy-tailed for any z-test).
 #[test]
 fn strategies_agree_on_mis_test() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     let scene = c.join("hw4/mis.test");
     let size = (96, 64);
     let mut mis = Vec::new();

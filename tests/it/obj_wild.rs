@@ -218,16 +218,10 @@ const TABLE: &[(&str, Expect)] = &[
     ),
 ];
 
-fn corpus() -> Option<PathBuf> {
-    let p = std::env::var_os("STRATA_OBJ_WILD")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/corpora/obj-wild")));
-    if p.join("SOURCES.md").is_file() {
-        Some(p)
-    } else {
-        eprintln!("skipped: OBJ corpus not found at {} (set STRATA_OBJ_WILD)", p.display());
-        None
-    }
+/// The wild OBJ corpus (`../shared/corpora/obj-wild`, or `$STRATA_OBJ_WILD`); CI always has it,
+/// so a missing corpus fails the test naming the path.
+fn wild_corpus() -> PathBuf {
+    shared_required("STRATA_OBJ_WILD", "corpora/obj-wild", "SOURCES.md")
 }
 
 /// Every `.obj` under `dir`, as paths relative to it, sorted.
@@ -260,7 +254,7 @@ fn outcome(path: &Path) -> Result<Vec<String>, String> {
 
 #[test]
 fn every_wild_file_has_its_expected_outcome() {
-    let Some(dir) = corpus() else { return };
+    let dir = wild_corpus();
     let files = obj_files(&dir);
     let dump = std::env::var_os("STRATA_OBJ_WILD_DUMP").is_some();
     let mut problems = Vec::new();
@@ -308,7 +302,7 @@ fn every_wild_file_has_its_expected_outcome() {
 /// Every file the `tobj` crate loads (triangulated, with at least one triangle) loads here too.
 #[test]
 fn every_file_tobj_loads_renders() {
-    let Some(dir) = corpus() else { return };
+    let dir = wild_corpus();
     let options = tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true };
     let mut problems = Vec::new();
     for rel in obj_files(&dir) {
@@ -334,7 +328,7 @@ fn every_file_tobj_loads_renders() {
 /// Vertex normals are kept, unit length, one triple per triangle; broken ones are dropped.
 #[test]
 fn vertex_normals_are_kept_and_validated() {
-    let Some(dir) = corpus() else { return };
+    let dir = wild_corpus();
     let (mesh, w) = obj::load_with_warnings(&dir.join("scan-bunny-smooth-vn/bunny_smooth.obj")).unwrap();
     assert!(w.is_empty(), "{w:?}");
     assert_eq!(mesh.face_normals.len(), mesh.faces.len());
@@ -352,7 +346,7 @@ fn vertex_normals_are_kept_and_validated() {
 /// status 1 and file:line.
 #[test]
 fn cli_renders_representative_files() {
-    let Some(dir) = corpus() else { return };
+    let dir = wild_corpus();
     let out = tmpdir("objwild");
     for (rel, warning) in [
         ("cornell-original/CornellBox-Original.obj", None),
@@ -385,12 +379,6 @@ fn cli_renders_representative_files() {
     assert!(err.contains("test-nan.obj:12: 'v' argument 1: expected a finite number, got 'nan'"), "{err}");
 }
 
-/// The wild corpus (needs `../shared/corpora/obj-wild`; CI always has it, so a missing corpus
-/// fails here rather than skipping).
-fn corpus_required() -> PathBuf {
-    corpus().expect("the OBJ corpus ../shared/corpora/obj-wild is required")
-}
-
 /// The automatic camera of the scenes the README's gallery shows, asserted from the camera chosen
 /// (not from pixels): the up axis guessed from the bounds, the interiors seen from inside, the
 /// Cornell boxes looked into through their open side and filling the frame, the objects from
@@ -398,7 +386,7 @@ fn corpus_required() -> PathBuf {
 #[test]
 fn wild_scenes_get_the_up_axis_and_the_view_they_need() {
     use strata::scene::obj::frame::{frame_scene, UpAxis, View};
-    let dir = corpus_required();
+    let dir = wild_corpus();
     for (rel, up, view) in [
         ("scan-stanford-bunny/stanford-bunny.obj", UpAxis::Y, View::Exterior),
         ("sponza-dabrovic-2005/sponza.obj", UpAxis::Y, View::Interior),
@@ -455,7 +443,7 @@ fn wild_scenes_get_the_up_axis_and_the_view_they_need() {
 /// it renders the same image; `--up` is obeyed and said to be.
 #[test]
 fn the_printed_camera_renders_the_same_image() {
-    let dir = corpus_required();
+    let dir = wild_corpus();
     let out = tmpdir("objwild-camera");
     let scene = dir.join("cornell-original/CornellBox-Original.obj");
     let run = |extra: &[&str], stem: &str| {

@@ -139,7 +139,7 @@ fn maxdepth_1_with_nee_equals_direct() {
 /// cornellBRDF's s = 1000 sphere included), and packets past the first bounce stay full.
 #[test]
 fn course_path_tracing_scenes_are_finite_and_packets_full() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     for name in [
         "hw3/cornellSimple",
         "hw3/cornellNEE",

@@ -14,12 +14,8 @@ use strata::session::RenderOptions;
 
 #[test]
 fn every_hw1_scene_renders_finite_and_fast() {
-    let Some(c) = corpus() else { return };
+    let c = corpus_required();
     let dir = c.join("hw1");
-    if !dir.is_dir() {
-        eprintln!("skipped: {} not found", dir.display());
-        return;
-    }
     let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
