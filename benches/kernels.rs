@@ -1,5 +1,5 @@
 //! Feature-specialized kernels against the general kernel on the same scene, same seeds (the
-//! images are bit-identical, see tests/kernels.rs): a diffuse-only Cornell box path traced with
+//! images are bit-identical, see tests/it/kernels.rs): a diffuse-only Cornell box path traced with
 //! NEE (`scenes/cornell_diffuse_path.test`, every lobe compiled out) and a Phong scene (hw4
 //! cornellBRDF from ../shared/cse168, BRDF importance sampling; the built-in box path traced when
 //! the corpus is absent). One thread, whole renders. After criterion, a table of the two kernels'

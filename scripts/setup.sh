@@ -3,9 +3,9 @@
 #   - libclang (bindgen in embree4-sys needs the full -dev package for stddef.h), pkg-config
 #   - Embree 4.4 + TBB into ./.embree/lib, from the PyPI wheel embreex==4.4.0.post1
 #     (skipped when EMBREE_DIR is set or pkg-config finds embree4)
-#   - Debian's chromium (headless: the browser test of report.html, tests/report_html.rs)
+#   - Debian's chromium (headless: the browser test of report.html, tests/it/report_html.rs)
 #   - NVIDIA's flip-evaluator (FLIP's reference implementation, with numpy) into target/py, for
-#     tests/flip.rs (pip --target: no system packages touched)
+#     tests/it/flip.rs (pip --target: no system packages touched)
 #   - a Rust toolchain is assumed (cargo on PATH); rustup is used to install it if missing.
 #   - with --python: the project virtualenv .venv (maturin, numpy, pytest, matplotlib from PyPI)
 #     with the `strata` Python module built into it (scripts/test.sh asks for it).
