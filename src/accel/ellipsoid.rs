@@ -1,7 +1,8 @@
-//! Packet intersection of one ellipsoid (the unit sphere under an affine map) with up to 8 rays at
-//! once, in f32 SIMD, with a per-lane running error bound: a lane whose f32 answer could differ
-//! from the exact one (hit vs miss, which root, or a hit distance off by more than [`TAU`]
-//! relative) is recomputed by the scalar f64 [`Ellipsoid::hit`], which stays the reference.
+//! The ellipsoid (the unit sphere under an affine map: [`Ellipsoid`], with its scalar f64 hit) and
+//! its packet intersection with up to 8 rays at once, in f32 SIMD, with a per-lane running error
+//! bound: a lane whose f32 answer could differ from the exact one (hit vs miss, which root, or a
+//! hit distance off by more than [`TAU`] relative) is recomputed by the scalar f64
+//! [`Ellipsoid::hit`], which stays the reference.
 //! Safe code only: the Embree callbacks in `accel/user_geometry.rs` load the SoA lanes and call
 //! [`hits8`] (packets of 8, Embree's case for `rtcIntersect8`/`rtcOccluded8`) or [`packet_hits`]
 //! (any other width, 8 lanes at a time).
@@ -47,8 +48,76 @@
 // Index loops over small fixed matrices (the Jacobi rotations) read as the maths does.
 #![allow(clippy::needless_range_loop)]
 
-use super::user_geometry::Ellipsoid;
 use crate::simd::{Mask8, Vec3x8, F8};
+use glam::Mat4;
+
+/// One ellipsoid: the unit sphere under an affine map, stored as the world-to-object map in f64.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Ellipsoid {
+    /// world-to-object linear part (row-major 3x3) and translation
+    pub(super) inv: [[f64; 4]; 3],
+    pub(super) lower: [f32; 3],
+    pub(super) upper: [f32; 3],
+    /// the f32 SIMD intersector's precomputed form (below)
+    pub(super) fast: Fast,
+}
+
+impl Ellipsoid {
+    /// The unit sphere under `m`, or None if `m` is singular.
+    pub(super) fn new(m: &Mat4) -> Option<Self> {
+        let md = glam::DMat4::from_cols_array(&m.to_cols_array().map(f64::from));
+        let det = md.determinant();
+        if !det.is_finite() || det.abs() < 1e-300 {
+            return None;
+        }
+        let inv = md.inverse();
+        let r = |i: usize| {
+            let row = inv.row(i);
+            [row.x, row.y, row.z, row.w]
+        };
+        // Bounds of the image of the unit ball: centre +- the row norms of the linear part.
+        let (mut lower, mut upper) = ([0f32; 3], [0f32; 3]);
+        for i in 0..3 {
+            let row = md.row(i);
+            let ext = (row.x * row.x + row.y * row.y + row.z * row.z).sqrt() * (1.0 + 1e-6);
+            lower[i] = (row.w - ext) as f32;
+            upper[i] = (row.w + ext) as f32;
+        }
+        let inv = [r(0), r(1), r(2)];
+        Some(Self { inv, lower, upper, fast: Fast::new(&inv) })
+    }
+
+    /// Nearest root t in (tnear, tfar) of |o' + t d'| = 1 in object space, if any.
+    #[inline]
+    pub(super) fn hit(&self, o: [f32; 3], d: [f32; 3], tnear: f32, tfar: f32) -> Option<f32> {
+        let m = &self.inv;
+        let (o, d) = (o.map(f64::from), d.map(f64::from));
+        let oo: [f64; 3] = std::array::from_fn(|i| m[i][0] * o[0] + m[i][1] * o[1] + m[i][2] * o[2] + m[i][3]);
+        let dd: [f64; 3] = std::array::from_fn(|i| m[i][0] * d[0] + m[i][1] * d[1] + m[i][2] * d[2]);
+        let a = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+        if a.is_nan() || a <= 0.0 {
+            return None;
+        }
+        // Numerically robust form: the discriminant from the distance of the closest approach.
+        let b = -(oo[0] * dd[0] + oo[1] * dd[1] + oo[2] * dd[2]) / a; // t of the closest approach
+        let f: [f64; 3] = std::array::from_fn(|i| oo[i] + b * dd[i]);
+        let disc = 1.0 - (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        if disc < 0.0 {
+            return None;
+        }
+        let h = (disc / a).sqrt();
+        let (t0, t1) = (b - h, b + h);
+        let (tn, tf) = (f64::from(tnear), f64::from(tfar));
+        let t = if t0 > tn && t0 < tf {
+            t0
+        } else if t1 > tn && t1 < tf {
+            t1
+        } else {
+            return None;
+        };
+        Some(t as f32).filter(|t| *t > tnear && *t < tfar)
+    }
+}
 
 /// Largest relative error bound on a hit distance answered in f32 (bigger goes to f64).
 pub(super) const TAU: f32 = 9e-6;

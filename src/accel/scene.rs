@@ -2,8 +2,9 @@
 //! 8-wide closest-hit and any-hit queries, and their results in SoA form ([`Hits8`]).
 
 use super::device::{AccelError, Device};
+use super::ellipsoid::Ellipsoid;
 use super::ffi::{finite_ray, query_args, QueryArgs, Ray8, RayHit8, RayQueryContext, Valid8};
-use super::user_geometry::{ellipsoid_bounds, ellipsoid_intersect, ellipsoid_occluded, Ellipsoid};
+use super::user_geometry::{ellipsoid_bounds, ellipsoid_intersect, ellipsoid_occluded};
 use super::{GEOM_ELLIPSOIDS, GEOM_FIRST_INSTANCE, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
 use crate::simd::{mask_to_valid, Mask8, F8, U8};
 use embree4_sys as sys;

@@ -13,7 +13,7 @@
 //! `Ng`).
 
 use super::ellipsoid::bench::Rng;
-use super::user_geometry::Ellipsoid;
+use super::ellipsoid::Ellipsoid;
 use super::*;
 use crate::simd::{mask_first, mask_to_bools, Vec3x8, F8};
 use glam::{DVec3, Mat4, Vec3, Vec4};

@@ -1,8 +1,9 @@
 //! `strata compare`: sampling techniques against a reference, K independent runs per variant, at
 //! equal spp (a ladder) or equal time (a budget). Inputs are checked first ([`super::checks`]):
-//! the reference must be of the variants' scene, size and camera. Writes per-step and per-run rows
-//! (CSV, JSON), a Markdown table, log-log plots with error bars and `report.html`. Seconds are the
-//! worker threads' CPU seconds, and every row carries the sampler's cost from the phase profiler.
+//! the reference must be of the variants' scene, size and camera. Measures per-step and per-run
+//! rows (`report_page.rs` writes them: CSV, JSON, a Markdown table, log-log plots with error bars
+//! and `report.html`). Seconds are the worker threads' CPU seconds, and every row carries the
+//! sampler's cost from the phase profiler.
 
 use super::progress::Progress;
 use super::{checks, io_err, LabError};
@@ -412,45 +413,6 @@ fn convergence(variant: &str, runs: &[RunRow]) -> Convergence {
     let (lo, hi) = secs.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
     let vs_seconds = if hi > 1.5 * lo { loglog_slope(&secs) } else { None };
     Convergence { variant: variant.into(), vs_spp: loglog_slope(&spp), vs_seconds }
-}
-
-/// Writes `rows.csv`, `rows.json`, `runs.csv`, `runs.json`, `table.md`, `error.svg` (RMSE against
-/// seconds with 95% error bars), `error-spp.svg` (RMSE against spp, ladders) and `report.html`
-/// into `dir`; `commands` are the command lines that reproduce it, said back in the report.
-/// Returns the Markdown table with the notes and slopes under it.
-pub fn write_outputs(c: &Comparison, dir: &Path, title: &str, commands: &[String]) -> Result<String, LabError> {
-    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
-    let mut md = report::to_markdown(&c.rows);
-    md += &super::report_page::slopes_markdown(&c.convergence);
-    for n in &c.notes {
-        md += &format!("\nNote: {n}\n");
-    }
-    let json = serde_json::to_string_pretty(&report::to_json(&c.rows))?;
-    let runs_json = serde_json::to_string_pretty(&c.runs)?;
-    let mut runs_csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(Vec::new());
-    for r in &c.runs {
-        runs_csv.serialize(r).map_err(|e| LabError::Io { path: dir.join("runs.csv"), source: e.into() })?;
-    }
-    let runs_csv = String::from_utf8(runs_csv.into_inner().unwrap_or_default()).unwrap_or_default();
-    let (svg_s, svg_spp) = super::report_page::compare_plots(c, title);
-    let html = super::report_page::compare_html(c, title, commands, &svg_s, &svg_spp);
-    let mut files = vec![
-        ("rows.csv", report::to_csv(&c.rows)),
-        ("rows.json", json),
-        ("runs.csv", runs_csv),
-        ("runs.json", runs_json),
-        ("table.md", md.clone()),
-        ("error.svg", svg_s),
-    ];
-    if let Some(s) = svg_spp {
-        files.push(("error-spp.svg", s));
-    }
-    files.push(("report.html", html));
-    for (name, text) in files {
-        let p = dir.join(name);
-        film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
-    }
-    Ok(md)
 }
 
 /// The samplers an integrator runs, for the `samplers` column: pixel, light and the others, and

@@ -10,9 +10,9 @@ pub mod progress;
 pub mod report_page;
 
 pub use compare::{
-    compare, compare_profiled, run, write_outputs, Comparison, Convergence, Mode, Options, RunRow, Variant,
-    VariantProfile,
+    compare, compare_profiled, run, Comparison, Convergence, Mode, Options, RunRow, Variant, VariantProfile,
 };
+pub use report_page::write_outputs;
 
 use crate::report::ReportError;
 use crate::session::SessionError;

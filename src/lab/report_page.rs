@@ -1,12 +1,16 @@
-//! The pages and plots of `strata compare` (and the pieces `strata experiments` shares): the
-//! convergence plots with 95% error bars and spp labels, the slopes table, and `report.html`
-//! through [`crate::report::html`].
+//! The outputs of `strata compare` ([`write_outputs`]: rows and runs as CSV and JSON, the Markdown
+//! table, the plots, `report.html`) and the pieces `strata experiments` shares: the convergence
+//! plots with 95% error bars and spp labels, the slopes table, and `report.html` through
+//! [`crate::report::html`].
 
 use super::compare::{Comparison, Convergence, RunRow};
+use super::{io_err, LabError};
+use crate::film;
 use crate::report::html::{self, Page, Section, Shot};
-use crate::report::{self, slope::t_quantile, Annotation, Series};
+use crate::report::{self, student_t_quantile, Annotation, Series};
 use crate::session::profile::{profile_svg, Profile};
 use std::fmt::Write as _;
+use std::path::Path;
 
 /// Mean of the runs' RMSE at one (variant, step) and its two-sided 95% Student-t interval.
 pub fn rmse_interval(runs: &[&RunRow]) -> (f64, f64, f64) {
@@ -17,7 +21,7 @@ pub fn rmse_interval(runs: &[&RunRow]) -> (f64, f64, f64) {
         return (mean, mean, mean);
     }
     let sd = (rmse.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0)).sqrt();
-    let half = t_quantile(0.975, k - 1.0) * sd / k.sqrt();
+    let half = student_t_quantile(0.975, k - 1.0) * sd / k.sqrt();
     (mean, mean - half, mean + half)
 }
 
@@ -178,4 +182,43 @@ pub fn compare_html(
         commands: commands.to_vec(),
     };
     html::page_html(&page)
+}
+
+/// Writes `rows.csv`, `rows.json`, `runs.csv`, `runs.json`, `table.md`, `error.svg` (RMSE against
+/// seconds with 95% error bars), `error-spp.svg` (RMSE against spp, ladders) and `report.html`
+/// into `dir`; `commands` are the command lines that reproduce it, said back in the report.
+/// Returns the Markdown table with the notes and slopes under it.
+pub fn write_outputs(c: &Comparison, dir: &Path, title: &str, commands: &[String]) -> Result<String, LabError> {
+    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
+    let mut md = report::to_markdown(&c.rows);
+    md += &slopes_markdown(&c.convergence);
+    for n in &c.notes {
+        md += &format!("\nNote: {n}\n");
+    }
+    let json = serde_json::to_string_pretty(&report::to_json(&c.rows))?;
+    let runs_json = serde_json::to_string_pretty(&c.runs)?;
+    let mut runs_csv = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(Vec::new());
+    for r in &c.runs {
+        runs_csv.serialize(r).map_err(|e| LabError::Io { path: dir.join("runs.csv"), source: e.into() })?;
+    }
+    let runs_csv = String::from_utf8(runs_csv.into_inner().unwrap_or_default()).unwrap_or_default();
+    let (svg_s, svg_spp) = compare_plots(c, title);
+    let html = compare_html(c, title, commands, &svg_s, &svg_spp);
+    let mut files = vec![
+        ("rows.csv", report::to_csv(&c.rows)),
+        ("rows.json", json),
+        ("runs.csv", runs_csv),
+        ("runs.json", runs_json),
+        ("table.md", md.clone()),
+        ("error.svg", svg_s),
+    ];
+    if let Some(s) = svg_spp {
+        files.push(("error-spp.svg", s));
+    }
+    files.push(("report.html", html));
+    for (name, text) in files {
+        let p = dir.join(name);
+        film::write_atomic(&p, text.as_bytes()).map_err(io_err(&p))?;
+    }
+    Ok(md)
 }

@@ -1,7 +1,7 @@
 //! FLIP (Andersson et al. 2020, "FLIP: A Difference Evaluator for Alternating Images"), the LDR
 //! version, through the `nv-flip` crate (NVIDIA's C++ implementation). Images are linear RGB;
 //! they are shown to FLIP as a display would show them: clamped to [0, 1], sRGB-encoded, 8 bits.
-//! `tests/flip.rs` checks the mean against NVIDIA's Python package (`flip-evaluator`).
+//! `tests/it/flip.rs` checks the mean against NVIDIA's Python package (`flip-evaluator`).
 
 /// FLIP's default viewing condition: 0.7 m from a 0.7 m wide, 3840-pixel monitor (67 pixels per
 /// degree), as in the paper and the reference tools.

@@ -8,7 +8,7 @@
 //!
 //! Self-test: opened with `#selftest`, the page presses each flip-book key of every section and
 //! writes what it showed, and any script error, into `<pre id="selftest">` (read with headless
-//! Chromium's `--dump-dom`; see `tests/report_html.rs`).
+//! Chromium's `--dump-dom`; see `tests/it/report_html.rs`).
 
 use super::flip::{self, magma};
 use base64::Engine as _;

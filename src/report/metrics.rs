@@ -4,16 +4,13 @@
 //! validated first: a NaN or infinite value, an empty reference or a size mismatch is an error,
 //! so a returned metric is always a finite number.
 
+use super::student_t::student_t_quantile;
 use super::ReportError;
 use crate::film;
 use serde::Serialize;
 
 /// The offset in the relative MSE's denominator, as in pbrt: `(v - r)^2 / (r + REL_EPS)^2`.
 pub const REL_EPS: f64 = 0.01;
-
-/// Degrees of freedom above this are evaluated at this value by [`student_t_quantile`]; the
-/// quantile then differs from the normal limit by less than 1e-5.
-pub const MAX_DOF: f64 = 1e6;
 
 /// Mean squared error over all pixels and channels: mean of `(v - r)^2`.
 pub fn mse(img: &[[f32; 3]], reference: &[[f32; 3]]) -> Result<f64, ReportError> {
@@ -273,16 +270,6 @@ fn check_image(img: &[[f32; 3]], name: &str, pixels: usize) -> Result<(), Report
         }
     }
     Ok(())
-}
-
-/// Quantile of Student's t distribution: the `t` with `P(T <= t) = p` for `dof` degrees of freedom
-/// (`dof` need not be an integer; values above [`MAX_DOF`] are evaluated at `MAX_DOF`), from
-/// `statrs` (its inverse CDF over the regularized incomplete beta function).
-///
-/// # Panics
-/// If `p` is not strictly between 0 and 1 or `dof` is not positive.
-pub fn student_t_quantile(p: f64, dof: f64) -> f64 {
-    super::slope::t_quantile(p, dof)
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 //! - [`flip`]: FLIP error maps and means (LDR, through `nv-flip`).
 //! - [`html`]: the self-contained `report.html` (flip-books, error maps, tables, plots).
 //! - [`slope`]: fitted log-log convergence slopes with a Student-t interval.
+//! - [`student_t`]: Student's t quantile, shared by the intervals above.
 
 pub mod bars;
 pub mod flip;
@@ -21,12 +22,14 @@ pub mod html;
 pub mod metrics;
 pub mod plot;
 pub mod slope;
+pub mod student_t;
 pub mod table;
 
 pub use bars::{stacked_bars_svg, Bar};
-pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, EightBit, ReferenceInfo, RunStats};
+pub use metrics::{efficiency, mse, rel_mse, EightBit, ReferenceInfo, RunStats};
 pub use plot::{loglog_svg, loglog_svg_annotated, Annotation, LogScale, Series};
 pub use slope::{loglog_slope, Slope};
+pub use student_t::{student_t_quantile, MAX_DOF};
 pub use table::{g3, html_table, markdown_table, to_csv, to_grouped_json, to_json, to_markdown, Column, Row, Style};
 
 use std::fmt;

@@ -3,8 +3,8 @@
 //! interval of its slope. An unbiased Monte Carlo estimator converges at slope -1/2 (RMSE
 //! against samples or time); a stratified one can be steeper.
 
+use super::student_t::student_t_quantile;
 use serde::Serialize;
-use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// A fitted slope of `ln y` against `ln x` and its two-sided 95% confidence interval.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -47,17 +47,8 @@ pub fn loglog_slope(points: &[(f64, f64)]) -> Option<Slope> {
     let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
     let sse: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
     let se = (sse / (n - 2.0) / sxx).sqrt();
-    let half = t_quantile(0.975, n - 2.0) * se;
+    let half = student_t_quantile(0.975, n - 2.0) * se;
     Some(Slope { slope, lo: slope - half, hi: slope + half, points: pts.len() })
-}
-
-/// The `p` quantile of Student's t with `dof` degrees of freedom (statrs).
-///
-/// # Panics
-/// If `p` is not strictly between 0 and 1 or `dof` is not positive.
-pub fn t_quantile(p: f64, dof: f64) -> f64 {
-    assert!(p > 0.0 && p < 1.0 && dof > 0.0, "t_quantile: need 0 < p < 1 and dof > 0, got p={p}, dof={dof}");
-    StudentsT::new(0.0, 1.0, dof.min(super::metrics::MAX_DOF)).map_or(f64::NAN, |t| t.inverse_cdf(p))
 }
 
 #[cfg(test)]
@@ -91,7 +82,7 @@ mod tests {
     #[test]
     fn t_quantiles_match_tables() {
         for (dof, want) in [(1.0, 12.706_205), (4.0, 2.776_445), (10.0, 2.228_139), (30.0, 2.042_272)] {
-            assert!((t_quantile(0.975, dof) - want).abs() < 1e-5, "dof {dof}");
+            assert!((student_t_quantile(0.975, dof) - want).abs() < 1e-5, "dof {dof}");
         }
     }
 }

@@ -32,7 +32,7 @@
 
 use super::hash::{hash, mix};
 use super::lanes::Lanes;
-use super::layout::{Layout, SetShape};
+use super::layout::{Layout, SetLayout, SetShape};
 use super::{SamplerInfo, SamplerKind, SAMPLERS};
 use std::sync::{Mutex, OnceLock};
 
@@ -184,7 +184,7 @@ impl Layout for FileLayout {
         let x = scramble(x, kx).unit24();
         match self.pad {
             None => (x, scramble(y, ky).unit24()),
-            Some(kind) => (x, L::dyn_point(kind.layout(), set, pixel, sample, dim, k, seed).1),
+            Some(kind) => (x, L::dyn_point(&SetLayout { layout: kind.layout(), set }, pixel, sample, dim, k, seed).1),
         }
     }
 }

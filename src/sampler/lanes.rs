@@ -1,8 +1,17 @@
 //! The scalar/x8 lane abstraction every generator is written against. All arithmetic wraps modulo
 //! 2^32, so the `u32` and the [`U8`] instantiation of one generic generator agree bit for bit.
 
-use super::layout::{DynLayout, SetShape};
 use crate::simd::{i32x8, F8, U8};
+
+/// A 2D point function with a scalar and an 8-lane form that agree bit for bit: what a generic
+/// generator calls through [`Lanes::dyn_point`] when the function is chosen at run time (file
+/// padding draws a registry layout this way: `layout::SetLayout`).
+pub trait PointFn {
+    /// The point of (pixel, sample, dim, k) under seed, one lane.
+    fn point_1(&self, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> (f32, f32);
+    /// The point of (pixel, sample, dim, k) under seed, eight lanes.
+    fn point_8(&self, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8);
+}
 
 /// Unsigned 32-bit lanes: `u32` (one lane) or `U8` (eight). Every generator is written once against
 /// this trait, so the scalar and the x8 instantiation run the same integer operations.
@@ -39,11 +48,9 @@ pub trait Lanes: Copy {
     fn mulhi(self, o: Self) -> Self {
         self.mul_wide(o).1
     }
-    /// `layout`'s point for these lanes (a run-time layout inside a generic one: file padding).
-    #[allow(clippy::too_many_arguments)]
-    fn dyn_point(
-        layout: &dyn DynLayout,
-        set: &SetShape,
+    /// `f`'s point for these lanes (a run-time point function inside a generic one: file padding).
+    fn dyn_point<P: PointFn + ?Sized>(
+        f: &P,
         pixel: Self,
         sample: Self,
         dim: u32,
@@ -100,16 +107,8 @@ impl Lanes for u32 {
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         f(self)
     }
-    fn dyn_point(
-        l: &dyn DynLayout,
-        set: &SetShape,
-        pixel: u32,
-        sample: u32,
-        dim: u32,
-        k: u32,
-        seed: u64,
-    ) -> (f32, f32) {
-        l.point_1(set, pixel, sample, dim, k, seed)
+    fn dyn_point<P: PointFn + ?Sized>(f: &P, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> (f32, f32) {
+        f.point_1(pixel, sample, dim, k, seed)
     }
 }
 
@@ -169,7 +168,7 @@ impl Lanes for U8 {
         U8::new(self.to_array().map(f))
     }
     #[inline]
-    fn dyn_point(l: &dyn DynLayout, set: &SetShape, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
-        l.point_8(set, pixel, sample, dim, k, seed)
+    fn dyn_point<P: PointFn + ?Sized>(f: &P, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
+        f.point_8(pixel, sample, dim, k, seed)
     }
 }

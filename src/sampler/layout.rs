@@ -6,7 +6,7 @@
 
 use super::divisor::Divisor;
 use super::grid::Grid;
-use super::lanes::Lanes;
+use super::lanes::{Lanes, PointFn};
 use crate::simd::{F8, U8};
 
 /// What one point set is prepared for: built once per (layout, n, width) by
@@ -162,5 +162,25 @@ impl<T: Layout> DynLayout for T {
     }
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]> {
         Layout::cell_span(self, set, k)
+    }
+}
+
+/// A run-time layout with the set it draws from: the [`PointFn`] a generic layout hands to
+/// [`Lanes::dyn_point`] (file padding draws the registry's layout this way).
+pub struct SetLayout<'a> {
+    /// the layout
+    pub layout: &'a dyn DynLayout,
+    /// the set it draws from
+    pub set: &'a SetShape,
+}
+
+impl PointFn for SetLayout<'_> {
+    #[inline]
+    fn point_1(&self, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> (f32, f32) {
+        self.layout.point_1(self.set, pixel, sample, dim, k, seed)
+    }
+    #[inline]
+    fn point_8(&self, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
+        self.layout.point_8(self.set, pixel, sample, dim, k, seed)
     }
 }

@@ -42,8 +42,8 @@ mod slow_test;
 
 pub use grid::strata_shape;
 pub use halton::radical_inverse;
-pub use lanes::Lanes;
-pub use layout::{DynLayout, Layout, SetShape, StreamKey};
+pub use lanes::{Lanes, PointFn};
+pub use layout::{DynLayout, Layout, SetLayout, SetShape, StreamKey};
 pub use permute::{permute, permute_x8, shuffled_index_x8, ShuffleKey};
 pub use stratified::{GridTable, PathDim};
 

@@ -16,6 +16,7 @@ mod flip;
 mod furnace;
 mod golden;
 mod kernels;
+mod layering;
 mod light_selection;
 mod normals;
 mod obj;
