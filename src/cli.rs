@@ -322,8 +322,8 @@ pub(crate) struct RenderArgs {
     #[arg(long, help_heading = LIGHTS, value_parser = parse_positive::<u32>)]
     pub(crate) light_samples: Option<u32>,
     /// Path tracer NEE light selection: all (every light, `lightsamples` points each; the CSE168
-    /// convention, default for .test scenes), uniform (one light, the historical path-tracer choice;
-    /// default for .obj scenes), power (one light by emitted power), spatial (one light by the light tree).
+    /// convention, default for .test scenes), uniform (one light, equal odds; default for .obj
+    /// scenes), power (one light by emitted power), spatial (one light by the light tree).
     #[arg(long, help_heading = LIGHTS, value_name = "NAME")]
     pub(crate) light_selection: Option<strata::integrator::LightSelection>,
     /// A constant environment light ("sky") of this radiance, R or R,G,B (path tracer; sampled
@@ -473,9 +473,49 @@ impl RenderArgs {
     }
 }
 
+/// Why a flag's value was refused (clap prints the message after the flag's name).
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum ValueError {
+    /// The value is not of the form the flag takes.
+    #[error("expected {expected}, got `{got}`")]
+    Expected {
+        /// the form the flag takes
+        expected: &'static str,
+        /// the value given
+        got: String,
+    },
+    /// A name the flag does not know.
+    #[error("unknown {what} `{got}` ({known})")]
+    Unknown {
+        /// what the flag names
+        what: &'static str,
+        /// the value given
+        got: String,
+        /// the names it knows
+        known: &'static str,
+    },
+    /// `--clamp` needs a positive finite radiance.
+    #[error("--clamp expects a positive finite radiance, got `{0}`")]
+    Clamp(String),
+    /// A `--limit` assignment the scene limits refuse.
+    #[error(transparent)]
+    Limit(strata::scene::parse::LimitError),
+    /// A sampler name or point-set file that does not resolve.
+    #[error(transparent)]
+    Sampler(strata::pointset::PointSetError),
+}
+
+fn expected(expected: &'static str, got: &str) -> ValueError {
+    ValueError::Expected { expected, got: got.into() }
+}
+
+fn unknown(what: &'static str, got: &str, known: &'static str) -> ValueError {
+    ValueError::Unknown { what, got: got.into(), known }
+}
+
 /// Checks one `--limit NAME=VALUE` (the assignment is applied again in [`limits_of`]).
-pub(crate) fn parse_limit(s: &str) -> Result<String, String> {
-    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string()).map_err(|e| e.to_string())
+pub(crate) fn parse_limit(s: &str) -> Result<String, ValueError> {
+    strata::scene::parse::Limits::default().set(s).map(|()| s.to_string()).map_err(ValueError::Limit)
 }
 
 /// The default limits with every (already checked) `--limit` applied in order.
@@ -487,71 +527,69 @@ pub(crate) fn limits_of(assignments: &[String]) -> strata::scene::parse::Limits 
     limits
 }
 
-pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got `{s}`"))?;
-    let p = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected WxH with positive integers, got `{s}`"));
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), ValueError> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| expected("WxH", s))?;
+    let p = |v: &str| v.trim().parse::<u32>().map_err(|_| expected("WxH with positive integers", s));
     Ok((p(w)?, p(h)?))
 }
 
-pub(crate) fn parse_quantize(s: &str) -> Result<strata::film::Quantize, String> {
-    strata::film::Quantize::parse(s).ok_or_else(|| format!("expected truncate or round, got `{s}`"))
+pub(crate) fn parse_quantize(s: &str) -> Result<strata::film::Quantize, ValueError> {
+    strata::film::Quantize::parse(s).ok_or_else(|| expected("truncate or round", s))
 }
 
-pub(crate) fn parse_first_sample(s: &str) -> Result<strata::integrator::FirstSample, String> {
-    strata::integrator::FirstSample::parse(s).ok_or_else(|| format!("expected centre or jittered, got `{s}`"))
+pub(crate) fn parse_first_sample(s: &str) -> Result<strata::integrator::FirstSample, ValueError> {
+    strata::integrator::FirstSample::parse(s).ok_or_else(|| expected("centre or jittered", s))
 }
 
-pub(crate) fn parse_clamp(s: &str) -> Result<f32, String> {
+pub(crate) fn parse_clamp(s: &str) -> Result<f32, ValueError> {
     match s.trim().parse::<f32>() {
         Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
-        _ => Err(format!("--clamp expects a positive finite radiance, got `{s}`")),
+        _ => Err(ValueError::Clamp(s.into())),
     }
 }
 
-pub(crate) fn parse_range(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B, got `{s}`"))?;
-    let p =
-        |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected A..B with non-negative integers, got `{s}`"));
+pub(crate) fn parse_range(s: &str) -> Result<(u32, u32), ValueError> {
+    let (a, b) = s.split_once("..").ok_or_else(|| expected("A..B", s))?;
+    let p = |v: &str| v.trim().parse::<u32>().map_err(|_| expected("A..B with non-negative integers", s));
     let (a, b) = (p(a)?, p(b)?);
     if a >= b {
-        return Err(format!("expected A..B with A < B, got `{s}`"));
+        return Err(expected("A..B with A < B", s));
     }
     Ok((a, b))
 }
 
 /// A registry sampler name, or `file:PATH?options` (the file is loaded and checked here).
-pub(crate) fn parse_sampler(s: &str) -> Result<SamplerKind, String> {
-    strata::pointset::spec::resolve_sampler(s).map_err(|e| e.to_string())
+pub(crate) fn parse_sampler(s: &str) -> Result<SamplerKind, ValueError> {
+    strata::pointset::spec::resolve_sampler(s).map_err(ValueError::Sampler)
 }
 
-pub(crate) fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
-    IntegratorKind::parse(s)
-        .ok_or_else(|| format!("unknown integrator `{s}` (raytracer, analyticdirect, direct, pathtracer)"))
+pub(crate) fn parse_integrator(s: &str) -> Result<IntegratorKind, ValueError> {
+    IntegratorKind::parse(s).ok_or_else(|| unknown("integrator", s, "raytracer, analyticdirect, direct, pathtracer"))
 }
 
-pub(crate) fn parse_nee(s: &str) -> Result<Nee, String> {
-    Nee::parse(s).ok_or_else(|| format!("unknown next event estimation `{s}` (off, on, mis)"))
+pub(crate) fn parse_nee(s: &str) -> Result<Nee, ValueError> {
+    Nee::parse(s).ok_or_else(|| unknown("next event estimation", s, "off, on, mis"))
 }
 
-pub(crate) fn parse_on_off(s: &str) -> Result<bool, String> {
+pub(crate) fn parse_on_off(s: &str) -> Result<bool, ValueError> {
     match s {
         "on" => Ok(true),
         "off" => Ok(false),
-        _ => Err(format!("expected on or off, got `{s}`")),
+        _ => Err(expected("on or off", s)),
     }
 }
 
-pub(crate) fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, String> {
-    ImportanceSampling::parse(s).ok_or_else(|| format!("unknown importance sampling `{s}` (hemisphere, cosine, brdf)"))
+pub(crate) fn parse_importance_sampling(s: &str) -> Result<ImportanceSampling, ValueError> {
+    ImportanceSampling::parse(s).ok_or_else(|| unknown("importance sampling", s, "hemisphere, cosine, brdf"))
 }
 
-pub(crate) fn parse_up(s: &str) -> Result<strata::scene::obj::frame::UpAxis, String> {
-    strata::scene::obj::frame::UpAxis::parse(s).ok_or_else(|| format!("expected x, y or z, got `{s}`"))
+pub(crate) fn parse_up(s: &str) -> Result<strata::scene::obj::frame::UpAxis, ValueError> {
+    strata::scene::obj::frame::UpAxis::parse(s).ok_or_else(|| expected("x, y or z", s))
 }
 
 /// `R` or `R,G,B` (or `R G B`): finite radiances >= 0.
-pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, String> {
-    let bad = || format!("expected a radiance R or R,G,B of finite numbers >= 0, got `{s}`");
+pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, ValueError> {
+    let bad = || expected("a radiance R or R,G,B of finite numbers >= 0", s);
     let v: Vec<f32> = s
         .split([',', ' '])
         .filter(|t| !t.is_empty())
@@ -571,39 +609,39 @@ pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, String> {
 
 /// A whole number >= 0 (counts, seeds, thread counts: 0 often means "all"), refused with what is
 /// allowed when negative or malformed.
-pub(crate) fn parse_count<T: std::str::FromStr>(s: &str) -> Result<T, String> {
-    s.trim().parse::<T>().map_err(|_| format!("expected a whole number >= 0, got `{s}`"))
+pub(crate) fn parse_count<T: std::str::FromStr>(s: &str) -> Result<T, ValueError> {
+    s.trim().parse::<T>().map_err(|_| expected("a whole number >= 0", s))
 }
 
 /// A whole number >= 1 (spp, light samples, sizes), refused with what is allowed otherwise.
-pub(crate) fn parse_positive<T: std::str::FromStr + PartialOrd + Default>(s: &str) -> Result<T, String> {
+pub(crate) fn parse_positive<T: std::str::FromStr + PartialOrd + Default>(s: &str) -> Result<T, ValueError> {
     match s.trim().parse::<T>() {
         Ok(v) if v > T::default() => Ok(v),
-        _ => Err(format!("expected a whole number >= 1, got `{s}`")),
+        _ => Err(expected("a whole number >= 1", s)),
     }
 }
 
 /// Seconds of a budget: a positive finite number.
-pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, ValueError> {
     match s.trim().parse::<f64>() {
         Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
-        _ => Err(format!("expected a positive number of seconds, got `{s}`")),
+        _ => Err(expected("a positive number of seconds", s)),
     }
 }
 
 /// `--max-depth`: -1 (unbounded) or a depth >= 0 (the upper cap is `--limit max_depth`'s).
-pub(crate) fn parse_max_depth(s: &str) -> Result<i32, String> {
+pub(crate) fn parse_max_depth(s: &str) -> Result<i32, ValueError> {
     match s.trim().parse::<i32>() {
         Ok(v) if v >= -1 => Ok(v),
-        _ => Err(format!("expected -1 (unbounded) or a depth >= 0, got `{s}`")),
+        _ => Err(expected("-1 (unbounded) or a depth >= 0", s)),
     }
 }
 
 /// Seconds between checkpoints: a finite number >= 0.
-pub(crate) fn parse_interval(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_interval(s: &str) -> Result<f64, ValueError> {
     match s.trim().parse::<f64>() {
         Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
-        _ => Err(format!("expected a number of seconds >= 0, got `{s}`")),
+        _ => Err(expected("a number of seconds >= 0", s)),
     }
 }
 
@@ -615,7 +653,7 @@ pub(crate) fn help_markdown() -> String {
     let mut md = String::from(
         "# strata command-line reference\n\n\
          Generated from the command line's own definitions by `strata help-markdown` (hidden); \
-         `tests/docs.rs` fails when this file is stale. Regenerate it with\n\
+         `tests/it/docs.rs` fails when this file is stale. Regenerate it with\n\
          `cargo run --release -- help-markdown > docs/cli.md`.\n\n",
     );
     let top = cmd.clone();

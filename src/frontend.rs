@@ -7,15 +7,59 @@
 use crate::cli::{Cli, Cmd};
 use crate::lab::{self, Mode, Variant, VariantProfile};
 use crate::report::Row;
-use crate::session::{self, RenderOptions};
+use crate::session::{self, RenderOptions, SessionError};
 use clap::Parser;
 use std::path::{Path, PathBuf};
 
+/// Why flags were refused or a comparison could not run; each message is the one the CLI prints.
+#[derive(Debug, thiserror::Error)]
+pub enum FrontendError {
+    /// The flags do not parse: clap's message, as the CLI prints it.
+    #[error("{0}")]
+    Flags(#[from] clap::Error),
+    /// A `--variant` without `=`.
+    #[error("--variant `{0}`: expected NAME=OPTIONS")]
+    VariantSpec(String),
+    /// A `--variant` whose options have unbalanced quotes.
+    #[error("--variant {name}: unbalanced quotes in `{flags}`")]
+    VariantQuotes {
+        /// the variant's name
+        name: String,
+        /// its options as given
+        flags: String,
+    },
+    /// A `--variant` whose options do not parse as `strata render` flags.
+    #[error("--variant {name}: {}", first_line(source))]
+    VariantFlags {
+        /// the variant's name
+        name: String,
+        /// clap's message about its options
+        source: clap::Error,
+    },
+    /// Neither `--budget` nor `--spp-ladder`.
+    #[error("give --budget SECONDS or --spp-ladder 1,2,4,...")]
+    NoMode,
+    /// An output could not be written, or a render failed.
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    /// The comparison failed.
+    #[error(transparent)]
+    Lab(#[from] lab::LabError),
+    /// The profiles could not be serialized.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
+/// The first line of clap's message (a variant's error is said on one line).
+fn first_line(e: &clap::Error) -> String {
+    e.to_string().lines().next().unwrap_or("").to_string()
+}
+
 /// The options of `strata render ARGS...` (`args` without the program and subcommand names);
 /// the error is clap's message, as the CLI prints it.
-pub fn render_options(args: &[String]) -> Result<RenderOptions, String> {
+pub fn render_options(args: &[String]) -> Result<RenderOptions, FrontendError> {
     let argv = ["strata", "render"].into_iter().map(String::from).chain(args.iter().cloned());
-    match Cli::try_parse_from(argv).map_err(|e| e.to_string())?.cmd {
+    match Cli::try_parse_from(argv)?.cmd {
         Cmd::Render(a) => Ok(a.into_args().options()),
         _ => unreachable!("parsed as render"),
     }
@@ -72,9 +116,9 @@ pub struct CompareOutput {
 }
 
 /// The arguments of `strata compare ARGS...` (without the program and subcommand names).
-pub fn compare_args(args: &[String]) -> Result<CompareArgs, String> {
+pub fn compare_args(args: &[String]) -> Result<CompareArgs, FrontendError> {
     let argv = ["strata", "compare"].into_iter().map(String::from).chain(args.iter().cloned());
-    match Cli::try_parse_from(argv).map_err(|e| e.to_string())?.cmd {
+    match Cli::try_parse_from(argv)?.cmd {
         Cmd::Compare {
             scene,
             reference,
@@ -111,33 +155,36 @@ pub fn compare_args(args: &[String]) -> Result<CompareArgs, String> {
 }
 
 /// Splits `--variant NAME=FLAGS` into the name and its flags (shell quoting, `shlex`).
-pub fn variant_flags(spec: &str) -> Result<(&str, Vec<String>), String> {
-    let (name, flags) = spec.split_once('=').ok_or_else(|| format!("--variant `{spec}`: expected NAME=OPTIONS"))?;
-    let words = shlex::split(flags).ok_or_else(|| format!("--variant {name}: unbalanced quotes in `{flags}`"))?;
+pub fn variant_flags(spec: &str) -> Result<(&str, Vec<String>), FrontendError> {
+    let (name, flags) = spec.split_once('=').ok_or_else(|| FrontendError::VariantSpec(spec.into()))?;
+    let words =
+        shlex::split(flags).ok_or_else(|| FrontendError::VariantQuotes { name: name.into(), flags: flags.into() })?;
     Ok((name, words))
 }
 
 /// The variants of `compare`: each `NAME=FLAGS` parsed as `strata render [SCENE] FLAGS` (size,
 /// threads and spp are compare's, set by [`lab::run`]).
-pub fn compare_variants(scene: Option<&Path>, specs: &[String]) -> Result<Vec<Variant>, String> {
+pub fn compare_variants(scene: Option<&Path>, specs: &[String]) -> Result<Vec<Variant>, FrontendError> {
     let mut variants = Vec::new();
     for spec in specs {
         let (name, flags) = variant_flags(spec)?;
         let mut args: Vec<String> = scene.iter().map(|p| p.display().to_string()).collect();
         args.extend(flags.iter().cloned());
-        let opts =
-            render_options(&args).map_err(|e| format!("--variant {name}: {}", e.lines().next().unwrap_or("")))?;
+        let opts = render_options(&args).map_err(|e| match e {
+            FrontendError::Flags(source) => FrontendError::VariantFlags { name: name.into(), source },
+            other => other,
+        })?;
         variants.push(Variant { name: name.to_string(), opts, flags });
     }
     Ok(variants)
 }
 
 /// Equal time (`--budget`) or equal spp (`--spp-ladder`); the values are checked by [`lab::run`].
-pub fn compare_mode(budget: Option<f64>, ladder: Option<Vec<u32>>) -> Result<Mode, String> {
+pub fn compare_mode(budget: Option<f64>, ladder: Option<Vec<u32>>) -> Result<Mode, FrontendError> {
     match (budget, ladder) {
         (Some(b), _) => Ok(Mode::Budget(b)),
         (None, Some(l)) => Ok(Mode::Ladder(l)),
-        (None, None) => Err("give --budget SECONDS or --spp-ladder 1,2,4,...".into()),
+        (None, None) => Err(FrontendError::NoMode),
     }
 }
 
@@ -149,11 +196,11 @@ pub fn command_line() -> String {
 
 /// Runs `strata compare` and writes its outputs (report.html, rows.csv/json, runs.csv/json,
 /// table.md, error.svg in `out`, and the profiles asked for).
-pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, String> {
+pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, FrontendError> {
     let variants = compare_variants(a.scene.as_deref(), &a.variants)?;
     let mode = compare_mode(a.budget, a.spp_ladder.clone())?;
     for f in [&a.profile.json, &a.profile.svg].into_iter().flatten() {
-        session::checks::check_output_file(f).map_err(|e| e.to_string())?;
+        session::checks::check_output_file(f)?;
     }
     let opts = lab::Options {
         runs: a.runs,
@@ -164,22 +211,22 @@ pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, String> {
         threads: a.threads,
         progress: !a.quiet,
     };
-    let c = lab::run(&variants, &a.reference, &opts).map_err(|e| e.to_string())?;
+    let c = lab::run(&variants, &a.reference, &opts)?;
     let title = format!(
         "{} vs {}",
         a.scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
         a.reference.display()
     );
-    let markdown = lab::write_outputs(&c, &a.out, &title, &[command_line()]).map_err(|e| e.to_string())?;
+    let markdown = lab::write_outputs(&c, &a.out, &title, &[command_line()])?;
     if let Some(f) = &a.profile.json {
-        let text = serde_json::to_string_pretty(&c.profiles).map_err(|e| e.to_string())?;
-        session::profile::write_text(f, &text).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string_pretty(&c.profiles)?;
+        session::profile::write_text(f, &text)?;
     }
     if let Some(f) = &a.profile.svg {
         let entries: Vec<(&str, &session::Profile)> =
             c.profiles.iter().map(|v| (v.variant.as_str(), &v.profile)).collect();
         let svg = session::profile::profile_svg(&entries, &format!("phases per variant: {title}"));
-        session::profile::write_text(f, &svg).map_err(|e| e.to_string())?;
+        session::profile::write_text(f, &svg)?;
     }
     Ok(CompareOutput { rows: c.rows, profiles: c.profiles, markdown })
 }

@@ -116,8 +116,8 @@ fn main() -> ExitCode {
         Cmd::Compare { ref json, .. } => {
             let json = json.clone();
             let early = json.as_ref().map_or(Ok(()), |f| session::checks::check_output_file(f));
-            early.map_err(|e| e.to_string()).and_then(|()| strata::frontend::compare_args(&std::env::args().skip(2).collect::<Vec<_>>())).and_then(|args| {
-                strata::frontend::run_compare(&args).and_then(|o| {
+            early.map_err(|e| e.to_string()).and_then(|()| strata::frontend::compare_args(&std::env::args().skip(2).collect::<Vec<_>>()).map_err(|e| e.to_string())).and_then(|args| {
+                strata::frontend::run_compare(&args).map_err(|e| e.to_string()).and_then(|o| {
                     println!("{}", o.markdown);
                     println!("written to {}/ (report.html, rows.csv, rows.json, runs.csv, runs.json, table.md, error.svg)", args.out.display());
                     copy_rows_json(&args.out, json.as_deref())

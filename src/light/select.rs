@@ -112,11 +112,25 @@ impl std::fmt::Display for LightSelection {
     }
 }
 
+/// A light-selection rule or light-choice mode name that is not registered.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown {what} '{name}' (expected one of: {known})")]
+pub struct UnknownName {
+    /// what was named ("light selection", "light choice")
+    pub what: &'static str,
+    /// the name given
+    pub name: String,
+    /// the registered names, comma-separated
+    pub known: String,
+}
+
 impl std::str::FromStr for LightSelection {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::from_name(s).ok_or_else(|| {
-            format!("unknown light selection '{s}' (expected one of: {})", Self::names().collect::<Vec<_>>().join(", "))
+    type Err = UnknownName;
+    fn from_str(s: &str) -> Result<Self, UnknownName> {
+        Self::from_name(s).ok_or_else(|| UnknownName {
+            what: "light selection",
+            name: s.into(),
+            known: Self::names().collect::<Vec<_>>().join(", "),
         })
     }
 }
@@ -143,13 +157,13 @@ impl LightChoice {
 }
 
 impl std::str::FromStr for LightChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Self::ALL
-            .iter()
-            .find(|(_, n)| n.eq_ignore_ascii_case(s.trim()))
-            .map(|(c, _)| *c)
-            .ok_or_else(|| format!("unknown light choice '{s}' (expected one of: reuse, dimension)"))
+    type Err = UnknownName;
+    fn from_str(s: &str) -> Result<Self, UnknownName> {
+        Self::ALL.iter().find(|(_, n)| n.eq_ignore_ascii_case(s.trim())).map(|(c, _)| *c).ok_or_else(|| UnknownName {
+            what: "light choice",
+            name: s.into(),
+            known: Self::ALL.map(|(_, n)| n).join(", "),
+        })
     }
 }
 

@@ -94,7 +94,7 @@ fn registry_names_round_trip() {
         assert!(!info.description.is_empty());
     }
     assert_eq!("Spatial".parse::<LightSelection>(), Ok(LightSelection::Spatial));
-    assert!("tree".parse::<LightSelection>().unwrap_err().contains("all, uniform, power, spatial"));
+    assert!("tree".parse::<LightSelection>().unwrap_err().to_string().contains("all, uniform, power, spatial"));
     assert!(!LightSelection::All.picks_one() && LightSelection::Power.picks_one());
 }
 

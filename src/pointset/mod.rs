@@ -94,7 +94,7 @@ pub enum PointSetError {
         /// coordinate index
         coord: usize,
         /// what is wrong ("1.5 is outside [0, 1)", "NaN")
-        why: String,
+        why: CoordinateError,
     },
     /// a spec or option that strata does not know
     #[error("{0}")]
@@ -104,12 +104,23 @@ pub enum PointSetError {
     Register(#[from] crate::sampler::file::RegisterError),
 }
 
-/// Why a coordinate is refused: NaN, or outside [0, 1).
-pub(crate) fn check_value(v: f64) -> Result<(), String> {
+/// Why a coordinate is refused.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum CoordinateError {
+    /// NaN.
+    #[error("NaN (coordinates must be numbers in [0, 1))")]
+    NotANumber,
+    /// A number outside [0, 1).
+    #[error("{0} is outside [0, 1)")]
+    OutOfRange(f64),
+}
+
+/// Checks a coordinate: a number in [0, 1).
+pub(crate) fn check_value(v: f64) -> Result<(), CoordinateError> {
     if v.is_nan() {
-        Err("NaN (coordinates must be numbers in [0, 1))".into())
+        Err(CoordinateError::NotANumber)
     } else if !(0.0..1.0).contains(&v) {
-        Err(format!("{v} is outside [0, 1)"))
+        Err(CoordinateError::OutOfRange(v))
     } else {
         Ok(())
     }
