@@ -4,7 +4,7 @@
 //!
 //! Specialization changes speed, never results: a specialized kernel differs from the general one
 //! only by code that, under the scene's [`Lobes`] promise, adds exact zeros (tested bit for bit
-//! in `tests/kernels.rs`). Settings that are uniform over a render (NEE mode, Russian roulette,
+//! in `tests/it/kernels.rs`). Settings that are uniform over a render (NEE mode, Russian roulette,
 //! strategy) are branched on once per packet and are not worth a monomorphized copy. What else a
 //! scene does not use costs nothing either: with one light the path tracer splats it instead of
 //! gathering a per-lane choice (and skips drawing the choice dimension unless BRDF sampling needs
@@ -95,7 +95,9 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         "geometry": geometry,
         "quad_lights": scene.lights.len(),
         "emissive_triangles": scene.emitters.n_triangles(),
-        "light_selection": match (scene.emitters.len(), scene.emitters.n_triangles()) {
+        // `direct`'s own choice among the emitters (the rule in use is `light_selection`, added by
+        // the session's `--stats`).
+        "direct_light_choice": match (scene.emitters.len(), scene.emitters.n_triangles()) {
             (0, _) => "none",
             (1, _) => "single",
             (_, 0) => "uniform",

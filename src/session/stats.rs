@@ -46,10 +46,20 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "first_sample": out.integrator.first_sample.name(),
         "light_selection": out.integrator.light_selection.name(),
         "quantize": out.header.options.get("quantize"),
-        "features": features_json(&out.scene, d.integrator, out.integrator.path.nee, out.integrator.path.russian_roulette, out.integrator.path.strategy),
+        "features": features(out),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
     })
+}
+
+/// `features` of `--stats`: what the scene uses, with `light_selection` the rule in use (the same
+/// value as the top-level `light_selection`; `direct`'s own choice is `direct_light_choice`).
+fn features(out: &RenderOutput) -> serde_json::Value {
+    let it = &out.integrator;
+    let mut f =
+        features_json(&out.scene, out.scene.desc.integrator, it.path.nee, it.path.russian_roulette, it.path.strategy);
+    f["light_selection"] = serde_json::json!(it.light_selection.name());
+    f
 }
 
 /// One-line summary printed after a render.

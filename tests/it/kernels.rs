@@ -63,7 +63,8 @@ fn stats_report_features() {
     assert_eq!(f["materials"], serde_json::json!(["diffuse"]));
     assert_eq!(f["geometry"], serde_json::json!(["triangles", "spheres"]));
     assert_eq!(f["quad_lights"], 1);
-    assert_eq!(f["light_selection"], "single");
+    assert_eq!(f["direct_light_choice"], "single");
+    assert_eq!(f["light_selection"], j["light_selection"], "one name for the rule in use");
     assert_eq!(f["nee"], "on");
     assert_eq!(j["kernel"], "pathtracer<lobes=none>");
 }

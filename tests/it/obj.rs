@@ -431,7 +431,9 @@ fn cli_gen_mesh_render_obj_with_camera_and_errors() {
     let j: serde_json::Value = serde_json::from_slice(&std::fs::read(&stats).unwrap()).unwrap();
     assert_eq!((j["integrator"].as_str(), j["width"].as_u64()), (Some("pathtracer"), Some(24)));
     assert_eq!(j["features"]["emissive_triangles"], 2);
-    assert_eq!(j["features"]["light_selection"], "power");
+    assert_eq!(j["features"]["direct_light_choice"], "power");
+    assert_eq!(j["features"]["light_selection"], "uniform", "the rule in use, as at the top level");
+    assert_eq!(j["light_selection"], "uniform");
     assert_eq!(j["nonfinite_samples"], 0);
     let bad = write(&d, "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
     let r = strata().arg("render").arg(&bad).args(["--size", "8x8", "-q"]).output().unwrap();
