@@ -162,7 +162,10 @@ fn paths_in(code: &str) -> Vec<String> {
         for root in ["crate::", "super::", "self::", "strata::"] {
             if rest.starts_with(root) {
                 let end = rest.find(|c: char| !(is_ident(c) || c == ':')).unwrap_or(rest.len());
-                paths.push(rest[..end].trim_end_matches(':').to_string());
+                // `super::{a, b}`: the prefix of a use tree, whose paths `expand` gives.
+                if !rest[end..].starts_with('{') {
+                    paths.push(rest[..end].trim_end_matches(':').to_string());
+                }
             }
         }
     }
