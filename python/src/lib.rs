@@ -132,7 +132,8 @@ fn render(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedS
 #[pyfunction]
 fn compare(py: Python<'_>, args: Vec<String>) -> PyResult<String> {
     let a = strata::frontend::compare_args(&args).map_err(err)?;
-    let out = py.detach(|| strata::frontend::run_compare(&a)).map_err(err)?;
+    // The message crosses the thread boundary (FrontendError is large; Python gets text anyway).
+    let out = py.detach(|| strata::frontend::run_compare(&a).map_err(|e| e.to_string())).map_err(err)?;
     Ok(strata::report::to_json(&out.rows).to_string())
 }
 
