@@ -117,10 +117,47 @@ pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), Checkpoint
     Ok((header, film))
 }
 
-/// Reads a checkpoint written by [`write`], checking magic, version, size and checksum.
+/// Reads a checkpoint written by [`write`], checking magic, version, size and checksum, through
+/// the bounded reader: a regular file only ([`crate::files::open_regular`]); the magic, version
+/// and header are read and checked first, and the file's size must be exactly what the header
+/// declares (no truncation, no trailing bytes) before the body is read.
 pub fn read(path: &Path) -> Result<(Header, Film), CheckpointError> {
-    let bytes = std::fs::read(path).map_err(|source| CheckpointError::Read { path: path.to_path_buf(), source })?;
-    from_bytes(&bytes, &path.display().to_string())
+    let name = path.display().to_string();
+    let io = |source| CheckpointError::Read { path: path.to_path_buf(), source };
+    let (mut file, len) = crate::files::open_regular(path).map_err(io)?;
+    let head = crate::files::read_exact_len(&mut file, 20).map_err(io)?;
+    let bad = |why: String| CheckpointError::Unusable { name: name.clone(), why };
+    if head.len() < 8 || &head[..8] != MAGIC {
+        return Err(bad("wrong magic (not a strata checkpoint file)".into()));
+    }
+    if head.len() < 20 {
+        return Err(bad(format!("truncated ({len} bytes)")));
+    }
+    let version = u32::from_le_bytes(head[8..12].try_into().expect("4 bytes"));
+    if version != VERSION {
+        return Err(bad(format!("format version {version}, this strata reads version {VERSION}")));
+    }
+    let hlen = u64::from_le_bytes(head[12..20].try_into().expect("8 bytes"));
+    if hlen > MAX_HEADER || 20 + hlen + 8 > len {
+        return Err(bad(format!("truncated or corrupt (header of {hlen} bytes in a file of {len})")));
+    }
+    let json = crate::files::read_exact_len(&mut file, hlen as usize).map_err(io)?;
+    let header: Header = serde_json::from_slice(&json).map_err(|e| bad(format!("corrupt header: {e}")))?;
+    let pixels = header.width as u64 * header.height as u64;
+    let expected =
+        (20 + hlen).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
+    if expected != len {
+        return Err(bad(format!(
+            "truncated or corrupt: {len} bytes, expected {expected} for {} blocks of {}x{} pixels",
+            header.blocks.len(),
+            header.width,
+            header.height
+        )));
+    }
+    let mut bytes = head;
+    bytes.extend_from_slice(&json);
+    bytes.extend(crate::files::read::read_all_of(file, len - 20 - hlen, len - 20 - hlen).map_err(io)?);
+    from_bytes(&bytes, &name)
 }
 
 #[cfg(test)]

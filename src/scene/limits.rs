@@ -164,7 +164,13 @@ pub const NUL_BYTE: &str = "the file is not valid UTF-8 text (a NUL byte: UTF-16
 pub fn read_bounded(path: &std::path::Path, what: &str, max: u64) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
     let io = |e: std::io::Error| (0, format!("cannot read {what}: {e}"));
-    let mut file = std::fs::File::open(path).map_err(io)?;
+    let (mut file, len) = crate::files::open_regular(path).map_err(io)?;
+    if len > max {
+        return Err((
+            0,
+            format!("{what} is {len} bytes, above the limit of {max} bytes ({})", limit_hint("max_file_bytes")),
+        ));
+    }
     let mut bytes = Vec::new();
     let mut chunk = vec![0u8; 1 << 20];
     let mut lines_before = 0;

@@ -195,6 +195,15 @@ pub enum SessionError {
         /// the checkpoint error
         source: Box<SessionError>,
     },
+    /// Outputs of a finished render that could not be written, and those that were (each output
+    /// is tried whatever happened to the others).
+    #[error("{failed}; {written}")]
+    OutputsFailed {
+        /// the errors, joined
+        failed: String,
+        /// what was written (`written: A, B`), or `nothing was written`
+        written: String,
+    },
     /// A point-set file (or array) has fewer points per set than the render draws per pixel.
     #[error(
         "{sampler}: its sets have {points} points, but {asked} are drawn per pixel (sets of {points} points \

@@ -124,7 +124,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         }
     }
     let desc = load_scene(opts)?;
-    super::checks::check_outputs(opts, &super::output_stem(opts, &desc))?;
+    super::checks::check_outputs(opts, &super::output_stem(opts, &desc), &desc.inputs)?;
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {
         return Err(over("spp", spp.to_string(), opts.limits.max_spp.into(), "", "max_spp"));
@@ -225,7 +225,8 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
 pub fn scene_hash(opts: &RenderOptions) -> Result<String, SessionError> {
     Ok(match &opts.scene {
         Some(p) => checkpoint::hash_bytes(
-            &std::fs::read(p).map_err(|source| SessionError::SceneRead { path: p.clone(), source })?,
+            &crate::files::read_bounded(p, opts.limits.max_file_bytes)
+                .map_err(|source| SessionError::SceneRead { path: p.clone(), source })?,
         ),
         None => checkpoint::hash_bytes(DEFAULT_SCENE.as_bytes()),
     })
