@@ -143,13 +143,15 @@ impl StemLock {
             }
             match file.try_lock() {
                 Ok(()) => {}
-                Err(fs::TryLockError::WouldBlock) => return Err(io::Error::new(
-                    io::ErrorKind::WouldBlock,
-                    format!(
+                Err(fs::TryLockError::WouldBlock) => {
+                    return Err(io::Error::new(
+                        io::ErrorKind::WouldBlock,
+                        format!(
                         "another strata process is writing this output (it holds {}); wait for it or use another -o",
                         path.display()
                     ),
-                )),
+                    ))
+                }
                 Err(fs::TryLockError::Error(e)) => return Err(e),
             }
             let same = fs::symlink_metadata(&path)
