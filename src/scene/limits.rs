@@ -157,7 +157,9 @@ pub type ReadError = (usize, String);
 /// The message of a text file holding a NUL byte (shared with the OBJ reader's decoding).
 pub const NUL_BYTE: &str = "the file is not valid UTF-8 text (a NUL byte: UTF-16 or binary?)";
 
-/// Reads `path` (`what` names its kind in messages) in chunks, refusing it as soon as it has more
+/// Reads `path` (`what` names its kind in messages) through the bounded reader's
+/// [`crate::files::open_regular`] (a FIFO, device or directory is refused before it is opened, a
+/// file over `max` before a byte is read), in chunks, refusing it as soon as it has more
 /// than `max` bytes (`--limit max_file_bytes`) or a NUL byte (no scene, OBJ or MTL text has one;
 /// a file starting with a UTF-16 byte-order mark is left to the decoder to name), so that
 /// `/dev/zero`, a binary file or an endless pipe fails at once instead of filling memory.
@@ -168,7 +170,7 @@ pub fn read_bounded(path: &std::path::Path, what: &str, max: u64) -> Result<Vec<
     if len > max {
         return Err((
             0,
-            format!("{what} is {len} bytes, above the limit of {max} bytes ({})", limit_hint("max_file_bytes")),
+            format!("{what} is larger than the limit of {max} bytes ({len} bytes; {})", limit_hint("max_file_bytes")),
         ));
     }
     let mut bytes = Vec::new();

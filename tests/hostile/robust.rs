@@ -332,3 +332,42 @@ fn smaller_findings() {
     }
     fs::remove_dir_all(&dir).ok();
 }
+
+/// Smaller findings, continued: an OBJ whose only triangle overflows is an error, not a black
+/// image; `compare` refuses a ladder that is not increasing and absurd run counts; merging a
+/// `--time-budget` checkpoint says what it is; `STRATA_BVH=bogus` is refused; the EXR records
+/// `bvh` and `spheres` as the checkpoint does.
+#[test]
+fn smaller_findings_of_scenes_and_commands() {
+    let dir = scratch("smaller2");
+    fs::write(dir.join("huge.obj"), "v -3e19 -3e19 -5\nv 3e19 -3e19 -5\nv 0 3e19 -5\nf 1 2 3\n").unwrap();
+    let r = strata(&dir, &["render", "huge.obj", "--size", "8x8", "--spp", "1", "-o", "h", "-q"], 60);
+    assert!(r.code == Some(1) && r.err.contains("every triangle was dropped"), "{:?}: {}", r.code, r.err);
+    assert!(!dir.join("h.png").exists());
+    fs::write(dir.join("s.test"), SCENE).unwrap();
+    let r = strata(&dir, &["reference", "s.test", "--size", "8x8", "--spp", "4", "-o", "ref", "-q"], 60);
+    assert_eq!(r.code, Some(0), "{}", r.err);
+    let (_, m) = super::run::exr(&dir.join("ref.exr"));
+    for k in ["strata.bvh", "strata.spheres"] {
+        assert!(!super::run::meta(&m, k).is_empty(), "{k} in {m:?}");
+    }
+    let cmp = ["compare", "s.test", "--reference", "ref.exr", "--variant", "a=--sampler=independent", "--size", "8x8"];
+    for (extra, says) in [
+        (vec!["--spp-ladder", "4,2,2"], "strictly increasing"),
+        (vec!["--spp-ladder", "1,2", "--runs", "4294967296"], "at most 100000 runs"),
+    ] {
+        let mut a = cmp.to_vec();
+        a.extend(extra);
+        let r = strata(&dir, &a, 60);
+        assert!(r.code == Some(1) && r.err.contains(says), "{a:?}: {}", r.err);
+    }
+    let r =
+        strata(&dir, &["render", "s.test", "--time-budget", "0.3", "--checkpoint", "tb.ckpt", "-o", "tb", "-q"], 60);
+    assert_eq!(r.code, Some(0), "{}", r.err);
+    let r = strata(&dir, &["merge", "tb.ckpt", "-o", "m"], 60);
+    assert!(r.code == Some(1) && r.err.contains("the checkpoint of a --time-budget render"), "{}", r.err);
+    assert!(!r.err.contains("4294967295"), "{}", r.err);
+    let r = super::run::strata_env(&dir, &["render", "s.test", "-o", "b", "-q"], &[("STRATA_BVH", "bogus")], 60);
+    assert!(r.code == Some(1) && r.err.contains("STRATA_BVH=\"bogus\""), "{}", r.err);
+    fs::remove_dir_all(&dir).ok();
+}
