@@ -145,7 +145,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     let (zero, huge) = (scene.degenerate_dropped - scene.overflow_dropped, scene.overflow_dropped);
     let d = &scene.desc;
     let triangles = d.triangles.len() + d.emissive_triangles.len();
-    if triangles > 0 && scene.degenerate_dropped >= triangles && d.spheres.is_empty() && d.quad_lights.is_empty() {
+    if triangles > 0 && scene.degenerate_dropped >= triangles && d.spheres.is_empty() {
         // Before: an OBJ whose only triangle overflowed got a camera framing the dropped vertices
         // and rendered black with exit 0.
         return Err(SessionError::NothingLeft { path: d.source.clone(), zero, huge });
