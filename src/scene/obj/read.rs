@@ -133,6 +133,10 @@ pub fn load_with_warnings_bounded(path: &Path, max: u64) -> Result<(ObjMesh, Vec
     Ok((mesh, warnings))
 }
 
+/// The materials of an OBJ's libraries (in library order), their names' indices, and the library
+/// files read.
+type Libraries = (Vec<MtlMaterial>, HashMap<String, u32>, Vec<PathBuf>);
+
 /// Finds and loads the OBJ's material libraries: the materials (in library order) and a name map
 /// (a later definition of a name wins, as in `tobj`).
 fn load_libraries(
@@ -140,7 +144,7 @@ fn load_libraries(
     parsed: &ParsedObj,
     max: u64,
     warnings: &mut Vec<ObjWarning>,
-) -> Result<(Vec<MtlMaterial>, HashMap<String, u32>, Vec<PathBuf>), SceneError> {
+) -> Result<Libraries, SceneError> {
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let mut loaded: Vec<PathBuf> = Vec::new();
     let mut missing: Vec<(usize, String, String)> = Vec::new();
