@@ -11,12 +11,14 @@ pub mod checkpoint;
 #[allow(dead_code)]
 #[path = "cli.rs"]
 mod cli;
+pub mod files;
 pub mod film;
 pub mod frontend;
 pub mod integrator;
 pub mod lab;
 pub mod light;
 pub mod measure;
+pub mod plan;
 pub mod pointset;
 pub mod profile;
 pub mod render;

@@ -1,6 +1,6 @@
 //! `strata` command line.
 
-use clap::{CommandFactory, Parser};
+use clap::{CommandFactory, FromArgMatches, Parser};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -38,9 +38,24 @@ fn main() -> ExitCode {
         eprintln!("strata: {msg}");
         return ExitCode::from(2);
     }
-    let cli = Cli::parse();
+    // A file-size limit (`ulimit -f`) must not kill a finished render: with SIGXFSZ caught, a
+    // write past the limit fails with EFBIG, which is reported (exit 1) and removes its temporary
+    // file, while the other outputs are still tried.
+    if let Err(e) = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, Arc::new(AtomicBool::new(false))) {
+        eprintln!("strata: warning: cannot catch SIGXFSZ ({e}): a file-size limit would kill the process");
+    }
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let is_reference = matches!(cli.cmd, Cmd::Reference(_));
     refuse_unused_flags(&cli.cmd);
+    // Every subcommand's inputs and outputs, checked before any work (render and reference check
+    // theirs in the session, with the stem and MTL libraries the scene names).
+    if !matches!(cli.cmd, Cmd::Render(_) | Cmd::Reference(_)) {
+        if let Err(e) = strata::plan::check(&matches) {
+            eprintln!("strata: {e}; checked before any work, nothing was written");
+            return ExitCode::FAILURE;
+        }
+    }
     let result = match cli.cmd {
         Cmd::HelpMarkdown => {
             print!("{}", cli::help_markdown());

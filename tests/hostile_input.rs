@@ -554,5 +554,8 @@ mod cpus;
 mod outputs;
 #[path = "hostile/resources.rs"]
 mod resources;
+// Issue 32: no subcommand clobbers an input, reads without bound, or hangs.
+#[path = "hostile/robust.rs"]
+mod robust;
 #[path = "hostile/run.rs"]
 mod run;

@@ -44,7 +44,12 @@ impl Device {
     /// Creates a device with the error callback installed, configured by [`EmbreeConfig::from_env`]
     /// (the instruction set pinned to AVX2 unless `$STRATA_EMBREE_CONFIG` asks for AVX-512).
     pub fn new() -> Result<Self, AccelError> {
-        let setup = EmbreeConfig::from_env()?;
+        Self::with_config(EmbreeConfig::from_env()?)
+    }
+
+    /// Creates a device from a parsed configuration, then asks Embree which instruction set it
+    /// actually runs ([`Device::check_isa`]) and refuses one below AVX2 or other than `setup.isa`.
+    pub fn with_config(setup: EmbreeConfig) -> Result<Self, AccelError> {
         let config = std::ffi::CString::new(setup.config)
             .map_err(|_| AccelError(format!("{CONFIG_VAR} contains a NUL byte")))?;
         // SAFETY: a NUL-terminated config string; a null return is checked.
@@ -55,7 +60,44 @@ impl Device {
         let sink = Box::new(ErrorSink(Mutex::new(Vec::new())));
         // SAFETY: `raw` is a live device; the sink pointer stays valid until after rtcReleaseDevice.
         unsafe { sys::rtcSetDeviceErrorFunction(raw, Some(error_callback), &*sink as *const ErrorSink as *mut c_void) };
-        Ok(Self { raw, sink, isa: setup.isa })
+        let device = Self { raw, sink, isa: setup.isa };
+        device.check_isa()?;
+        Ok(device)
+    }
+
+    /// Asks the running device for its packet widths (`rtcGetDeviceProperty`:
+    /// `NATIVE_RAY8_SUPPORTED` is set when Embree enabled AVX or more, `NATIVE_RAY16_SUPPORTED`
+    /// when it enabled AVX-512) and refuses a device below AVX (so below AVX2: strata's
+    /// configuration never asks for plain AVX) or whose AVX-512 use differs from [`Device::isa`],
+    /// the instruction set a render's identity records. This catches a configuration that reached
+    /// Embree by a route [`EmbreeConfig::parse`] did not see.
+    fn check_isa(&self) -> Result<(), AccelError> {
+        // SAFETY: a live device; both properties are documented readable properties (an Embree
+        // built without the width answers 0 or reports an error through the callback).
+        let (ray8, ray16) = unsafe {
+            (
+                sys::rtcGetDeviceProperty(self.raw, sys::RTCDeviceProperty::NATIVE_RAY8_SUPPORTED),
+                sys::rtcGetDeviceProperty(self.raw, sys::RTCDeviceProperty::NATIVE_RAY16_SUPPORTED),
+            )
+        };
+        let _ = self.take_errors();
+        let running = match (ray8 != 0, ray16 != 0) {
+            (false, _) => "an instruction set below AVX (no 8-wide kernels)",
+            (true, false) => "avx2",
+            (true, true) => "avx512",
+        };
+        if running != self.isa {
+            let why = if ray8 == 0 {
+                "below AVX2, which strata needs (x86-64-v3)"
+            } else {
+                "not what the render's identity records"
+            };
+            return Err(AccelError(format!(
+                "Embree runs {running} but strata configured isa={}: {why}; check {CONFIG_VAR}",
+                self.isa
+            )));
+        }
+        Ok(())
     }
 
     /// The instruction set Embree runs (`avx2` or `avx512`, as configured).
@@ -130,7 +172,10 @@ impl EmbreeConfig {
         Self::parse(raw.as_deref().unwrap_or(""), cpu_has_avx512())
     }
 
-    /// Parses `key=value` items (separated by commas or spaces) of an Embree configuration:
+    /// Parses `key=value` items of an Embree configuration, separated as Embree separates them
+    /// (commas, spaces, tabs, newlines, carriage returns; keys and values are made of letters,
+    /// digits, `_` and `.`, anything else is refused, so nothing can smuggle a second `isa` past
+    /// this parser into Embree's):
     /// `isa` or `max_isa` (`avx2`, `avx512`; lower instruction sets are refused) and the keys that
     /// do not change hits (`verbose`, `threads`, ...); an unknown key is refused. The instruction
     /// set is `avx2` unless `isa=avx512` (refused on a CPU without AVX-512, `avx512` saying whether
@@ -141,9 +186,15 @@ impl EmbreeConfig {
         let mut isa_key: Option<&str> = None;
         let mut rest = Vec::new();
         let mut verbose = false;
-        for item in raw.split([',', ' ', '\t']).filter(|s| !s.is_empty()) {
+        let word = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'.');
+        for item in raw.split([',', ' ', '\t', '\n', '\r']).filter(|s| !s.is_empty()) {
             let (key, value) = item.split_once('=').ok_or_else(|| bad(format!("`{item}`: expected key=value")))?;
-            let (key, value) = (key.trim(), value.trim());
+            if !word(key) || !word(value) {
+                return Err(bad(format!(
+                    "`{}`: expected key=value made of letters, digits, `_` and `.`",
+                    item.escape_debug()
+                )));
+            }
             match key {
                 "isa" | "max_isa" => {
                     if let Some(k) = isa_key {
@@ -228,11 +279,33 @@ mod config_tests {
             ("tri_accel=bvh4.triangle4v", "unknown key `tri_accel`"),
             ("isa", "expected key=value"),
             ("isa=avx2,max_isa=avx512", "give the instruction set once"),
+            // Embree splits on newlines too: before, `threads=2\nisa=sse2` passed as one item.
+            ("threads=2\nisa=sse2", "below AVX2"),
+            ("threads=2\r\nisa=sse2", "below AVX2"),
+            ("threads=2\x0bisa=sse2", "letters, digits"),
+            ("threads=(2)", "letters, digits"),
+            ("threads=2=isa=sse2", "letters, digits"),
         ] {
             let e = EmbreeConfig::parse(raw, true).unwrap_err().to_string();
             assert!(e.contains("STRATA_EMBREE_CONFIG") && e.contains(says), "{raw}: {e}");
         }
         let e = EmbreeConfig::parse("isa=avx512", false).unwrap_err().to_string();
         assert!(e.contains("no AVX-512"), "{e}");
+    }
+
+    /// A configuration that reaches Embree past the parser is caught by asking the running device.
+    #[test]
+    fn the_running_instruction_set_is_checked_against_the_identity() {
+        let raw = |isa: &'static str, config: &str| EmbreeConfig { isa, config: format!("{config},verbose=0") };
+        let e = super::Device::with_config(raw("avx2", "isa=sse2")).err().expect("sse2 refused").to_string();
+        assert!(e.contains("below AVX2") && e.contains("isa=avx2"), "{e}");
+        if super::cpu_has_avx512() {
+            let e = super::Device::with_config(raw("avx2", "isa=avx512")).err().expect("refused").to_string();
+            assert!(e.contains("runs avx512") && e.contains("identity"), "{e}");
+            assert!(super::Device::with_config(raw("avx512", "isa=avx512")).is_ok());
+        }
+        let e = super::Device::with_config(raw("avx512", "isa=avx2")).err().expect("refused").to_string();
+        assert!(e.contains("runs avx2") && e.contains("isa=avx512"), "{e}");
+        assert!(super::Device::with_config(raw("avx2", "isa=avx2")).is_ok());
     }
 }

@@ -60,17 +60,6 @@ pub fn write(path: &Path, header: &Header, film: &Film) -> Result<(), Checkpoint
         .map_err(|source| CheckpointError::Write { path: path.to_path_buf(), source })
 }
 
-/// The length of a checkpoint file whose header (ending at byte `hend`) is `header`: the header,
-/// 48 bytes per pixel and block, the checksum. Refuses an image size outside the default limits.
-fn file_len(hend: u64, header: &Header) -> Result<u64, String> {
-    let pixels = u64::from(header.width) * u64::from(header.height);
-    let max = crate::scene::parse::Limits::default().max_pixels;
-    if pixels == 0 || pixels > max {
-        return Err(format!("image size {}x{} outside 1..={max} pixels", header.width, header.height));
-    }
-    Ok(hend.saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)).saturating_add(8))
-}
-
 /// Parses checkpoint bytes; `name` labels errors.
 pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), CheckpointError> {
     let bad = |why: String| CheckpointError::Unusable { name: name.to_string(), why };
@@ -92,7 +81,13 @@ pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), Checkpoint
     let stored = u64::from_le_bytes(bytes[body_end..].try_into().expect("8 bytes"));
     let hend = 20 + hlen as usize;
     let header: Header = serde_json::from_slice(&bytes[20..hend]).map_err(|e| bad(format!("corrupt header: {e}")))?;
-    let expected = file_len(hend as u64, &header).map_err(bad)?;
+    let pixels = header.width as u64 * header.height as u64;
+    let max = crate::scene::parse::Limits::default().max_pixels;
+    if pixels == 0 || pixels > max {
+        return Err(bad(format!("image size {}x{} outside 1..={max} pixels", header.width, header.height)));
+    }
+    let expected =
+        (hend as u64).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
     if expected != bytes.len() as u64 {
         return Err(bad(format!(
             "truncated or corrupt: {} bytes, expected {expected} for {} blocks of {}x{} pixels",
@@ -122,31 +117,47 @@ pub fn from_bytes(bytes: &[u8], name: &str) -> Result<(Header, Film), Checkpoint
     Ok((header, film))
 }
 
-/// Reads a checkpoint written by [`write`], checking magic, version, size and checksum. Reads
-/// the fixed prefix and the header first (at most [`MAX_HEADER`] bytes of it), then no more than
-/// the length that header implies and one byte past it: a wrong file, a device or a pipe that
-/// never ends costs at most that much memory and time.
+/// Reads a checkpoint written by [`write`], checking magic, version, size and checksum, through
+/// the bounded reader: a regular file only ([`crate::files::open_regular`]); the magic, version
+/// and header are read and checked first, and the file's size must be exactly what the header
+/// declares (no truncation, no trailing bytes) before the body is read.
 pub fn read(path: &Path) -> Result<(Header, Film), CheckpointError> {
-    use std::io::Read;
+    let name = path.display().to_string();
     let io = |source| CheckpointError::Read { path: path.to_path_buf(), source };
-    let mut file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::new();
-    let mut more = |bytes: &mut Vec<u8>, n: u64| (&mut file).take(n).read_to_end(bytes).map(drop).map_err(io);
-    more(&mut bytes, 20)?;
-    if bytes.len() == 20 && &bytes[..8] == MAGIC {
-        let hlen = u64::from_le_bytes(bytes[12..20].try_into().expect("8 bytes"));
-        more(&mut bytes, hlen.min(MAX_HEADER))?;
-        let header = serde_json::from_slice::<Header>(&bytes[20..]).ok();
-        let len = header.and_then(|h| file_len(bytes.len() as u64, &h).ok()).unwrap_or(0);
-        // One byte past the implied length, so a longer file is told apart (and refused).
-        let rest = (len + 1).saturating_sub(bytes.len() as u64);
-        more(&mut bytes, rest)?;
-        if len > 0 && bytes.len() as u64 > len {
-            let why = format!("longer than the {len} bytes its header implies (not a checkpoint strata wrote)");
-            return Err(CheckpointError::Unusable { name: path.display().to_string(), why });
-        }
+    let (mut file, len) = crate::files::open_regular(path).map_err(io)?;
+    let head = crate::files::read_exact_len(&mut file, 20).map_err(io)?;
+    let bad = |why: String| CheckpointError::Unusable { name: name.clone(), why };
+    if head.len() < 8 || &head[..8] != MAGIC {
+        return Err(bad("wrong magic (not a strata checkpoint file)".into()));
     }
-    from_bytes(&bytes, &path.display().to_string())
+    if head.len() < 20 {
+        return Err(bad(format!("truncated ({len} bytes)")));
+    }
+    let version = u32::from_le_bytes(head[8..12].try_into().expect("4 bytes"));
+    if version != VERSION {
+        return Err(bad(format!("format version {version}, this strata reads version {VERSION}")));
+    }
+    let hlen = u64::from_le_bytes(head[12..20].try_into().expect("8 bytes"));
+    if hlen > MAX_HEADER || 20 + hlen + 8 > len {
+        return Err(bad(format!("truncated or corrupt (header of {hlen} bytes in a file of {len})")));
+    }
+    let json = crate::files::read_exact_len(&mut file, hlen as usize).map_err(io)?;
+    let header: Header = serde_json::from_slice(&json).map_err(|e| bad(format!("corrupt header: {e}")))?;
+    let pixels = header.width as u64 * header.height as u64;
+    let expected =
+        (20 + hlen).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
+    if expected != len {
+        return Err(bad(format!(
+            "truncated or corrupt: {len} bytes, expected {expected} for {} blocks of {}x{} pixels",
+            header.blocks.len(),
+            header.width,
+            header.height
+        )));
+    }
+    let mut bytes = head;
+    bytes.extend_from_slice(&json);
+    bytes.extend(crate::files::read::read_all_of(file, len - 20 - hlen, len - 20 - hlen).map_err(io)?);
+    from_bytes(&bytes, &name)
 }
 
 #[cfg(test)]
@@ -260,42 +271,5 @@ mod tests {
         let mut b = a.clone();
         (b.cpu_seconds, b.target, b.parts) = (9.0, [0, 8], vec!["p".into()]);
         assert_eq!(a.mismatch(&b, "this render"), None);
-    }
-
-    /// A read stops one byte past the length the header implies: a file with bytes after the
-    /// checkpoint is refused, and a pipe that goes on is not read to its end (the writer here
-    /// offers 64 MiB more and is cut off after the pipe's buffer).
-    #[test]
-    fn reads_stop_at_the_length_the_header_implies() {
-        use std::io::Write;
-        let dir = tempfile::tempdir().unwrap();
-        let bytes = to_bytes(&header(), &film(0..9));
-        let long = dir.path().join("long.ckpt");
-        std::fs::write(&long, [bytes.as_slice(), b"more"].concat()).unwrap();
-        let e = read(&long).unwrap_err().to_string();
-        assert!(e.contains("longer than the") && e.contains(&format!("{} bytes", bytes.len())), "{e}");
-        std::fs::write(&long, &bytes).unwrap();
-        assert_eq!(read(&long).unwrap().1, film(0..9));
-
-        let fifo = dir.path().join("pipe.ckpt");
-        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
-        let writer = {
-            let (fifo, bytes) = (fifo.clone(), bytes.clone());
-            std::thread::spawn(move || {
-                let mut f = std::fs::OpenOptions::new().write(true).open(fifo).unwrap();
-                let mut written = 0usize;
-                for chunk in std::iter::once(bytes).chain(std::iter::repeat_n(vec![0u8; 1 << 16], 1024)) {
-                    if f.write_all(&chunk).is_err() {
-                        break; // the reader closed the pipe
-                    }
-                    written += chunk.len();
-                }
-                written
-            })
-        };
-        let e = read(&fifo).unwrap_err().to_string();
-        assert!(e.contains("longer than the"), "{e}");
-        let written = writer.join().unwrap();
-        assert!(written < bytes.len() + (4 << 20), "the reader took {written} bytes of a 64 MiB stream");
     }
 }

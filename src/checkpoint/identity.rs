@@ -199,6 +199,8 @@ pub fn header_metadata(h: &Header) -> Metadata {
         ("strata.embree_isa".into(), opt("embree_isa")),
         ("strata.embree_approx".into(), opt("embree_approx")),
         ("strata.embree_version".into(), opt("embree_version")),
+        ("strata.bvh".into(), opt("bvh")),
+        ("strata.spheres".into(), opt("spheres")),
         ("strata.scene".into(), h.scene.clone()),
         ("strata.scene_hash".into(), h.scene_hash.clone()),
         ("strata.integrator".into(), opt("integrator")),

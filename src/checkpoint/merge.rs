@@ -29,6 +29,9 @@ pub fn run_merge(parts: &[PathBuf], out: &Path, allow_other_build: bool) -> Resu
     let mut loaded: Vec<(PathBuf, Header, Film)> = Vec::new();
     for p in parts {
         let (h, f) = format::read(p)?;
+        if h.target[1] == u32::MAX && h.samples != h.target {
+            return Err(CheckpointError::TimeBudgetPart { path: p.clone(), samples: h.samples });
+        }
         if h.samples != h.target {
             return Err(CheckpointError::Unfinished { path: p.clone(), samples: h.samples, target: h.target });
         }

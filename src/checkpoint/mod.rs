@@ -51,6 +51,14 @@ pub enum CheckpointError {
     /// `strata merge` without parts.
     #[error("merge: give the part files to merge")]
     NoParts,
+    /// A checkpoint of a `--time-budget` render (its range has no end) given to merge.
+    #[error("{}: the checkpoint of a --time-budget render (samples {}..{}, no fixed range), not a part of `render --samples A..B`: continue it with --resume and --time-budget, or write its image with --resume", path.display(), samples[0], samples[1])]
+    TimeBudgetPart {
+        /// the file
+        path: PathBuf,
+        /// the samples it holds
+        samples: [u32; 2],
+    },
     /// A part whose sample range is not finished.
     #[error("{}: unfinished part: it holds samples {}..{} of its range {}..{} (finish it with --resume)", path.display(), samples[0], samples[1], target[0], target[1])]
     Unfinished {

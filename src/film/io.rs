@@ -1,8 +1,8 @@
 //! Image files: linear f32 EXR with an optional variance layer and text metadata, an 8-bit gamma
 //! PNG preview, output names, and the atomic file writer they share.
 
-use std::fs::{self, File};
-use std::io::{self, Cursor, Write};
+use std::fs;
+use std::io::{self, Cursor};
 use std::path::{Path, PathBuf};
 
 /// Key/value metadata written into the EXR header as text attributes (spp, seconds, sampler, seed,
@@ -26,6 +26,10 @@ pub struct ExrImage {
 
 /// Channel names of one RGB triple, in pixel order.
 const RGB: [&str; 3] = ["R", "G", "B"];
+/// The largest EXR read (8 GiB: a 2^28-pixel image, the largest a render makes, with its variance
+/// layer as f32).
+pub const MAX_EXR_BYTES: u64 = 8 << 30;
+
 /// Channel-name prefix of the variance layer.
 const VARIANCE_PREFIX: &str = "variance.";
 
@@ -80,10 +84,25 @@ pub fn write_exr(
 }
 
 /// Reads back an EXR written by [`write_exr`] (any EXR whose first layer has R, G and B channels):
-/// size, RGB, the variance layer if present, and the text attributes.
+/// size, RGB, the variance layer if present, and the text attributes. Read through the bounded
+/// reader ([`crate::files::read_bounded`]): a regular file (not a FIFO or device) of at most
+/// [`MAX_EXR_BYTES`], starting with the EXR magic number.
 pub fn read_exr(path: &Path) -> io::Result<ExrImage> {
     use exr::prelude::*;
-    let image = read_first_flat_layer_from_file(path).map_err(|e| exr_error(e, path))?;
+    let bytes = crate::files::read_bounded(path, MAX_EXR_BYTES)
+        .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+    if !bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        let msg = format!("{}: not an OpenEXR file (no EXR magic number)", path.display());
+        return Err(io::Error::new(io::ErrorKind::InvalidData, msg));
+    }
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| exr_error(e, path))?;
     let layer = image.layer_data;
     let (width, height) = (layer.size.width(), layer.size.height());
     let channel = |name: String| -> Option<Vec<f32>> {
@@ -213,59 +232,7 @@ pub fn encode_png_quantized(
     Ok(bytes)
 }
 
-/// Writes `bytes` to `path` atomically: to a temporary file created exclusively (`O_EXCL`, an
-/// unpredictable name, `tempfile`) in `path`'s directory, fsync, rename over `path`, then fsync the
-/// directory (best effort). `path` must be a regular file or a new name ([`check_target`]): a
-/// symbolic link, directory or device is refused, never replaced. On failure the temporary file is
-/// removed and an existing file at `path` is left untouched. A link planted at any temporary name
-/// is never followed.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    check_target(path)?;
-    let dir = dir_of(path);
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let mut tmp = tempfile::Builder::new().prefix(&format!(".{name}.")).suffix(".tmp").tempfile_in(&dir)?;
-    tmp.write_all(bytes)?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    if let Ok(d) = File::open(&dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
-}
-
-/// The directory `path` is written in ("." for a bare name).
-pub fn dir_of(path: &Path) -> PathBuf {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    }
-}
-
-/// Refuses an output path that is neither a regular file nor a new name, saying what it is: a
-/// symbolic link (even to a regular file: the link would be replaced, or its target clobbered), a
-/// directory, a device, a FIFO or a socket (replacing `/dev/null` would break the system).
-pub fn check_target(path: &Path) -> io::Result<()> {
-    let meta = match fs::symlink_metadata(path) {
-        Ok(m) => m,
-        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(e),
-    };
-    let t = meta.file_type();
-    if t.is_file() {
-        return Ok(());
-    }
-    let what = if t.is_symlink() {
-        "a symbolic link"
-    } else if t.is_dir() {
-        "a directory"
-    } else {
-        "a device, FIFO or socket"
-    };
-    Err(io::Error::new(
-        io::ErrorKind::InvalidInput,
-        format!("is {what}; strata writes only regular files or new names (it replaces the file)"),
-    ))
-}
+pub use crate::files::{check_target, dir_of, write_atomic};
 
 /// Refuses an output stem (`-o OUT`, which names OUT.exr and OUT.png) that names a directory:
 /// ending in `/`, `.` or `..`, or an existing directory.
@@ -280,6 +247,14 @@ pub fn check_stem(out: &Path) -> io::Result<()> {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             "-o names a directory; give a file stem (-o DIR/NAME writes DIR/NAME.exr and DIR/NAME.png)",
+        ));
+    }
+    let stem = stem_of(out);
+    let name = stem.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    if name.is_empty() || s.ends_with("/.exr") || s.ends_with("/.png") {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "-o has an empty file stem (it would write hidden files .exr and .png); give a name, e.g. -o out.exr",
         ));
     }
     Ok(())

@@ -170,6 +170,9 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
     if opts.runs < 2 {
         return Err(LabError::TooFewRuns { why: " (bias and variance need independent runs)" });
     }
+    if opts.runs > super::MAX_RUNS {
+        return Err(LabError::TooManyRuns(opts.runs));
+    }
     let baseline = match &opts.baseline {
         Some(b) if variants.iter().any(|v| &v.name == b) => b.clone(),
         Some(b) => {
@@ -180,7 +183,9 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
     };
     let img = film::read_exr(reference).map_err(io_err(reference))?;
     let steps: Vec<u32> = match &opts.mode {
-        Mode::Ladder(l) if l.is_empty() || l.contains(&0) => return Err(LabError::BadLadder),
+        Mode::Ladder(l) if l.is_empty() || l.contains(&0) || l.windows(2).any(|w| w[0] >= w[1]) => {
+            return Err(LabError::BadLadder)
+        }
         Mode::Ladder(l) => l.clone(),
         Mode::Budget(b) if !(b.is_finite() && *b > 0.0) => return Err(LabError::BadBudget(*b)),
         Mode::Budget(_) => vec![0],

@@ -464,6 +464,9 @@ pub fn run(cfg: &Config) -> Result<String, LabError> {
     if cfg.runs < 2 {
         return Err(LabError::TooFewRuns { why: "" });
     }
+    if cfg.runs > super::MAX_RUNS {
+        return Err(LabError::TooManyRuns(cfg.runs));
+    }
     if !cfg.corpus.join("hw2").is_dir() {
         return Err(LabError::NoCorpus(cfg.corpus.clone()));
     }

@@ -18,6 +18,9 @@ use crate::report::ReportError;
 use crate::session::SessionError;
 use std::path::PathBuf;
 
+/// The most independent runs per variant `compare` and `experiments` accept.
+pub const MAX_RUNS: usize = 100_000;
+
 /// Why a comparison or an experiment could not run or write its outputs.
 #[derive(Debug, thiserror::Error)]
 pub enum LabError {
@@ -59,11 +62,14 @@ pub enum LabError {
         /// the variants' names
         names: String,
     },
-    /// An empty ladder or a zero step.
-    #[error("--spp-ladder: expected positive spp values")]
+    /// An empty ladder, a zero step, or steps not strictly increasing.
+    #[error("--spp-ladder: expected positive spp values, strictly increasing (e.g. 1,2,4,8)")]
     BadLadder,
+    /// More runs per variant than [`MAX_RUNS`].
+    #[error("--runs {0}: at most {max} runs per variant", max = MAX_RUNS)]
+    TooManyRuns(usize),
     /// A budget that is not a positive number of seconds.
-    #[error("--budget {0}: expected a positive number of seconds")]
+    #[error("--budget {}: expected a positive number of seconds", crate::session::error::short_f64(*.0))]
     BadBudget(f64),
     /// A variant's statistics could not be computed.
     #[error("variant {variant}: {source}")]

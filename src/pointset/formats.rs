@@ -36,9 +36,15 @@ impl Format {
     }
 }
 
-/// Reads and checks the point sets in `path` (format by extension).
+/// The largest point-set file read (1 GiB: 2^26 points of two coordinates as UTK text take about
+/// 1.6 GB, far above any sampler's use): a sparse or endless file is refused before it is read.
+pub const MAX_POINTSET_BYTES: u64 = 1 << 30;
+
+/// Reads and checks the point sets in `path` (format by extension), through the bounded reader
+/// ([`crate::files::read_bounded`]: a regular file of at most [`MAX_POINTSET_BYTES`]).
 pub fn read(path: &Path) -> Result<PointSets, PointSetError> {
-    let bytes = std::fs::read(path).map_err(|source| PointSetError::Io { path: path.to_path_buf(), source })?;
+    let bytes = crate::files::read_bounded(path, MAX_POINTSET_BYTES)
+        .map_err(|source| PointSetError::Io { path: path.to_path_buf(), source })?;
     let name = path.display().to_string();
     let ps = match Format::of(path) {
         Format::Text => parse_text(&name, &bytes)?,
@@ -166,6 +172,7 @@ pub fn parse_npy(name: &str, bytes: &[u8]) -> Result<PointSets, PointSetError> {
     let bad = |why: String| PointSetError::Format { source_name: name.into(), why };
     let npy = npyz::NpyFile::new(bytes).map_err(|e| bad(format!("not a NumPy .npy file: {e}")))?;
     let shape: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
+    check_npy_length(bytes, &shape, &npy.dtype().descr()).map_err(bad)?;
     let (sets, points, dims) = match shape[..] {
         [p, d] => (1, p, d),
         [s, p, d] => (s, p, d),
@@ -195,6 +202,34 @@ pub fn parse_npy(name: &str, bytes: &[u8]) -> Result<PointSets, PointSetError> {
         data
     };
     PointSets::new(name, sets, points, dims, data)
+}
+
+/// Checks that an `.npy` file holds exactly the data its header declares (`shape` of items of
+/// `descr`): a short file is named as truncated, bytes after the array are refused.
+fn check_npy_length(bytes: &[u8], shape: &[usize], descr: &str) -> Result<(), String> {
+    let major = bytes.get(6).copied().unwrap_or(0);
+    let start = match major {
+        1 => bytes.get(8..10).map(|b| 10 + u16::from_le_bytes([b[0], b[1]]) as u64),
+        _ => bytes.get(8..12).map(|b| 12 + u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64),
+    }
+    .ok_or("truncated header")?;
+    let item: u64 = descr.chars().filter(char::is_ascii_digit).collect::<String>().parse().unwrap_or(0);
+    let data = shape
+        .iter()
+        .try_fold(item, |n, &d| n.checked_mul(d as u64))
+        .ok_or_else(|| format!("shape {shape:?} is too large"))?;
+    let want = start.saturating_add(data);
+    let have = bytes.len() as u64;
+    if have < want {
+        return Err(format!(
+            "truncated: the header declares shape {shape:?} of {descr} ({data} bytes of data), the file ends {} bytes short",
+            want - have
+        ));
+    }
+    if have > want {
+        return Err(format!("{} trailing bytes after the {shape:?} array its header declares", have - want));
+    }
+    Ok(())
 }
 
 /// Writes `ps` to `path` in the format of its extension (values printed so they read back

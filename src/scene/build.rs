@@ -136,6 +136,22 @@ pub enum BuildError {
     /// The scene has no `camera` command (the scene file).
     #[error("{}: no camera command", .0.display())]
     NoCamera(std::path::PathBuf),
+    /// `STRATA_BVH` set to something other than `high` or `medium`.
+    #[error("STRATA_BVH={0:?}: expected `high` or `medium` (or unset: by triangle count)")]
+    Bvh(String),
+}
+
+/// The BVH quality `STRATA_BVH` forces: `high` (true), `medium` (false), unset or empty (None:
+/// by triangle count); anything else is refused (before, a misspelling was silently ignored).
+pub fn forced_bvh() -> Result<Option<bool>, BuildError> {
+    match std::env::var("STRATA_BVH") {
+        Ok(v) if v == "high" => Ok(Some(true)),
+        Ok(v) if v == "medium" => Ok(Some(false)),
+        Ok(v) if v.is_empty() => Ok(None),
+        Ok(v) => Err(BuildError::Bvh(v)),
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => Err(BuildError::Bvh(v.to_string_lossy().into_owned())),
+    }
 }
 
 /// The intersection backend's settings that can change which hits a ray gets: each one is in a
@@ -284,11 +300,7 @@ impl Scene {
         }
         let device = accel::Device::new()?;
         let mut b = accel::SceneBuilder::new(&device)?;
-        let high = match std::env::var("STRATA_BVH").as_deref() {
-            Ok("high") => true,
-            Ok("medium") => false,
-            _ => indices.len() >= HIGH_QUALITY_MIN_TRIANGLES,
-        };
+        let high = forced_bvh()?.unwrap_or(indices.len() >= HIGH_QUALITY_MIN_TRIANGLES);
         if high {
             b.high_quality();
         }

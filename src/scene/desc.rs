@@ -149,6 +149,8 @@ pub struct DirectionalLightDesc {
 pub struct SceneDesc {
     /// file it came from (for messages)
     pub source: PathBuf,
+    /// other files read to make it (an OBJ's MTL libraries): inputs no output may replace
+    pub inputs: Vec<PathBuf>,
     /// image width in pixels
     pub width: u32,
     /// image height in pixels
@@ -269,6 +271,7 @@ impl Default for SceneDesc {
     fn default() -> Self {
         Self {
             source: PathBuf::new(),
+            inputs: Vec::new(),
             width: 640,
             height: 480,
             output: None,

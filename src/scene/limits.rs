@@ -157,14 +157,22 @@ pub type ReadError = (usize, String);
 /// The message of a text file holding a NUL byte (shared with the OBJ reader's decoding).
 pub const NUL_BYTE: &str = "the file is not valid UTF-8 text (a NUL byte: UTF-16 or binary?)";
 
-/// Reads `path` (`what` names its kind in messages) in chunks, refusing it as soon as it has more
+/// Reads `path` (`what` names its kind in messages) through the bounded reader's
+/// [`crate::files::open_regular`] (a FIFO, device or directory is refused before it is opened, a
+/// file over `max` before a byte is read), in chunks, refusing it as soon as it has more
 /// than `max` bytes (`--limit max_file_bytes`) or a NUL byte (no scene, OBJ or MTL text has one;
 /// a file starting with a UTF-16 byte-order mark is left to the decoder to name), so that
 /// `/dev/zero`, a binary file or an endless pipe fails at once instead of filling memory.
 pub fn read_bounded(path: &std::path::Path, what: &str, max: u64) -> Result<Vec<u8>, ReadError> {
     use std::io::Read;
     let io = |e: std::io::Error| (0, format!("cannot read {what}: {e}"));
-    let mut file = std::fs::File::open(path).map_err(io)?;
+    let (mut file, len) = crate::files::open_regular(path).map_err(io)?;
+    if len > max {
+        return Err((
+            0,
+            format!("{what} is larger than the limit of {max} bytes ({len} bytes; {})", limit_hint("max_file_bytes")),
+        ));
+    }
     let mut bytes = Vec::new();
     let mut chunk = vec![0u8; 1 << 20];
     let mut lines_before = 0;

@@ -26,13 +26,14 @@ pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
     }
     // STRATA_EMBREE_CONFIG: refused before the scene is read (the device checks it again).
     crate::accel::EmbreeConfig::from_env().map_err(|e| SessionError::Build(e.into()))?;
+    crate::scene::build::forced_bvh().map_err(SessionError::Build)?;
     match &opts.out {
         Some(o) => {
             film::check_stem(o).map_err(|e| SessionError::BadOutput { path: o.clone(), why: e.to_string() })?;
-            check_outputs(opts, &stem_of(o))
+            check_outputs(opts, &stem_of(o), &[])
         }
         // The stem comes from the scene's `output`: checked again once the scene is read.
-        None => check_outputs(opts, Path::new("strata")),
+        None => check_outputs(opts, Path::new("strata"), &[]),
     }
 }
 
@@ -49,76 +50,55 @@ pub fn output_files(opts: &RenderOptions, stem: &Path) -> Vec<(String, PathBuf)>
     out
 }
 
-/// Checks the outputs of a render with output stem `stem` before any sample: each a regular file
-/// or a new name ([`film::check_target`]) in a writable directory (a probe file is created and
-/// removed), none the same file as another output or as an input (the scene file, `--resume`
-/// unless it is also the checkpoint).
-pub fn check_outputs(opts: &RenderOptions, stem: &Path) -> Result<(), SessionError> {
+/// Checks the outputs of a render with output stem `stem` before any sample, as one
+/// [`crate::files::Plan`]: each a regular file or a new name in a writable directory with room for
+/// its temporary name, none the same file as another output or as an input (the scene file and
+/// `extra_inputs`, the files it read such as its MTL libraries; the point-set files of `file:`
+/// samplers; `--resume` unless it is also the checkpoint).
+pub fn check_outputs(opts: &RenderOptions, stem: &Path, extra_inputs: &[PathBuf]) -> Result<(), SessionError> {
     let outputs = output_files(opts, stem);
-    for (_, f) in &outputs {
-        check_writable(&film::dir_of(f))?;
-        film::check_target(f).map_err(|e| SessionError::BadOutput { path: f.clone(), why: e.to_string() })?;
+    let mut plan = crate::files::Plan::new();
+    for (what, f) in &outputs {
+        let label = if what == "the image" { format!("the image {}", f.display()) } else { what.clone() };
+        plan.output(label, f);
     }
-    let mut inputs: Vec<(String, PathBuf)> =
-        opts.scene.iter().map(|p| ("the scene file".to_string(), p.clone())).collect();
+    if let Some(p) = &opts.scene {
+        plan.input("the scene file", p);
+    }
+    for p in extra_inputs {
+        plan.input(format!("the scene's file {}", p.display()), p);
+    }
     let ckpt = &outputs[2].1;
-    inputs
-        .extend(opts.resume.iter().filter(|r| *r != ckpt).map(|p| ("the --resume checkpoint".to_string(), p.clone())));
-    let keys: Vec<Option<FileKey>> = outputs.iter().chain(&inputs).map(|(_, p)| FileKey::of(p)).collect();
-    for (i, (what, path)) in outputs.iter().enumerate() {
-        for (j, (other, other_path)) in outputs.iter().chain(&inputs).enumerate().skip(i + 1) {
-            if keys[i].is_some() && keys[i] == keys[j] {
-                let label = if what == "the image" { format!("the image {}", path.display()) } else { what.clone() };
-                let why = format!(
-                    "{label} and {other} ({}) are the same file: one would overwrite the other",
-                    other_path.display()
-                );
-                return Err(SessionError::BadOutput { path: path.clone(), why });
+    for p in opts.resume.iter().filter(|r| *r != ckpt) {
+        plan.input("the --resume checkpoint", p);
+    }
+    for (flag, kind) in
+        [("--sampler", opts.sampler), ("--pixel-sampler", opts.pixel_sampler), ("--light-sampler", opts.light_sampler)]
+    {
+        if let Some(kind) = kind.filter(|k| crate::sampler::file::file_info(*k).is_some()) {
+            if let Some(rest) = kind.info().name.strip_prefix("file:") {
+                plan.input(format!("the {flag} point set"), rest.split('?').next().unwrap_or(rest));
             }
         }
     }
-    Ok(())
+    plan.check().map_err(plan_error)
 }
 
-/// What makes two paths one file: the device and inode of an existing file, else the resolved
-/// directory and the name.
-#[derive(PartialEq, Eq)]
-enum FileKey {
-    Inode(u64, u64),
-    New(PathBuf),
-}
-
-impl FileKey {
-    fn of(p: &Path) -> Option<Self> {
-        use std::os::unix::fs::MetadataExt;
-        if let Ok(m) = std::fs::metadata(p) {
-            return Some(Self::Inode(m.dev(), m.ino()));
-        }
-        let dir = std::fs::canonicalize(film::dir_of(p)).ok()?;
-        Some(Self::New(dir.join(p.file_name()?)))
+/// A refused plan as the session's error.
+fn plan_error(e: crate::files::PlanError) -> SessionError {
+    match e {
+        crate::files::PlanError::Bad { path, why } => SessionError::BadOutput { path, why },
+        crate::files::PlanError::NotWritable { dir, source } => SessionError::NotWritable { dir, source },
     }
 }
 
-/// Checks that the directory `file` would be written in is writable (a probe file) and that
-/// `file` is a regular file or a new name, for outputs the render options do not name (`strata
-/// profile --json/--svg`, `compare --profile`), so a bad path fails before the renders.
+/// Checks that `file` is a regular file or a new name in a writable directory, for outputs the
+/// render options do not name (`strata profile --json/--svg`, `compare --profile`), so a bad path
+/// fails before the renders.
 pub fn check_output_file(file: &Path) -> Result<(), SessionError> {
-    check_writable(&film::dir_of(file))?;
-    film::check_target(file).map_err(|e| SessionError::BadOutput { path: file.to_path_buf(), why: e.to_string() })
-}
-
-/// Creates and removes a probe file in `dir` (named by process and a per-process counter, so
-/// renders running at once in one process or several never collide).
-fn check_writable(dir: &Path) -> Result<(), SessionError> {
-    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let probe = dir.join(format!(".strata-write-probe-{}-{n}", std::process::id()));
-    let fail = |source| SessionError::NotWritable { dir: dir.to_path_buf(), source };
-    if !dir.is_dir() {
-        return Err(fail(std::io::Error::new(std::io::ErrorKind::NotFound, "no such directory")));
-    }
-    std::fs::OpenOptions::new().write(true).create_new(true).open(&probe).map_err(fail)?;
-    std::fs::remove_file(&probe).map_err(fail)
+    let mut plan = crate::files::Plan::new();
+    plan.output("the output", file);
+    plan.check().map_err(plan_error)
 }
 
 /// Refuses a sampler asked for more points than its period ([`crate::sampler::SamplerInfo`]'s

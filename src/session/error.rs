@@ -80,10 +80,10 @@ pub enum SessionError {
     #[error(transparent)]
     NotProgressive(#[from] crate::integrator::NotProgressive),
     /// `--time-budget` not a positive number.
-    #[error("--time-budget {0}: expected a positive number of seconds")]
+    #[error("--time-budget {}: expected a positive number of seconds", short_f64(*.0))]
     TimeBudget(f64),
     /// `--checkpoint-every` negative or not finite.
-    #[error("--checkpoint-every {0}: expected a number of seconds >= 0")]
+    #[error("--checkpoint-every {}: expected a number of seconds >= 0", short_f64(*.0))]
     CheckpointEvery(f64),
     /// `--samples A..B` outside the spp.
     #[error("--samples {a}..{b}: expected A < B <= spp ({cap})")]
@@ -195,6 +195,25 @@ pub enum SessionError {
         /// the checkpoint error
         source: Box<SessionError>,
     },
+    /// Every triangle of a scene without other geometry was dropped: nothing would be rendered.
+    #[error("{}: every triangle was dropped ({zero} zero-area, {huge} with an area that overflows f32): nothing is left to render", path.display())]
+    NothingLeft {
+        /// the scene file
+        path: PathBuf,
+        /// zero-area triangles
+        zero: usize,
+        /// triangles whose area overflows f32
+        huge: usize,
+    },
+    /// Outputs of a finished render that could not be written, and those that were (each output
+    /// is tried whatever happened to the others).
+    #[error("{failed}; {written}")]
+    OutputsFailed {
+        /// the errors, joined
+        failed: String,
+        /// what was written (`written: A, B`), or `nothing was written`
+        written: String,
+    },
     /// A point-set file (or array) has fewer points per set than the render draws per pixel.
     #[error(
         "{sampler}: its sets have {points} points, but {asked} are drawn per pixel (sets of {points} points \
@@ -215,4 +234,27 @@ pub enum SessionError {
     /// A signal handler could not be installed.
     #[error("signal handler: {0}")]
     Signal(std::io::Error),
+}
+
+/// `v` as Rust prints it when that is short, else in scientific notation (`-1e-300`, not 300
+/// digits).
+pub fn short_f64(v: f64) -> String {
+    let plain = v.to_string();
+    if plain.len() <= 24 {
+        plain
+    } else {
+        format!("{v:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Before: `--time-budget -1e-300` from the library printed the number with 300 digits.
+    #[test]
+    fn tiny_numbers_print_short() {
+        assert_eq!(super::short_f64(-1e-300), "-1e-300");
+        assert_eq!(super::short_f64(2.5), "2.5");
+        let e = super::SessionError::TimeBudget(-1e-300).to_string();
+        assert!(e.len() < 80 && e.contains("-1e-300"), "{e}");
+    }
 }

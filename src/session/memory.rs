@@ -83,11 +83,9 @@ pub fn estimate(desc: &SceneDesc, range: std::ops::Range<u32>, threads: usize) -
     let film = pass.max(state + (100 * px).max(48 * px * b));
     let tris = (desc.triangles.len() + desc.emissive_triangles.len() + 2 * desc.quad_lights.len()) as u64;
     let normals = if desc.triangle_normals.is_empty() { 0 } else { PER_TRIANGLE_NORMALS * tris };
-    let high = match std::env::var("STRATA_BVH").as_deref() {
-        Ok("high") => true,
-        Ok("medium") => false,
-        _ => tris >= crate::scene::build::HIGH_QUALITY_MIN_TRIANGLES as u64,
-    };
+    // A bad STRATA_BVH was refused by the command-line checks; here it counts as unset.
+    let by_count = tris >= crate::scene::build::HIGH_QUALITY_MIN_TRIANGLES as u64;
+    let high = crate::scene::build::forced_bvh().ok().flatten().unwrap_or(by_count);
     let bvh_factor = if high { BVH_HIGH_FACTOR } else { 1 };
     Estimate {
         film,

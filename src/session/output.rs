@@ -53,7 +53,7 @@ pub fn metadata(out: &RenderOutput) -> Metadata {
 /// checkpoint (last: one that cannot be written is an error, the images stay). Non-finite samples
 /// (counted as zero) are reported on stderr.
 pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
-    let mut out = render_passes(opts)?;
+    let mut out = render_passes(opts, true)?;
     let nonfinite = out.stats.counters.nonfinite;
     if nonfinite > 0 {
         eprintln!(
@@ -78,26 +78,64 @@ pub fn run_render(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
         let exr_result = film::write_exr(&exr, w, h, &mean, Some(&var), &meta);
         (exr_result, png_job.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
     });
-    exr_result.map_err(|source| SessionError::Output { path: exr.clone(), source })?;
-    png_bytes
-        .and_then(|bytes| film::write_atomic(&png, &bytes))
-        .map_err(|source| SessionError::Output { path: png.clone(), source })?;
-    out.out = Some(stem);
+    // Every output is tried even when another failed (a full disk, a removed directory): the
+    // finished render survives in whichever could be written, and the error says which.
+    let mut failed: Vec<SessionError> = Vec::new();
+    let mut written: Vec<PathBuf> = Vec::new();
+    match exr_result {
+        Ok(()) => {
+            written.push(exr.clone());
+            match png_bytes.and_then(|bytes| film::write_atomic(&png, &bytes)) {
+                Ok(()) => written.push(png.clone()),
+                Err(source) => failed.push(SessionError::Output { path: png.clone(), source }),
+            }
+        }
+        Err(source) => failed.push(SessionError::Output { path: exr.clone(), source }),
+    }
+    if failed.is_empty() {
+        out.out = Some(stem.clone());
+    }
     if let Some(p) = &opts.profile {
         // The encoding ran on this thread after the render: its own phase, added to the total.
         let ns = encode_start.elapsed().as_nanos() as u64;
         out.stats.phase_ns[crate::profile::Phase::Output as usize] += ns;
         out.stats.profiled_ns += ns;
         let profile = super::profile::Profile::from_stats(&out.scene.desc.source.display().to_string(), &out.stats);
-        super::profile::write_text(p, &serde_json::to_string_pretty(&profile)?)?;
+        match super::profile::write_text(p, &serde_json::to_string_pretty(&profile)?) {
+            Ok(()) => written.push(p.clone()),
+            Err(e) => failed.push(e),
+        }
     }
     if let Some(p) = &opts.stats {
         let text = serde_json::to_string_pretty(&stats_json(&out))?;
-        film::write_atomic(p, text.as_bytes()).map_err(|source| SessionError::Output { path: p.clone(), source })?;
+        match film::write_atomic(p, text.as_bytes()) {
+            Ok(()) => written.push(p.clone()),
+            Err(source) => failed.push(SessionError::Output { path: p.clone(), source }),
+        }
     }
-    write_checkpoint(&out).map_err(|e| SessionError::CheckpointAfterImages {
-        images: out.out.clone().unwrap_or_default(),
-        source: Box::new(e),
-    })?;
-    Ok(out)
+    let ckpt = write_checkpoint(&out);
+    drop(out.lock.take());
+    match ckpt {
+        Ok(()) if failed.is_empty() => return Ok(out),
+        Ok(()) => written.extend(out.checkpoint.clone()),
+        Err(e) if failed.is_empty() => {
+            return Err(SessionError::CheckpointAfterImages { images: stem, source: Box::new(e) })
+        }
+        Err(e) => failed.push(e),
+    }
+    Err(SessionError::OutputsFailed {
+        failed: failed.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "),
+        written: if written.is_empty() {
+            "nothing was written".into()
+        } else {
+            let w: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+            let resume = match &out.checkpoint {
+                Some(c) if written.contains(c) => {
+                    format!(" (the finished render is in {}: --resume it to write the rest)", c.display())
+                }
+                _ => String::new(),
+            };
+            format!("written: {}{resume}", w.join(", "))
+        },
+    })
 }

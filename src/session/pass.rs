@@ -38,6 +38,9 @@ pub struct RenderOutput {
     pub checkpoint: Option<PathBuf>,
     /// stopped by the `stop` flag (a signal) before the sample range was done
     pub interrupted: bool,
+    /// the advisory lock on the output stem, held from before the first pass until the outputs
+    /// are written (a render that writes images; None for [`render_to_film`])
+    pub(super) lock: Option<crate::files::StemLock>,
 }
 
 /// Renders without writing images: scene build, integrator set-up, the sample range in passes
@@ -45,7 +48,7 @@ pub struct RenderOutput {
 /// early on `opts.stop` or when `opts.time_budget` is spent). A render that ends with no sample
 /// is an error ([`SessionError::NoSamples`]) and writes nothing.
 pub fn render_to_film(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
-    let out = render_passes(opts)?;
+    let out = render_passes(opts, false)?;
     write_checkpoint(&out)?;
     Ok(out)
 }
@@ -61,9 +64,18 @@ pub(super) fn write_checkpoint(out: &RenderOutput) -> Result<(), SessionError> {
 /// [`render_to_film`] without the final checkpoint (the caller writes the images first, then it:
 /// a checkpoint that cannot be written never costs the finished images). Periodic checkpoints
 /// are written here; one that fails is reported and tried again a period later, the previous
-/// one staying in place.
-pub(super) fn render_passes(opts: &RenderOptions) -> Result<RenderOutput, SessionError> {
+/// one staying in place. With `lock`, the output stem's [`crate::files::StemLock`] is taken
+/// before the first pass (a second render to the same stem is refused) and returned held.
+pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOutput, SessionError> {
     let (scene, mut integrator) = prepare(opts)?;
+    let stem = output_stem(opts, &scene.desc);
+    let lock = match lock {
+        true => Some(
+            crate::files::StemLock::acquire(&stem)
+                .map_err(|e| SessionError::BadOutput { path: stem.clone(), why: e.to_string() })?,
+        ),
+        false => None,
+    };
     if let Some(b) = opts.time_budget {
         if !(b > 0.0 && b.is_finite()) {
             return Err(SessionError::TimeBudget(b));
@@ -102,7 +114,12 @@ pub(super) fn render_passes(opts: &RenderOptions) -> Result<RenderOutput, Sessio
         (header.cpu_seconds, header.render_seconds, header.rays) = (h.cpu_seconds, h.render_seconds, h.rays);
         film = f;
     }
-    let ckpt_path = opts.checkpoint.clone().or_else(|| opts.resume.clone());
+    // `--samples` checkpoints to OUT.ckpt by default, periodically too (`--checkpoint-every`).
+    let ckpt_path = opts
+        .checkpoint
+        .clone()
+        .or_else(|| opts.resume.clone())
+        .or_else(|| opts.samples.is_some().then(|| with_ext(&stem, "ckpt")));
     let pool = render::thread_pool(opts.threads)?;
     let (w, h) = (scene.desc.width, scene.desc.height);
     let tiles = u64::from(w.div_ceil(render::TILE)) * u64::from(h.div_ceil(render::TILE));
@@ -167,14 +184,13 @@ pub(super) fn render_passes(opts: &RenderOptions) -> Result<RenderOutput, Sessio
             None => "no pass ran".to_string(),
         }));
     }
-    let stem = output_stem(opts, &scene.desc);
     let final_ckpt = match ckpt_path {
         Some(p) => Some(p),
         None if interrupted || opts.samples.is_some() => Some(with_ext(&stem, "ckpt")),
         None => None,
     };
     header = checkpoint::header_for(header, &film);
-    Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted })
+    Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted, lock })
 }
 
 /// Sets the returned flag on SIGINT or SIGTERM (a render checks it between passes, then writes a

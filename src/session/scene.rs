@@ -124,7 +124,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         }
     }
     let desc = load_scene(opts)?;
-    super::checks::check_outputs(opts, &super::output_stem(opts, &desc))?;
+    super::checks::check_outputs(opts, &super::output_stem(opts, &desc), &desc.inputs)?;
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {
         return Err(over("spp", spp.to_string(), opts.limits.max_spp.into(), "", "max_spp"));
@@ -143,6 +143,13 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     let scene = Scene::build(desc)?;
     let plural = |n: usize| if n == 1 { "" } else { "s" };
     let (zero, huge) = (scene.degenerate_dropped - scene.overflow_dropped, scene.overflow_dropped);
+    let d = &scene.desc;
+    let triangles = d.triangles.len() + d.emissive_triangles.len();
+    if triangles > 0 && scene.degenerate_dropped >= triangles && d.spheres.is_empty() {
+        // Before: an OBJ whose only triangle overflowed got a camera framing the dropped vertices
+        // and rendered black with exit 0.
+        return Err(SessionError::NothingLeft { path: d.source.clone(), zero, huge });
+    }
     if zero > 0 {
         eprintln!(
             "strata: warning: {}: dropped {zero} degenerate (zero-area) triangle{}",
@@ -225,7 +232,8 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
 pub fn scene_hash(opts: &RenderOptions) -> Result<String, SessionError> {
     Ok(match &opts.scene {
         Some(p) => checkpoint::hash_bytes(
-            &std::fs::read(p).map_err(|source| SessionError::SceneRead { path: p.clone(), source })?,
+            &crate::files::read_bounded(p, opts.limits.max_file_bytes)
+                .map_err(|source| SessionError::SceneRead { path: p.clone(), source })?,
         ),
         None => checkpoint::hash_bytes(DEFAULT_SCENE.as_bytes()),
     })

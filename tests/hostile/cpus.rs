@@ -121,6 +121,9 @@ fn embree_configs_below_avx2_or_unknown_are_refused() {
         ("isa=sse2", "below AVX2"),
         ("isa=sse4.2", "below AVX2"),
         ("threads=2,tri_accel=bvh4.triangle4", "unknown key `tri_accel`"),
+        // Issue 32, finding 1: Embree splits on newlines too (before, this ran SSE2 and the EXR
+        // said avx2).
+        ("threads=2\nisa=sse2", "below AVX2"),
     ] {
         let a = ["render", s, "--size", "32x32", "--spp", "1", "--threads", "2", "-o", "d", "-q"];
         let r = strata_env(&dir, &a, &[("STRATA_EMBREE_CONFIG", cfg)], 120);

@@ -117,6 +117,8 @@ pub struct ObjMesh {
     /// `faces`), or `[NO_NORMAL; 3]` when any corner has no valid normal. Empty (not
     /// `faces.len()` long) when no triangle has normals.
     pub face_normals: Vec<[u32; 3]>,
+    /// the MTL libraries read for it
+    pub libraries: Vec<PathBuf>,
 }
 
 impl ObjMesh {

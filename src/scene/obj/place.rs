@@ -41,6 +41,7 @@ pub fn scene_from_obj_with_warnings(path: &Path, limits: &Limits) -> Result<(Sce
     let (mesh, warnings) = load_with_warnings_bounded(path, limits.max_file_bytes)?;
     let mut desc = SceneDesc {
         source: path.to_path_buf(),
+        inputs: mesh.libraries.clone(),
         spp: 16,
         gamma: 2.2,
         integrator: IntegratorKind::PathTracer,

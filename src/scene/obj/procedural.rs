@@ -12,10 +12,12 @@ fn torus_side(min_triangles: usize) -> usize {
 
 /// Bytes [`procedural_mesh`] holds for `min_triangles` (positions 12 and face 12 + material 4 bytes
 /// per triangle, reserved up front), so that `gen-mesh` can refuse a mesh that does not fit.
+/// Computed in u128 and saturated, so a huge count (`--triangles 9223372036854775807`) is refused
+/// as too big rather than wrapping to a small number (before: a `capacity overflow` panic).
 pub fn procedural_mesh_bytes(min_triangles: usize) -> u64 {
-    let n = torus_side(min_triangles) as u64;
+    let n = torus_side(min_triangles) as u128;
     let (verts, tris) = (2 * n * n + 12, 4 * n * n + 6);
-    12 * verts + 16 * tris
+    u64::try_from(12 * verts + 16 * tris).unwrap_or(u64::MAX)
 }
 
 /// A procedural test mesh of at least `min_triangles` triangles: a bumpy torus (2 n x n quads, no
@@ -75,11 +77,15 @@ pub fn procedural_mesh(min_triangles: usize) -> ObjMesh {
 }
 
 /// Writes `mesh` as `path` (OBJ, one `usemtl` per run of faces) and `path` with extension `.mtl`
-/// (its materials). Returns the MTL path.
+/// (its materials), each through the safe-write path ([`crate::files::AtomicFile`]: a link, FIFO
+/// or device at either name is refused, never written through; the files appear whole or not at
+/// all). Returns the MTL path.
 pub fn write_obj(path: &Path, mesh: &ObjMesh) -> std::io::Result<PathBuf> {
     let mtl_path = path.with_extension("mtl");
     let mtl_name = mtl_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let mut m = std::io::BufWriter::new(std::fs::File::create(&mtl_path)?);
+    let mut mtl_file = crate::files::AtomicFile::create(&mtl_path)?;
+    let mut obj_file = crate::files::AtomicFile::create(path)?;
+    let mut m = std::io::BufWriter::new(mtl_file.file());
     for mat in &mesh.materials {
         writeln!(m, "newmtl {}", mat.name)?;
         let v3 = |k: &str, v: Option<Vec3>| v.map(|v| format!("{k} {} {} {}\n", v.x, v.y, v.z)).unwrap_or_default();
@@ -89,7 +95,8 @@ pub fn write_obj(path: &Path, mesh: &ObjMesh) -> std::io::Result<PathBuf> {
         }
     }
     m.flush()?;
-    let mut w = std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(path)?);
+    drop(m);
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, obj_file.file());
     writeln!(w, "# strata procedural mesh: {} triangles\nmtllib {mtl_name}", mesh.faces.len())?;
     for p in &mesh.positions {
         writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
@@ -105,5 +112,8 @@ pub fn write_obj(path: &Path, mesh: &ObjMesh) -> std::io::Result<PathBuf> {
         writeln!(w, "f {} {} {}", f[0] + 1, f[1] + 1, f[2] + 1)?;
     }
     w.flush()?;
+    drop(w);
+    mtl_file.commit()?;
+    obj_file.commit()?;
     Ok(mtl_path)
 }

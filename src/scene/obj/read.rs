@@ -77,7 +77,7 @@ pub fn load_with_warnings_bounded(path: &Path, max: u64) -> Result<(ObjMesh, Vec
         err(path, line, msg)
     })?;
     warnings.extend(parsed.warnings.iter().map(|(line, m)| warn(path, *line, m.clone())));
-    let (materials, by_name) = load_libraries(path, &parsed, max, &mut warnings)?;
+    let (materials, by_name, libraries) = load_libraries(path, &parsed, max, &mut warnings)?;
     // usemtl slots -> material indices
     let any_library = !materials.is_empty() || !parsed.mtllibs.is_empty();
     let mut slot_material = Vec::with_capacity(parsed.usemtl.len());
@@ -113,6 +113,7 @@ pub fn load_with_warnings_bounded(path: &Path, max: u64) -> Result<(ObjMesh, Vec
         materials,
         normals: parsed.normals,
         face_normals: parsed.face_normals,
+        libraries,
     };
     if mesh.faces.is_empty() {
         return Err(err(path, 0, "the OBJ file has no faces"));
@@ -132,6 +133,10 @@ pub fn load_with_warnings_bounded(path: &Path, max: u64) -> Result<(ObjMesh, Vec
     Ok((mesh, warnings))
 }
 
+/// The materials of an OBJ's libraries (in library order), their names' indices, and the library
+/// files read.
+type Libraries = (Vec<MtlMaterial>, HashMap<String, u32>, Vec<PathBuf>);
+
 /// Finds and loads the OBJ's material libraries: the materials (in library order) and a name map
 /// (a later definition of a name wins, as in `tobj`).
 fn load_libraries(
@@ -139,7 +144,7 @@ fn load_libraries(
     parsed: &ParsedObj,
     max: u64,
     warnings: &mut Vec<ObjWarning>,
-) -> Result<(Vec<MtlMaterial>, HashMap<String, u32>), SceneError> {
+) -> Result<Libraries, SceneError> {
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let mut loaded: Vec<PathBuf> = Vec::new();
     let mut missing: Vec<(usize, String, String)> = Vec::new();
@@ -199,7 +204,7 @@ fn load_libraries(
         let then = if loaded.is_empty() { "using default materials" } else { "skipped" };
         warnings.push(warn(path, line, format!("mtllib '{name}' {why}; {then}")));
     }
-    Ok((materials, by_name))
+    Ok((materials, by_name, loaded))
 }
 
 /// The file names on an `mtllib` line: the whole rest of the line if that names a file in `dir`
