@@ -9,7 +9,7 @@ use strata::session;
 
 mod cli;
 
-use cli::{Cli, Cmd};
+use cli::{Cli, Cmd, ReferenceCmd};
 
 /// The build targets x86-64-v3 (see `.cargo/config.toml`): on a CPU without AVX2/FMA the first SIMD
 /// instruction would kill the process with SIGILL, so check before anything else runs.
@@ -53,7 +53,23 @@ fn main() -> ExitCode {
             println!("ok");
             Ok(())
         }
-        Cmd::Render(cmd) | Cmd::Reference(cmd) => {
+        Cmd::Reference(cmd) if cmd.replicas > 1 => {
+            let args = cmd.render.into_args();
+            let quiet = args.quiet;
+            let mut opts = args.options();
+            // A reference is unbiased by default, whatever the scene's course conventions.
+            opts.first_sample.get_or_insert(strata::integrator::FirstSample::Jittered);
+            match session::reference::run_reference(&opts, cmd.replicas) {
+                Ok(rep) => {
+                    if !quiet {
+                        println!("{}", session::reference::summary(&rep));
+                    }
+                    Ok(())
+                }
+                Err(e) => Err(e.to_string()),
+            }
+        }
+        Cmd::Render(cmd) | Cmd::Reference(ReferenceCmd { render: cmd, .. }) => {
             let args = cmd.into_args();
             let quiet = args.quiet;
             let mut opts = args.options();
@@ -205,7 +221,7 @@ fn main() -> ExitCode {
 /// a render writing an image uses (and `rays` with `--profile`).
 fn refuse_unused_flags(cmd: &Cmd) {
     let (name, args) = match cmd {
-        Cmd::Reference(cmd) if cmd.args.spp.is_none() => usage_error(
+        Cmd::Reference(cmd) if cmd.render.args.spp.is_none() => usage_error(
             "reference",
             "`strata reference` needs --spp N (a reference is a high-spp render, e.g. --spp 4096)".into(),
         ),

@@ -215,4 +215,10 @@ pub enum SessionError {
     /// A signal handler could not be installed.
     #[error("signal handler: {0}")]
     Signal(std::io::Error),
+    /// `strata reference --replicas`: what a replicated reference cannot do.
+    #[error("reference: {why}")]
+    Replicas {
+        /// what was refused and why
+        why: String,
+    },
 }
