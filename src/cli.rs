@@ -264,11 +264,12 @@ pub(crate) struct ReferenceCmd {
     #[command(flatten)]
     pub(crate) render: RenderCmd,
     /// Independent replicas (seeds and scrambles of their own) of spp/replicas samples each: the
-    /// variance layer is their variance of the mean, right for every sampler (1: one render, the
-    /// i.i.d. formula, which overstates stratified and low-discrepancy samplers' error; it keeps
-    /// --checkpoint, --resume, --samples).
-    #[arg(long, help_heading = SAMPLING, default_value_t = strata::session::reference::DEFAULT_REPLICAS, value_parser = parse_positive::<u32>)]
-    pub(crate) replicas: u32,
+    /// variance layer is their variance of the mean, right for every sampler (default: the
+    /// largest divisor of --spp from 2 to 8; 1: one render and the i.i.d. formula, which
+    /// overstates stratified and low-discrepancy samplers' error, but keeps --checkpoint,
+    /// --resume and --samples).
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_positive::<u32>)]
+    pub(crate) replicas: Option<u32>,
 }
 
 impl RenderCmd {

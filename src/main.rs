@@ -53,13 +53,14 @@ fn main() -> ExitCode {
             println!("ok");
             Ok(())
         }
-        Cmd::Reference(cmd) if cmd.replicas > 1 => {
+        Cmd::Reference(cmd) if resolve_replicas(&cmd) > 1 => {
+            let replicas = resolve_replicas(&cmd);
             let args = cmd.render.into_args();
             let quiet = args.quiet;
             let mut opts = args.options();
             // A reference is unbiased by default, whatever the scene's course conventions.
             opts.first_sample.get_or_insert(strata::integrator::FirstSample::Jittered);
-            match session::reference::run_reference(&opts, cmd.replicas) {
+            match session::reference::run_reference(&opts, replicas) {
                 Ok(rep) => {
                     if !quiet {
                         println!("{}", session::reference::summary(&rep));
@@ -214,6 +215,14 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The replicas of `strata reference`: `--replicas`, else [`session::reference::default_replicas`]
+/// of its spp (1 when there is none: a shard, a resumed or checkpointed reference).
+fn resolve_replicas(cmd: &ReferenceCmd) -> u32 {
+    let a = &cmd.render.args;
+    let single = a.samples.is_some() || a.resume.is_some() || a.checkpoint.is_some() || a.time_budget.is_some();
+    cmd.replicas.unwrap_or(if single { 1 } else { session::reference::default_replicas(a.spp.unwrap_or(1)) })
 }
 
 /// Refuses, as a usage error (exit status 2), what the parsed command line asks for but the

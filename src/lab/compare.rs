@@ -224,7 +224,9 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         }
         prepared.push((o, scene, integ));
     }
-    let ref_info = ReferenceInfo { variance: img.variance.as_deref(), gamma: None };
+    let (variance_dof, noise_notes) = checks::reference_noise(&img);
+    notes.extend(noise_notes);
+    let ref_info = ReferenceInfo { variance: img.variance.as_deref(), gamma: None, variance_dof };
     let ref_srgb = flip::to_srgb8(&img.rgb);
     let mut progress = Progress::new("compare", variants.len() * steps.len() * opts.runs, opts.progress);
     let (mut rows, mut run_rows, mut profiles, mut images) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());

@@ -18,6 +18,7 @@ fn row(variant: &str, seconds: f64, mse: f64) -> Row {
         rel_mse: 3.0 * mse,
         eight_bit: Some(EightBit { variance: 2.5, mse: 3.5 }),
         ref_variance: 0.0,
+        mse_corrected_ci: (0.5 * mse, 1.5 * mse),
     };
     Row::new(variant, seconds, 64.0, &stats).unwrap().with_sampler(12.5, 0.25)
 }
@@ -105,6 +106,7 @@ fn json_has_the_compare_keys_and_round_trips_the_numbers() {
         "flip",
         "eff_vs_baseline",
         "same_as",
+        "mse_corrected_ci",
     ];
     want.sort_unstable();
     let mut keys = keys;

@@ -18,8 +18,15 @@ use super::stats::stats_json;
 use super::{output_stem, RenderOptions, SessionError};
 use crate::film::{self, with_ext, Metadata};
 
-/// Replicas of `strata reference` unless `--replicas` says otherwise.
+/// The most replicas `strata reference` makes unless `--replicas` says otherwise.
 pub const DEFAULT_REPLICAS: u32 = 8;
+
+/// The replicas of a reference of `spp` samples unless `--replicas` says otherwise: the largest
+/// divisor of `spp` from 2 to [`DEFAULT_REPLICAS`] (1 when there is none: then one render, and
+/// the i.i.d. variance layer, which says so in `strata.variance`).
+pub fn default_replicas(spp: u32) -> u32 {
+    (2..=DEFAULT_REPLICAS).rev().find(|r| spp % r == 0).unwrap_or(1)
+}
 
 /// `strata.variance` of a render: the i.i.d. formula over its samples.
 pub const VARIANCE_IID: &str =
