@@ -54,7 +54,9 @@ fn csv_has_header_one_line_per_row_and_parses_back() {
     assert_eq!(lines[0], CSV_HEADER);
     for (line, row) in lines[1..].iter().zip(&rows) {
         let f = parse_csv_line(line);
-        assert_eq!(f.len(), 17, "{line}");
+        assert_eq!(f.len(), 19, "{line}");
+        let ci: Vec<f64> = f[17..19].iter().map(|s| s.parse().unwrap()).collect();
+        assert_eq!(ci, [row.stats.mse_corrected_ci.0, row.stats.mse_corrected_ci.1], "{line}");
         let x: Vec<f64> = f[1..12].iter().map(|s| s.parse().unwrap()).collect();
         assert_eq!(f[0], row.variant);
         let s = &row.stats;
