@@ -518,7 +518,11 @@ mod tests {
             }
         }
         assert_eq!(budget_pass(0.0, 0, 1.0), 1);
-        assert_eq!(budget_pass(0.99, 99, 1.0), 1, "a sample that does not fit still runs: the run stops at t >= budget");
+        assert_eq!(
+            budget_pass(0.99, 99, 1.0),
+            1,
+            "a sample that does not fit still runs: the run stops at t >= budget"
+        );
         assert_eq!(budget_pass(0.01, 10, 1.0), 10, "at most doubling");
     }
 

@@ -80,7 +80,9 @@ impl Replicated {
 pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated, SessionError> {
     let spp = opts.spp.ok_or(SessionError::Replicas { why: "it needs --spp".into() })?;
     if replicas < 2 {
-        return Err(SessionError::Replicas { why: format!("--replicas {replicas}: at least 2 give an error estimate") });
+        return Err(SessionError::Replicas {
+            why: format!("--replicas {replicas}: at least 2 give an error estimate"),
+        });
     }
     if spp % replicas != 0 {
         return Err(SessionError::Replicas {
@@ -194,7 +196,8 @@ pub fn run_reference(opts: &RenderOptions, replicas: u32) -> Result<Replicated, 
         .map_err(|source| SessionError::Output { path: png.clone(), source })?;
     rep.out.out = Some(stem);
     if let Some(p) = &opts.profile {
-        let profile = super::profile::Profile::from_stats(&rep.out.scene.desc.source.display().to_string(), &rep.out.stats);
+        let profile =
+            super::profile::Profile::from_stats(&rep.out.scene.desc.source.display().to_string(), &rep.out.stats);
         super::profile::write_text(p, &serde_json::to_string_pretty(&profile)?)?;
     }
     if let Some(p) = &opts.stats {
