@@ -284,7 +284,7 @@ pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "MSE - ref. var.", cell: |r, _| sci(r.stats.mse_corrected()) },
     Column {
         header: "its 95% CI",
-        cell: |r, _| format!("[{}, {}]", sci(r.stats.mse_corrected_ci.0), sci(r.stats.mse_corrected_ci.1)),
+        cell: |r, _| format!("{} .. {}", sci(r.stats.mse_corrected_ci.0), sci(r.stats.mse_corrected_ci.1)),
     },
     Column { header: "relMSE", cell: |r, _| sci(r.stats.rel_mse) },
     Column { header: "FLIP", cell: |r, _| if r.flip.is_finite() { format!("{:.4}", r.flip) } else { "n/a".into() } },
