@@ -25,7 +25,7 @@ pub const DEFAULT_REPLICAS: u32 = 8;
 /// divisor of `spp` from 2 to [`DEFAULT_REPLICAS`] (1 when there is none: then one render, and
 /// the i.i.d. variance layer, which says so in `strata.variance`).
 pub fn default_replicas(spp: u32) -> u32 {
-    (2..=DEFAULT_REPLICAS).rev().find(|r| spp % r == 0).unwrap_or(1)
+    (2..=DEFAULT_REPLICAS).rev().find(|&r| spp.is_multiple_of(r)).unwrap_or(1)
 }
 
 /// `strata.variance` of a render: the i.i.d. formula over its samples.
@@ -84,7 +84,7 @@ pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated
             why: format!("--replicas {replicas}: at least 2 give an error estimate"),
         });
     }
-    if spp % replicas != 0 {
+    if !spp.is_multiple_of(replicas) {
         return Err(SessionError::Replicas {
             why: format!(
                 "--spp {spp} is not a multiple of --replicas {replicas} (each replica renders spp / replicas samples; e.g. --spp {})",
