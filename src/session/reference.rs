@@ -184,6 +184,7 @@ pub fn replicated_metadata(rep: &Replicated, base_seed: u64) -> Metadata {
 /// `replicas`, `replica_spp` and `variance_estimate`) and the `--profile` JSON.
 pub fn run_reference(opts: &RenderOptions, replicas: u32) -> Result<Replicated, SessionError> {
     let mut rep = render_replicas(opts, replicas)?;
+    let encode_start = std::time::Instant::now();
     let stem = output_stem(opts, &rep.out.scene.desc);
     let (w, h) = (rep.out.film.width, rep.out.film.height);
     let (exr, png) = (with_ext(&stem, "exr"), with_ext(&stem, "png"));
@@ -196,6 +197,10 @@ pub fn run_reference(opts: &RenderOptions, replicas: u32) -> Result<Replicated, 
         .map_err(|source| SessionError::Output { path: png.clone(), source })?;
     rep.out.out = Some(stem);
     if let Some(p) = &opts.profile {
+        // The encoding ran on this thread after the replicas: its own phase, added to the total.
+        let ns = encode_start.elapsed().as_nanos() as u64;
+        rep.out.stats.phase_ns[crate::profile::Phase::Output as usize] += ns;
+        rep.out.stats.profiled_ns += ns;
         let profile =
             super::profile::Profile::from_stats(&rep.out.scene.desc.source.display().to_string(), &rep.out.stats);
         super::profile::write_text(p, &serde_json::to_string_pretty(&profile)?)?;
