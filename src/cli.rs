@@ -47,9 +47,11 @@ pub(crate) enum Cmd {
     Render(RenderCmd),
     /// Render a high-spp reference: linear EXR with a per-pixel variance layer (and a PNG), with
     /// progress and ETA. Same flags as `render`; --spp is required. Unbiased by default:
-    /// --first-sample jittered unless given.
+    /// --first-sample jittered unless given. The image is the mean of --replicas independent
+    /// renders (own seeds and scrambles) of spp/replicas samples each, and the variance layer is
+    /// the variance of that mean estimated across them (EXR attribute `strata.variance`).
     #[command(allow_negative_numbers = true)]
-    Reference(RenderCmd),
+    Reference(ReferenceCmd),
     /// Compare sampling techniques against a reference: K independent runs per variant at equal spp
     /// (--spp-ladder) or equal time (--budget); writes rows.csv/json, runs.csv/json (one row per
     /// run), table.md, error.svg and report.html (flip-book, error maps, plots). The reference must
@@ -254,6 +256,20 @@ pub(crate) struct RenderCmd {
     /// Write statistics as JSON to this file (the same as --stats).
     #[arg(long, value_name = "FILE", help_heading = OUTPUT, conflicts_with = "stats")]
     pub(crate) json: Option<PathBuf>,
+}
+
+/// `reference`: the render flags and `--replicas`.
+#[derive(clap::Args)]
+pub(crate) struct ReferenceCmd {
+    #[command(flatten)]
+    pub(crate) render: RenderCmd,
+    /// Independent replicas (seeds and scrambles of their own) of spp/replicas samples each: the
+    /// variance layer is their variance of the mean, right for every sampler (default: the
+    /// largest divisor of --spp from 2 to 8; 1: one render and the i.i.d. formula, which
+    /// overstates stratified and low-discrepancy samplers' error, but keeps --checkpoint,
+    /// --resume and --samples).
+    #[arg(long, help_heading = SAMPLING, value_parser = parse_positive::<u32>)]
+    pub(crate) replicas: Option<u32>,
 }
 
 impl RenderCmd {

@@ -84,3 +84,44 @@ pub fn reference_mismatch(
     }
     (diffs, notes)
 }
+
+/// What is known of a reference's own noise: the degrees of freedom of each value of its variance
+/// layer (`R - 1` for R replicas, `spp - 1` for the i.i.d. layer of one render; `None` when not
+/// recorded) and notes for the report: its provenance (spp, samplers, mean variance, how the layer
+/// was estimated) and a warning when the layer is the i.i.d. formula over samples that are not
+/// independent (it then overstates the reference's noise, and so does every statistic that
+/// subtracts it).
+pub fn reference_noise(reference: &ExrImage) -> (Option<f64>, Vec<String>) {
+    let meta = |k: &str| reference.meta.iter().find(|(key, _)| key == k).map(|(_, v)| v.as_str());
+    let Some(var) = &reference.variance else {
+        return (None, vec!["the reference has no variance layer: it is taken as exact".into()]);
+    };
+    let mean = var.iter().flat_map(|p| p.iter().map(|&v| f64::from(v))).sum::<f64>() / (3 * var.len().max(1)) as f64;
+    let samplers: Vec<&str> =
+        ["strata.pixel_sampler", "strata.light_sampler", "strata.layout"].iter().filter_map(|k| meta(k)).collect();
+    let how = meta("strata.variance");
+    let mut notes = vec![format!(
+        "reference: {} spp, samplers {}, seed {}, mean own variance {mean:.3e} per value ({})",
+        meta("strata.spp").unwrap_or("?"),
+        if samplers.is_empty() { "not recorded".to_string() } else { samplers.join(" / ") },
+        meta("strata.seed").unwrap_or("?"),
+        how.unwrap_or("how the variance layer was estimated is not recorded"),
+    )];
+    let replicas = meta("strata.replicas").and_then(|r| r.parse::<f64>().ok()).filter(|&r| r >= 2.0);
+    let dof = match replicas {
+        Some(r) => Some(r - 1.0),
+        None => {
+            let all_independent = !samplers.is_empty() && samplers.iter().all(|s| s.contains("independent"));
+            if !all_independent {
+                notes.push(
+                    "the reference's variance layer is the i.i.d. formula over samples that are not (all) independent: \
+                     it overstates the reference's noise, so `MSE - ref. var.` and the bias intervals are too generous; \
+                     remake it with `strata reference` (independent replicas)"
+                        .into(),
+                );
+            }
+            meta("strata.spp").and_then(|n| n.parse::<f64>().ok()).filter(|&n| n >= 2.0).map(|n| n - 1.0)
+        }
+    };
+    (dof, notes)
+}

@@ -230,7 +230,9 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         }
         prepared.push((o, scene, integ));
     }
-    let ref_info = ReferenceInfo { variance: img.variance.as_deref(), gamma: None };
+    let (variance_dof, noise_notes) = checks::reference_noise(&img);
+    notes.extend(noise_notes);
+    let ref_info = ReferenceInfo { variance: img.variance.as_deref(), gamma: None, variance_dof };
     let ref_srgb = flip::to_srgb8(&img.rgb);
     let mut progress = Progress::new("compare", variants.len() * steps.len() * opts.runs, opts.progress);
     let (mut rows, mut run_rows, mut profiles, mut images) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -332,9 +334,13 @@ fn image_hash(img: &[[f32; 3]]) -> u64 {
     crate::checkpoint::fnv1a(0xcbf2_9ce4_8422_2325, &bytes)
 }
 
-/// One equal-time run: whole passes of one sample until `budget` CPU seconds of the workers are
-/// spent or the `max_spp` cap is reached (said in `notes`). The pixel layout is independent (the
-/// spp is not known in advance). Returns the seconds and spp.
+/// One equal-time run: passes until `budget` CPU seconds of the workers are spent or the
+/// `max_spp` cap is reached (said in `notes`). The pixel layout is independent (the spp is not
+/// known in advance). Returns the seconds and spp.
+///
+/// Passes grow geometrically ([`budget_pass`]): a run of n spp takes O(log n) passes, so what a
+/// pass costs besides its samples (tile set-up, the film merge) is paid a few times per run, not
+/// once per sample. The stopping rule looks at CPU time only, never at the image, as before.
 #[allow(clippy::too_many_arguments)]
 fn budget_run(
     scene: &crate::scene::build::Scene,
@@ -349,10 +355,11 @@ fn budget_run(
 ) -> (f64, u32) {
     let (mut t, mut s) = (0.0, 0u32);
     while t < budget && s < max_spp {
-        let st = render::render(scene, it, film, s..s + 1, pool);
+        let n = budget_pass(t, s, budget).min(max_spp - s);
+        let st = render::render(scene, it, film, s..s + n, pool);
         stats.merge(&st);
         t += st.cpu_seconds;
-        s += 1;
+        s += n;
     }
     if t < budget {
         let note = format!(
@@ -363,6 +370,18 @@ fn budget_run(
         }
     }
     (t, s)
+}
+
+/// The next pass of an equal-time run that has spent `t` of `budget` CPU seconds on `s` samples:
+/// the whole samples that fit in what is left at the cost per sample so far, at most doubling the
+/// run (so a slow pass cannot overshoot by more than the run so far) and at least one (the run
+/// stops once `t >= budget`, as one-sample passes did).
+pub fn budget_pass(t: f64, s: u32, budget: f64) -> u32 {
+    if s == 0 || t <= 0.0 {
+        return 1;
+    }
+    let fit = (budget - t) / (t / f64::from(s));
+    (fit.floor().min(f64::from(u32::MAX)) as u32).clamp(1, s)
 }
 
 /// Marks variants whose every run at every step is bit-identical to an earlier variant's: they are
@@ -425,4 +444,58 @@ fn convergence(variant: &str, runs: &[RunRow]) -> Convergence {
 fn samplers_ran(it: &crate::integrator::Integrator) -> String {
     let [pixel, light, path] = it.kinds().map(|k| k.name());
     format!("pixel {pixel}, light {light}, other {path}, choice {}", it.light_choice.name())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pass loop of [`budget_run`] against a model machine: `cost` CPU seconds per sample and
+    /// `overhead` per pass. Returns (passes, spp, seconds).
+    fn simulate(budget: f64, cost: f64, overhead: f64) -> (u32, u32, f64) {
+        let (mut t, mut s, mut passes) = (0.0, 0u32, 0);
+        while t < budget {
+            let n = budget_pass(t, s, budget);
+            t += overhead + cost * f64::from(n);
+            s += n;
+            passes += 1;
+        }
+        (passes, s, t)
+    }
+
+    /// One-sample passes paid the per-pass overhead once per sample (compare reached half the spp
+    /// per CPU second of a fixed-spp render); geometric passes pay it O(log spp) times.
+    #[test]
+    fn equal_time_passes_grow_geometrically() {
+        for (budget, cost, overhead) in [(1.0, 1e-3, 2e-4), (1.0, 1e-5, 1e-4), (4.0, 3e-2, 0.0), (0.5, 0.2, 0.1)] {
+            let (passes, spp, t) = simulate(budget, cost, overhead);
+            let bound = 2.0 * f64::from(spp).log2() + 3.0;
+            assert!(f64::from(passes) <= bound, "{passes} passes for {spp} spp (bound {bound})");
+            let fixed_rate = 1.0 / cost;
+            let rate = f64::from(spp) / t;
+            assert!(t >= budget, "stopped at {t} of {budget}");
+            if spp >= 64 {
+                assert!(rate >= 0.95 * fixed_rate, "{rate} spp/s against {fixed_rate} at fixed spp");
+                assert!(t <= budget * 1.5 + cost + overhead, "overshoot: {t} for {budget}");
+                // One-sample passes (the old rule) on the same machine fall below 0.95x when a
+                // pass costs anything: the check is sharp.
+                if overhead > 0.0 {
+                    assert!(1.0 / (cost + overhead) < 0.95 * fixed_rate);
+                }
+            }
+        }
+        assert_eq!(budget_pass(0.0, 0, 1.0), 1);
+        assert_eq!(
+            budget_pass(0.99, 99, 1.0),
+            1,
+            "a sample that does not fit still runs: the run stops at t >= budget"
+        );
+        assert_eq!(budget_pass(0.01, 10, 1.0), 10, "at most doubling");
+    }
+
+    #[test]
+    fn compare_run_seeds_are_not_reference_replica_seeds() {
+        let replicas: Vec<u64> = (0..64).map(|r| session::reference::replica_seed(0, r)).collect();
+        assert!((0..256).all(|run| !replicas.contains(&run_seed(0, run))));
+    }
 }

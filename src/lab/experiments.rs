@@ -165,7 +165,7 @@ pub fn reference_spp(opts: &RenderOptions) -> Result<Reference, LabError> {
 /// The statistics of K runs against a reference, with its own variance and gamma (the 8-bit
 /// statistics are on that gamma).
 pub fn run_stats(images: &[Vec<[f32; 3]>], reference: &Reference) -> Result<RunStats, ReportError> {
-    let info = ReferenceInfo { variance: Some(&reference.var), gamma: Some(reference.gamma) };
+    let info = ReferenceInfo { variance: Some(&reference.var), gamma: Some(reference.gamma), variance_dof: None };
     RunStats::against(images, &reference.rgb, info)
 }
 

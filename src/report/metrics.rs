@@ -67,6 +67,9 @@ pub struct ReferenceInfo<'a> {
     /// the PNG gamma: also compute the statistics of the 8-bit gamma-encoded values (what a PNG
     /// shows); `None`: skip them
     pub gamma: Option<f32>,
+    /// degrees of freedom of each value of `variance` (a reference of R replicas: R - 1), for the
+    /// interval of [`RunStats::mse_corrected`]; `None`: the layer is taken as exact
+    pub variance_dof: Option<f64>,
 }
 
 /// Error statistics of the 8-bit gamma-encoded values 0..255 (see [`RunStats::eight_bit`]).
@@ -98,7 +101,12 @@ pub struct EightBit {
 /// - `bias_ratio = mean_i (m[i] - r[i])^2 / (variance / K + mean_i v[i])`: about 1 for an
 ///   unbiased technique (infinite when the denominator is 0),
 /// - `ref_variance = mean_i v[i]`, and the noise-corrected MSE `mse - ref_variance`
-///   ([`RunStats::mse_corrected`]).
+///   ([`RunStats::mse_corrected`]) with its 95% interval `mse_corrected_ci`:
+///   `-/+ t(0.975, K - 1) * sqrt(s_mse^2 / K + sum_i (2 v[i]^2 + 4 v[i] s[i]^2 / K + 2 v[i]^2 / d) / M^2)`
+///   with `s_mse^2` the runs' spread of their MSE, and, for the reference's one realized error
+///   `eps[i]` (common to every run): the spread of `mean_i eps[i]^2` around `mean_i v[i]` (`2 v^2`,
+///   Gaussian), of the cross term `2 mean_i (m[i] - truth[i]) eps[i]` (`4 v s^2 / K`), and of the
+///   layer's own estimate with `d` degrees of freedom ([`ReferenceInfo::variance_dof`]; `2 v^2 / d`).
 ///
 /// Algebraically `mse = bias_sq + variance` exactly (per value,
 /// `mean_k (x - r)^2 = (m - r)^2 + (K - 1)/K * s^2`); [`RunStats::decomposition_residual`]
@@ -131,6 +139,8 @@ pub struct RunStats {
     pub eight_bit: Option<EightBit>,
     /// mean over values of the reference's own variance (0 for an exact reference)
     pub ref_variance: f64,
+    /// two-sided 95% confidence interval of [`RunStats::mse_corrected`]
+    pub mse_corrected_ci: (f64, f64),
 }
 
 impl RunStats {
@@ -160,15 +170,19 @@ impl RunStats {
         let bias = over_runs(|e| e.err);
         let spread = per_run.iter().map(|e| (e.err - bias).powi(2)).sum::<f64>() / (kf - 1.0);
 
-        let (mut mean_sq_err, mut var_sum, mut ref_var) = (0.0, 0.0, 0.0);
+        let (mut mean_sq_err, mut var_sum, mut ref_var, mut ref_spread) = (0.0, 0.0, 0.0, 0.0);
         let (mut var8_sum, mut sq8_sum) = (0.0, 0.0);
         for (i, px) in reference.iter().enumerate() {
             for (c, &r) in px.iter().enumerate() {
                 let mean = runs.iter().map(|run| run[i][c] as f64).sum::<f64>() / kf;
-                var_sum += runs.iter().map(|run| (run[i][c] as f64 - mean).powi(2)).sum::<f64>();
+                let s2 = runs.iter().map(|run| (run[i][c] as f64 - mean).powi(2)).sum::<f64>();
+                var_sum += s2;
                 mean_sq_err += (mean - r as f64).powi(2);
                 if let Some(v) = info.variance {
-                    ref_var += f64::from(v[i][c]);
+                    let v = f64::from(v[i][c]);
+                    ref_var += v;
+                    let estimate = info.variance_dof.map_or(0.0, |d| 2.0 * v * v / d);
+                    ref_spread += 2.0 * v * v + 4.0 * v * s2 / (kf - 1.0) / kf + estimate;
                 }
                 if let Some(gamma) = info.gamma {
                     let q = |v: f32| f64::from(film::to_u8(v, gamma));
@@ -203,8 +217,12 @@ impl RunStats {
             rel_mse: over_runs(|e| e.rel),
             eight_bit: info.gamma.map(|_| EightBit { variance: var8_sum / (kf - 1.0) / m, mse: sq8_sum / kf / m }),
             ref_variance: ref_var / m,
+            mse_corrected_ci: (0.0, 0.0),
         };
         stats.bias_ci = stats.bias_ci_at(0.95);
+        let mse_spread = per_run.iter().map(|e| (e.sq - stats.mse).powi(2)).sum::<f64>() / (kf - 1.0);
+        let half = student_t_quantile(0.975, kf - 1.0) * (mse_spread / kf + ref_spread / (m * m)).sqrt();
+        stats.mse_corrected_ci = (stats.mse_corrected() - half, stats.mse_corrected() + half);
         Ok(stats)
     }
 
@@ -323,7 +341,7 @@ mod tests {
         let r = vec![[0.25f32, 0.5, 0.75]; 6];
         let zero = vec![[0.0f32; 3]; 6];
         fn with(var: &[[f32; 3]]) -> ReferenceInfo<'_> {
-            ReferenceInfo { variance: Some(var), gamma: Some(1.0) }
+            ReferenceInfo { variance: Some(var), gamma: Some(1.0), variance_dof: None }
         }
         // Two runs at r - d and r + d: no bias, per-value variance 2 d^2, MSE d^2.
         let d = 0.125f32;
@@ -403,6 +421,51 @@ mod tests {
         }
         let coverage = covered as f64 / trials as f64;
         assert!((coverage - 0.95).abs() < 0.012, "coverage {coverage}");
+    }
+
+    /// A reference noisier than the runs (a low-discrepancy variant against a replicated reference):
+    /// `mse - ref_variance` then often comes out negative, but its interval holds the true MSE
+    /// (the runs' own) about 95% of the time and is never wholly below 0 beyond that.
+    #[test]
+    fn noise_corrected_mse_interval_covers_the_true_mse() {
+        let (k, replicas, values, trials) = (8usize, 8usize, 300usize, 400);
+        let mut noise = normals(31);
+        let (mut covered, mut negative_point, mut below_zero) = (0, 0, 0);
+        for _ in 0..trials {
+            let truth: Vec<[f32; 3]> = (0..values / 3).map(|i| [0.5 + 0.001 * i as f32; 3]).collect();
+            // Per value: the reference's variance v (of its mean) and the runs' sigma^2 = v / 10.
+            let v: Vec<[f64; 3]> = (0..truth.len()).map(|i| [1e-4 * (1.0 + (i % 10) as f64); 3]).collect();
+            let (mut reference, mut layer) = (Vec::new(), Vec::new());
+            for (t, vv) in truth.iter().zip(&v) {
+                let (mut r, mut l) = ([0f32; 3], [0f32; 3]);
+                for c in 0..3 {
+                    let reps: Vec<f64> =
+                        (0..replicas).map(|_| f64::from(t[c]) + (vv[c] * replicas as f64).sqrt() * noise()).collect();
+                    let m = reps.iter().sum::<f64>() / replicas as f64;
+                    let s2 = reps.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (replicas - 1) as f64;
+                    (r[c], l[c]) = (m as f32, (s2 / replicas as f64) as f32);
+                }
+                reference.push(r);
+                layer.push(l);
+            }
+            let runs: Vec<Vec<[f32; 3]>> = (0..k)
+                .map(|_| {
+                    let px = truth.iter().zip(&v);
+                    px.map(|(t, vv)| std::array::from_fn(|c| t[c] + ((vv[c] / 10.0).sqrt() * noise()) as f32)).collect()
+                })
+                .collect();
+            let true_mse = v.iter().flatten().map(|x| x / 10.0).sum::<f64>() / values as f64;
+            let info = ReferenceInfo { variance: Some(&layer), gamma: None, variance_dof: Some((replicas - 1) as f64) };
+            let st = RunStats::against(&runs, &reference, info).unwrap();
+            let (lo, hi) = st.mse_corrected_ci;
+            covered += (lo <= true_mse && true_mse <= hi) as usize;
+            negative_point += (st.mse_corrected() < 0.0) as usize;
+            below_zero += (hi < 0.0) as usize;
+        }
+        let coverage = covered as f64 / trials as f64;
+        assert!(negative_point > trials / 10, "the case must make MSE - ref. var. negative often: {negative_point}");
+        assert!(coverage >= 0.92, "coverage {coverage}");
+        assert!(below_zero <= trials * 3 / 100, "interval wholly below 0 in {below_zero} of {trials}");
     }
 
     #[test]

@@ -239,14 +239,17 @@ pub const CSV_COLUMNS: &[Column] = &[
     Column { header: "flip", cell: |r, _| exact(r.flip) },
     Column { header: "eff_vs_baseline", cell: |r, _| exact(r.eff_vs_baseline) },
     Column { header: "same_as", cell: |r, _| r.same_as.clone().unwrap_or_default() },
+    Column { header: "mse_corrected_ci_lo", cell: |r, _| exact(r.stats.mse_corrected_ci.0) },
+    Column { header: "mse_corrected_ci_hi", cell: |r, _| exact(r.stats.mse_corrected_ci.1) },
 ];
 
 /// The CSV header written by [`to_csv`]; `bias_ci` is split into two columns. `seconds` is the
 /// workers' CPU seconds of one run; `sampler_share` a fraction (0..1), NaN when not profiled.
 /// `mse_corrected` is the MSE less the reference's own variance, `flip` the mean FLIP,
 /// `eff_vs_baseline` the efficiency over the baseline's at the same spp step, `same_as` the
-/// variant that rendered the same images.
-pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share,first_sample,mse_corrected,flip,eff_vs_baseline,same_as";
+/// variant that rendered the same images, `mse_corrected_ci_lo/hi` the 95% interval of
+/// `mse_corrected` (the runs' spread and the reference's noise).
+pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share,first_sample,mse_corrected,flip,eff_vs_baseline,same_as,mse_corrected_ci_lo,mse_corrected_ci_hi";
 
 /// Samples per pixel as an integer when it is one (ladders), else with one decimal (the mean over
 /// the runs of an equal-time budget).
@@ -279,6 +282,10 @@ pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "% of render in sampler", cell: |r, _| pct1(r.sampler_share) },
     Column { header: "MSE", cell: |r, _| sci(r.stats.mse) },
     Column { header: "MSE - ref. var.", cell: |r, _| sci(r.stats.mse_corrected()) },
+    Column {
+        header: "its 95% CI",
+        cell: |r, _| format!("{} .. {}", sci(r.stats.mse_corrected_ci.0), sci(r.stats.mse_corrected_ci.1)),
+    },
     Column { header: "relMSE", cell: |r, _| sci(r.stats.rel_mse) },
     Column { header: "FLIP", cell: |r, _| if r.flip.is_finite() { format!("{:.4}", r.flip) } else { "n/a".into() } },
     Column { header: "bias", cell: |r, _| sci(r.stats.bias) },
@@ -346,12 +353,14 @@ struct FlatRow<'a> {
     flip: f64,
     eff_vs_baseline: f64,
     same_as: Option<&'a str>,
+    mse_corrected_ci: (f64, f64),
 }
 
 /// The JSON of `strata compare`: an array of objects with the keys `variant`, `seconds` (the
 /// workers' CPU seconds of one run), `spp`, `mse`, `rel_mse`, `bias`, `bias_ci` (`[lo, hi]`),
 /// `variance`, `efficiency`, `sampler_ns_per_sample`, `sampler_share` (a fraction),
-/// `first_sample`, `mse_corrected`, `flip`, `eff_vs_baseline` and `same_as`. JSON has no
+/// `first_sample`, `mse_corrected`, `flip`, `eff_vs_baseline`, `same_as` and `mse_corrected_ci`
+/// (`[lo, hi]`, 95%). JSON has no
 /// infinity or NaN: such values (e.g. an infinite efficiency) become `null`.
 pub fn to_json(rows: &[Row]) -> serde_json::Value {
     let flat: Vec<FlatRow> = rows
@@ -374,6 +383,7 @@ pub fn to_json(rows: &[Row]) -> serde_json::Value {
             flip: r.flip,
             eff_vs_baseline: r.eff_vs_baseline,
             same_as: r.same_as.as_deref(),
+            mse_corrected_ci: r.stats.mse_corrected_ci,
         })
         .collect();
     serde_json::to_value(flat).expect("rows serialize to JSON")

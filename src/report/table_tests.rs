@@ -18,6 +18,7 @@ fn row(variant: &str, seconds: f64, mse: f64) -> Row {
         rel_mse: 3.0 * mse,
         eight_bit: Some(EightBit { variance: 2.5, mse: 3.5 }),
         ref_variance: 0.0,
+        mse_corrected_ci: (0.5 * mse, 1.5 * mse),
     };
     Row::new(variant, seconds, 64.0, &stats).unwrap().with_sampler(12.5, 0.25)
 }
@@ -53,7 +54,9 @@ fn csv_has_header_one_line_per_row_and_parses_back() {
     assert_eq!(lines[0], CSV_HEADER);
     for (line, row) in lines[1..].iter().zip(&rows) {
         let f = parse_csv_line(line);
-        assert_eq!(f.len(), 17, "{line}");
+        assert_eq!(f.len(), 19, "{line}");
+        let ci: Vec<f64> = f[17..19].iter().map(|s| s.parse().unwrap()).collect();
+        assert_eq!(ci, [row.stats.mse_corrected_ci.0, row.stats.mse_corrected_ci.1], "{line}");
         let x: Vec<f64> = f[1..12].iter().map(|s| s.parse().unwrap()).collect();
         assert_eq!(f[0], row.variant);
         let s = &row.stats;
@@ -105,6 +108,7 @@ fn json_has_the_compare_keys_and_round_trips_the_numbers() {
         "flip",
         "eff_vs_baseline",
         "same_as",
+        "mse_corrected_ci",
     ];
     want.sort_unstable();
     let mut keys = keys;

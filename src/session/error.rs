@@ -234,6 +234,12 @@ pub enum SessionError {
     /// A signal handler could not be installed.
     #[error("signal handler: {0}")]
     Signal(std::io::Error),
+    /// `strata reference --replicas`: what a replicated reference cannot do.
+    #[error("reference: {why}")]
+    Replicas {
+        /// what was refused and why
+        why: String,
+    },
 }
 
 /// `v` as Rust prints it when that is short, else in scientific notation (`-1e-300`, not 300

@@ -7,6 +7,7 @@
 //! - [`pass`] — the pass loop ([`render_to_film`]) with checkpoints, resume, budget, signals;
 //! - [`progress`] — the progress bar (`indicatif`) or plain lines;
 //! - [`output`] — output naming, EXR metadata, [`run_render`];
+//! - [`reference`] — `strata reference`: independent replicas, the variance layer from them;
 //! - [`stats`] — the `--stats` JSON and the summary line;
 //! - [`rays`] — `strata rays`;
 //! - [`checks`] — command-line checks before rendering (outputs: no directory, link or device,
@@ -25,6 +26,7 @@ pub mod pass;
 pub mod profile;
 pub mod progress;
 pub mod rays;
+pub mod reference;
 pub mod replay;
 pub mod scene;
 pub mod stats;

@@ -45,6 +45,8 @@ pub fn metadata(out: &RenderOutput) -> Metadata {
     m.push(("strata.threads".into(), out.stats.threads.to_string()));
     // The camera, so that `compare` can refuse a reference of another view.
     m.push(("strata.camera".into(), camera_text(out.scene.desc.camera.as_ref())));
+    // How the variance layer was estimated (`strata reference` replaces it: replicas).
+    m.push(("strata.variance".into(), super::reference::VARIANCE_IID.into()));
     m
 }
 

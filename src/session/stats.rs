@@ -64,6 +64,11 @@ fn features(out: &RenderOutput) -> serde_json::Value {
 
 /// One-line summary printed after a render.
 pub fn summary(out: &RenderOutput) -> String {
+    summary_with_spp(out, &format!("{} spp", out.film.samples().len()))
+}
+
+/// [`summary`] with the sample count spelled `spp` ("64 spp", "64 spp (8 replicas x 8)").
+pub fn summary_with_spp(out: &RenderOutput, spp: &str) -> String {
     let d = &out.scene.desc;
     let c = &out.stats.counters;
     let it = &out.integrator;
@@ -91,11 +96,11 @@ pub fn summary(out: &RenderOutput) -> String {
         _ => String::new(),
     };
     format!(
-        "{} {}x{} {} spp {}{}, kernel {}: {:.3} s, {:.2} Mrays/s (camera {}, bounce {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
+        "{} {}x{} {} {}{}, kernel {}: {:.3} s, {:.2} Mrays/s (camera {}, bounce {}, shadow {}), occupancy {:.1}%, {} threads, {} non-finite{}",
         d.source.display(),
         d.width,
         d.height,
-        out.film.samples().len(),
+        spp,
         d.integrator.name(),
         technique,
         it.kernel.name(d.integrator),
