@@ -212,7 +212,7 @@ impl Scene {
             lights.push(light);
         }
         let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
-        for t in &desc.emissive_triangles {
+        for (k, t) in desc.emissive_triangles.iter().enumerate() {
             let e = Emitter::triangle(t.v, t.radiance);
             if !(e.area > 0.0 && e.area.is_finite()) || is_degenerate(&t.v) {
                 degenerate_dropped += 1;
@@ -222,7 +222,9 @@ impl Scene {
             let base = vertices.len() as u32;
             vertices.extend_from_slice(&t.v);
             indices.push([base, base + 1, base + 2]);
-            tri_material.push(black);
+            // A Mitsuba area light also reflects with its shape's BSDF.
+            let reflects = desc.emissive_materials.get(k).copied().filter(|&m| (m as usize) < materials.len());
+            tri_material.push(reflects.unwrap_or(black));
             tri_light.push((lights.len() + tri_emitters.len()) as u32);
             tri_emitters.push(e);
         }

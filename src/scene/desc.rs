@@ -198,6 +198,13 @@ pub struct SceneDesc {
     pub directional_lights: Vec<DirectionalLightDesc>,
     /// constant environment light's radiance (`--sky`; path tracer only), None: black background
     pub sky: Option<Vec3>,
+    /// the material each emissive triangle also reflects with (index into `materials`), by
+    /// index; `u32::MAX` or a missing entry (the table may be shorter, and is empty for `.test`
+    /// and OBJ scenes): black, emitting only
+    pub emissive_materials: Vec<u32>,
+    /// the scene's sampler (a Mitsuba `<sampler>`); None: the session's default. `--sampler`
+    /// overrides it
+    pub sampler: Option<crate::sampler::SamplerKind>,
 }
 
 impl SceneDesc {
@@ -261,6 +268,15 @@ impl SceneDesc {
             h.word(self.triangle_normals.len() as u32);
             self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
         }
+        // Only when present, so that `.test` and OBJ scenes keep their hash.
+        if !self.emissive_materials.is_empty() {
+            h.word(0x656d_6d00);
+            self.emissive_materials.iter().for_each(|&m| h.word(m));
+        }
+        if let Some(s) = self.sampler {
+            h.word(0x736d_7000);
+            let _ = std::fmt::Write::write_str(&mut h, s.name());
+        }
         h.0
     }
 }
@@ -292,6 +308,8 @@ impl Default for SceneDesc {
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
             sky: None,
+            emissive_materials: Vec::new(),
+            sampler: None,
         }
     }
 }

@@ -6,3 +6,4 @@ pub mod gather;
 pub mod limits;
 pub mod obj;
 pub mod parse;
+pub mod xml;

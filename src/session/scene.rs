@@ -20,6 +20,13 @@ pub fn parse_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     let limits = opts.limits;
     Ok(match &opts.scene {
         Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits)?,
+        Some(p) if crate::scene::xml::is_xml(p) => {
+            let loaded = crate::scene::xml::load(p, &limits, &opts.defines)?;
+            for w in &loaded.warnings {
+                eprintln!("strata: warning: {w}");
+            }
+            loaded.desc
+        }
         Some(p) => parse::parse_file(p, &limits)?,
         None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits)?,
     })
@@ -124,6 +131,15 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         }
     }
     let desc = load_scene(opts)?;
+    // A Mitsuba scene's <sampler> stands where --sampler is not given.
+    let with_scene_sampler;
+    let opts = match (opts.sampler, desc.sampler) {
+        (None, Some(k)) => {
+            with_scene_sampler = RenderOptions { sampler: Some(k), ..opts.clone() };
+            &with_scene_sampler
+        }
+        _ => opts,
+    };
     super::checks::check_outputs(opts, &super::output_stem(opts, &desc))?;
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {

@@ -1,0 +1,254 @@
+//! The plugin registry: one line per Mitsuba plugin (`tag`, `type`, what reads it), and the
+//! plugins the renderer does not do yet with the reason that names the missing feature. Each
+//! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
+
+mod area;
+mod constant;
+mod cube;
+mod diffuse;
+mod direct;
+mod hdrfilm;
+mod integrator_moment;
+mod obj;
+mod path;
+mod perspective;
+mod rectangle;
+mod rfilter_box;
+mod sampler;
+mod sphere;
+mod twosided;
+
+use super::doc::{Elem, Loc};
+use super::props::Props;
+use super::shape::ShapeOut;
+use crate::scene::desc::{Material, SceneDesc};
+use crate::scene::error::SceneError;
+use crate::scene::limits::Limits;
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// What a plugin makes.
+pub enum Run {
+    /// writes into the scene (sensor, film, filter, sampler, integrator, top-level emitter)
+    Scene(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<(), SceneError>),
+    /// a surface material
+    Bsdf(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Material, SceneError>),
+    /// a shape's geometry (placed by the caller with its material and emitter)
+    Shape(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<ShapeOut, SceneError>),
+    /// an area emitter's radiance
+    Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Vec3, SceneError>),
+    /// known to Mitsuba, not rendered yet: the missing feature
+    Refused(&'static str),
+}
+
+/// One registry entry.
+pub struct Plugin {
+    /// element tag (`shape`, `bsdf`, ...)
+    pub tag: &'static str,
+    /// `type` attribute
+    pub kind: &'static str,
+    /// what reads it
+    pub run: Run,
+}
+
+const fn refused(tag: &'static str, kind: &'static str, why: &'static str) -> Plugin {
+    Plugin { tag, kind, run: Run::Refused(why) }
+}
+
+const LIGHTS: &str = "needs the `lights` work of issue 29 (emitters and cameras)";
+const MESHES: &str = "needs the `meshes` work of issue 29 (mesh loaders and generators)";
+const TEXTURES: &str = "needs the `textures` work of issue 29";
+const BSDFS: &str = "needs the BSDFs of issue 30";
+
+/// Every plugin the XML front end knows, one line each.
+pub const PLUGINS: &[Plugin] = &[
+    perspective::PLUGIN,
+    refused("sensor", "orthographic", LIGHTS),
+    hdrfilm::PLUGIN,
+    rfilter_box::PLUGIN,
+    refused("rfilter", "gaussian", "needs Gaussian filter importance sampling (the `lights` work of issue 29)"),
+    sampler::INDEPENDENT,
+    sampler::STRATIFIED,
+    sampler::MULTIJITTER,
+    sampler::LDSAMPLER,
+    sampler::SOBOL,
+    path::PLUGIN,
+    direct::PLUGIN,
+    integrator_moment::PLUGIN,
+    refused("integrator", "ptracer", "needs the particle tracer of issue 29"),
+    obj::PLUGIN,
+    rectangle::PLUGIN,
+    cube::PLUGIN,
+    sphere::PLUGIN,
+    refused("shape", "ply", MESHES),
+    refused("shape", "serialized", MESHES),
+    refused("shape", "disk", MESHES),
+    refused("shape", "cylinder", MESHES),
+    refused("shape", "shapegroup", MESHES),
+    refused("shape", "instance", MESHES),
+    refused("shape", "sdfgrid", MESHES),
+    area::PLUGIN,
+    constant::PLUGIN,
+    refused("emitter", "point", LIGHTS),
+    refused("emitter", "spot", LIGHTS),
+    refused("emitter", "directional", LIGHTS),
+    refused("emitter", "envmap", LIGHTS),
+    refused("emitter", "projector", LIGHTS),
+    diffuse::PLUGIN,
+    twosided::PLUGIN,
+    refused("bsdf", "conductor", BSDFS),
+    refused("bsdf", "roughconductor", BSDFS),
+    refused("bsdf", "dielectric", BSDFS),
+    refused("bsdf", "roughdielectric", BSDFS),
+    refused("bsdf", "thindielectric", BSDFS),
+    refused("bsdf", "plastic", BSDFS),
+    refused("bsdf", "roughplastic", BSDFS),
+    refused("bsdf", "principled", BSDFS),
+    refused("bsdf", "principledthin", BSDFS),
+    refused("bsdf", "blendbsdf", BSDFS),
+    refused("bsdf", "mask", BSDFS),
+    refused("bsdf", "bumpmap", BSDFS),
+    refused("bsdf", "normalmap", BSDFS),
+    refused("bsdf", "null", BSDFS),
+    refused("texture", "bitmap", TEXTURES),
+    refused("texture", "checkerboard", TEXTURES),
+    refused("texture", "mesh_attribute", TEXTURES),
+];
+
+/// The registry entry of `e` (by tag and type), or a file:line error naming the supported types.
+pub fn lookup(e: &Elem) -> Result<&'static Plugin, SceneError> {
+    let kind = e.need("type")?;
+    if let Some(p) = PLUGINS.iter().find(|p| p.tag == e.tag && p.kind == kind) {
+        if let Run::Refused(why) = p.run {
+            return Err(e.at.err(format!("{} is not supported yet: it {why}", e.what())));
+        }
+        return Ok(p);
+    }
+    let known: Vec<&str> =
+        PLUGINS.iter().filter(|p| p.tag == e.tag && !matches!(p.run, Run::Refused(_))).map(|p| p.kind).collect();
+    if known.is_empty() {
+        return Err(e.at.err(format!("unknown element <{}>", e.tag)));
+    }
+    Err(e.at.err(format!("unknown {} type \"{kind}\" (supported: {})", e.tag, known.join(", "))))
+}
+
+/// The state of one scene's conversion: the scene being filled, warnings, the ids.
+pub struct Build<'e> {
+    /// the scene
+    pub desc: SceneDesc,
+    /// `file:line: ...` warnings (unused properties, approximations)
+    pub warnings: Vec<String>,
+    /// objects declared with `id`
+    pub ids: &'e HashMap<String, Elem>,
+    /// resource caps
+    pub limits: &'e Limits,
+    /// `<path>` directories and the scene's, for file names
+    pub search: Vec<PathBuf>,
+    /// the sensor's `fov`, axis and to_world, resolved once the film's size is known
+    pub pending_camera: Option<perspective::Pending>,
+    /// interned materials
+    materials: HashMap<[u32; 6], u32>,
+}
+
+impl<'e> Build<'e> {
+    /// A conversion into a fresh scene from `source`.
+    pub fn new(source: PathBuf, ids: &'e HashMap<String, Elem>, limits: &'e Limits, search: Vec<PathBuf>) -> Self {
+        let desc = SceneDesc {
+            source,
+            width: 768,
+            height: 576,
+            integrator: crate::scene::desc::IntegratorKind::PathTracer,
+            ..SceneDesc::default()
+        };
+        Self { desc, warnings: Vec::new(), ids, limits, search, pending_camera: None, materials: HashMap::new() }
+    }
+
+    /// A file named in the scene, found as Mitsuba's resolver finds it.
+    pub fn resolve(&self, name: &str) -> PathBuf {
+        let p = std::path::Path::new(name);
+        if p.is_absolute() {
+            return p.to_path_buf();
+        }
+        self.search
+            .iter()
+            .rev()
+            .map(|d| d.join(p))
+            .find(|c| c.exists())
+            .unwrap_or_else(|| self.search.first().map_or_else(|| p.to_path_buf(), |d| d.join(p)))
+    }
+
+    /// The index of `m` in the scene's materials (added once).
+    pub fn intern(&mut self, m: Material) -> u32 {
+        let key = [m.diffuse.x, m.diffuse.y, m.diffuse.z, m.specular.x, m.specular.y, m.specular.z].map(f32::to_bits);
+        let n = self.desc.materials.len() as u32;
+        *self.materials.entry(key).or_insert_with(|| {
+            self.desc.materials.push(m);
+            n
+        })
+    }
+
+    /// Runs the plugin of `e` for its effect on the scene (`Run::Scene`), with its unused
+    /// properties reported.
+    pub fn run_scene(&mut self, e: &'e Elem) -> Result<(), SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        match p.run {
+            Run::Scene(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} cannot appear here", e.what()))),
+        }
+        self.warnings.extend(props.unused());
+        Ok(())
+    }
+
+    /// The material of a `<bsdf>` element.
+    pub fn bsdf(&mut self, e: &'e Elem) -> Result<Material, SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let m = match p.run {
+            Run::Bsdf(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} is not a BSDF", e.what()))),
+        };
+        self.warnings.extend(props.unused());
+        Ok(m)
+    }
+
+    /// The radiance of an `<emitter>` nested in a shape.
+    pub fn area(&mut self, e: &'e Elem) -> Result<Vec3, SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let r = match p.run {
+            Run::Area(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} cannot be attached to a shape (only `area` can)", e.what()))),
+        };
+        self.warnings.extend(props.unused());
+        Ok(r)
+    }
+
+    /// A shape: its geometry, material and area emitter, placed in the scene.
+    pub fn shape(&mut self, e: &'e Elem) -> Result<(), SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let out = match p.run {
+            Run::Shape(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} is not a shape", e.what()))),
+        };
+        let material = match props.object("bsdf")? {
+            Some(b) => self.bsdf(b)?,
+            None => diffuse::default_material(),
+        };
+        let emitter = match props.object("emitter")? {
+            Some(em) => Some((self.area(em)?, em.at.clone())),
+            None => None,
+        };
+        props.ignore("id");
+        super::shape::place(self, out, material, emitter, &e.at)?;
+        self.warnings.extend(props.unused());
+        Ok(())
+    }
+
+    /// A warning at `at`.
+    pub fn warn(&mut self, at: &Loc, message: impl std::fmt::Display) {
+        self.warnings.push(format!("{}: {message}", at.show()));
+    }
+}
