@@ -29,8 +29,13 @@
 //! 12`, `face 3`) or the byte offset. No loader panics on a hostile file (truncated, huge counts,
 //! bad indices, NaN): each has such cases among its tests.
 
+pub mod obj;
 mod place;
+pub use place::ShapeGroup;
 pub mod ply;
+pub mod sdfgrid;
+pub mod serialized;
+pub mod shapes;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};

@@ -53,3 +53,23 @@ impl SceneDesc {
         first as u32
     }
 }
+
+/// Mitsuba's `shapegroup`: meshes in the group's space, each with its material index.
+pub type ShapeGroup = [(Mesh, u32)];
+
+impl SceneDesc {
+    /// Mitsuba's `instance` of a `shapegroup`, flattened: a copy of each member mesh mapped by
+    /// `to_world` (as [`Mesh::transform`] does) is added with [`SceneDesc::add_mesh`]. (Embree
+    /// instancing, `accel::SceneBuilder::add_mesh_instance`, would share the members' BVH; the
+    /// shading tables are per world triangle, so this copy is what the renderer reads today.)
+    /// Returns the index of the first triangle added.
+    pub fn add_instance(&mut self, group: &ShapeGroup, to_world: &glam::Mat4) -> u32 {
+        let first = self.triangles.len() as u32;
+        for (mesh, material) in group {
+            let mut copy = mesh.clone();
+            copy.transform(to_world);
+            self.add_mesh(&copy, *material);
+        }
+        first
+    }
+}

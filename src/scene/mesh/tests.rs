@@ -121,3 +121,18 @@ fn add_mesh_fills_tables_and_keeps_hash_without_extras() {
 }
 
 use crate::scene::desc::TriangleDesc;
+
+#[test]
+fn instance_is_a_transformed_copy() {
+    let group = vec![(tri(), 2u32)];
+    let mut desc = SceneDesc::default();
+    let t = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0)) * Mat4::from_scale(Vec3::new(-2.0, 2.0, 2.0));
+    assert_eq!(desc.add_instance(&group, &Mat4::IDENTITY), 0);
+    assert_eq!(desc.add_instance(&group, &t), 1);
+    assert_eq!(desc.triangles.len(), 2);
+    // mirrored: winding reversed, so the copy's corners are v0, v2, v1 of the mapped triangle
+    assert_eq!(desc.triangles[1].v, [Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 2.0, 5.0), Vec3::new(-2.0, 0.0, 5.0)]);
+    assert_eq!(desc.triangles[1].material, 2);
+    assert_eq!(desc.triangle_normals[1], [Vec3::Z; 3]);
+    assert_eq!(desc.triangle_attrs.len(), 4, "each copy carries its attributes");
+}
