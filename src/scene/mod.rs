@@ -4,6 +4,7 @@ pub mod desc;
 pub mod error;
 pub mod gather;
 pub mod limits;
+pub mod mesh;
 pub mod obj;
 pub mod parse;
 pub mod xml;
