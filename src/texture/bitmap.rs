@@ -19,7 +19,7 @@ use glam::{Vec2, Vec3};
 
 use crate::simd::{Vec3x8, F8};
 
-use super::TextureError;
+use super::{TexQuery, TexQuery8, TextureError, UvTransform};
 
 /// How a lookup between texel centres is filtered (Mitsuba's `filter_type`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -264,6 +264,28 @@ impl Bitmap {
                 Vec3x8::new(channel(0), channel(1), channel(2))
             }
         }
+    }
+}
+
+/// The `bitmap` texture plugin: a [`Bitmap`] (shared) looked up at the hit's uv mapped by `to_uv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BitmapTexture {
+    /// The image with its filter and wrap mode.
+    pub bitmap: std::sync::Arc<Bitmap>,
+    /// Mitsuba's `to_uv` (default identity).
+    pub to_uv: UvTransform,
+}
+
+impl BitmapTexture {
+    /// The value at one point.
+    pub fn eval(&self, q: &TexQuery) -> Vec3 {
+        self.bitmap.eval(self.to_uv.apply(q.uv))
+    }
+
+    /// The values at eight points (bit-identical to [`BitmapTexture::eval`] per lane).
+    pub fn eval_x8(&self, q: &TexQuery8) -> Vec3x8 {
+        let (u, v) = self.to_uv.apply_x8(q.u, q.v);
+        self.bitmap.eval_x8(u, v)
     }
 }
 
