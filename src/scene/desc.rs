@@ -6,7 +6,7 @@
 //! ellipsoid). Radiance in linear RGB.
 
 pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
 /// Which integrator a scene asks for (`integrator` command).
@@ -90,6 +90,24 @@ pub struct TriangleDesc {
     pub v: [Vec3; 3],
     /// index into `SceneDesc::materials`
     pub material: u32,
+}
+
+/// A named attribute of the triangles `first..first + count` of `SceneDesc::triangles` (one mesh).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleAttrDesc {
+    /// Mitsuba's name with its prefix (`vertex_color`, `face_weight`)
+    pub name: String,
+    /// values per corner or per face (1 or 3)
+    pub dims: u32,
+    /// true: `dims` values per corner (3 corners per triangle, in the order of its `v`), to be
+    /// interpolated barycentrically; false: `dims` values per triangle
+    pub per_corner: bool,
+    /// the first triangle
+    pub first: u32,
+    /// how many triangles
+    pub count: u32,
+    /// `count * dims` (per face) or `count * 3 * dims` (per corner) values
+    pub data: Vec<f32>,
 }
 
 /// A unit sphere at the origin mapped by `object_to_world` (= M * T(c) * S(r)).
@@ -186,6 +204,14 @@ pub struct SceneDesc {
     /// the corner order of its `v`; `[Vec3::ZERO; 3]` or a missing entry (the table may be shorter
     /// than `triangles`, and is empty when no triangle has normals) means none: faceted shading
     pub triangle_normals: Vec<[Vec3; 3]>,
+    /// per-corner texture coordinates of `triangles[i]` at index i, in the corner order of its `v`
+    /// (Mitsuba meshes' uvs, `scene::mesh`); the table may be shorter than `triangles` and is empty
+    /// when no triangle has uvs: a missing entry means none (uv (0, 0) at every point, as Mitsuba
+    /// gives a mesh without uvs)
+    pub triangle_uvs: Vec<[Vec2; 3]>,
+    /// named per-vertex or per-face attributes over runs of `triangles` (Mitsuba's
+    /// `vertex_color`, `face_weight`, ...; read by the `mesh_attribute` texture); empty: none
+    pub triangle_attrs: Vec<TriangleAttrDesc>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -261,6 +287,20 @@ impl SceneDesc {
             h.word(self.triangle_normals.len() as u32);
             self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
         }
+        // Likewise uvs and attributes (Mitsuba meshes only).
+        if !self.triangle_uvs.is_empty() {
+            h.word(0x7576_0000);
+            h.word(self.triangle_uvs.len() as u32);
+            self.triangle_uvs.iter().flatten().for_each(|uv| uv.to_array().iter().for_each(|x| h.word(x.to_bits())));
+        }
+        for a in &self.triangle_attrs {
+            h.word(0x6174_7200);
+            let _ = std::fmt::Write::write_str(&mut h, &a.name);
+            [a.dims, u32::from(a.per_corner), a.first, a.count, a.data.len() as u32]
+                .into_iter()
+                .for_each(|w| h.word(w));
+            a.data.iter().for_each(|x| h.word(x.to_bits()));
+        }
         h.0
     }
 }
@@ -289,6 +329,8 @@ impl Default for SceneDesc {
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),
             triangle_normals: Vec::new(),
+            triangle_uvs: Vec::new(),
+            triangle_attrs: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
             sky: None,

@@ -4,5 +4,6 @@ pub mod desc;
 pub mod error;
 pub mod gather;
 pub mod limits;
+pub mod mesh;
 pub mod obj;
 pub mod parse;
