@@ -26,3 +26,4 @@ pub mod sampling;
 pub mod scene;
 pub mod session;
 pub mod simd;
+pub mod texture;
