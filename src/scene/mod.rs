@@ -1,8 +1,10 @@
 //! Scene description, parsing and building.
 pub mod build;
 pub mod desc;
+pub mod emitter;
 pub mod error;
 pub mod gather;
 pub mod limits;
 pub mod obj;
 pub mod parse;
+pub mod sensor;
