@@ -204,8 +204,12 @@ pub struct Scene {
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
-    /// the constant environment light (`--sky`), if any
+    /// the constant environment light (`--sky`, Mitsuba's `constant`), if any
     pub sky: Option<crate::light::sky::Sky>,
+    /// the image environment light (Mitsuba's `envmap`), if any
+    pub envmap: Option<crate::light::envmap::Envmap>,
+    /// point, directional, spot and projector lights, sampled at every next event
+    pub delta: Vec<crate::light::delta::DeltaLight>,
     /// materials (desc materials, then one black material per light)
     pub materials: Vec<Material>,
     /// per triangle: material index
@@ -249,6 +253,22 @@ pub enum BuildError {
     /// Embree refused something.
     #[error("{0}")]
     Accel(#[from] accel::AccelError),
+    /// A delta light that cannot be built.
+    #[error("{}: {err}", .file.display())]
+    Delta {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// what is wrong
+        err: crate::light::delta::DeltaLightError,
+    },
+    /// An environment map that cannot be built.
+    #[error("{}: {err}", .file.display())]
+    Envmap {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// what is wrong
+        err: crate::light::envmap::EnvmapError,
+    },
     /// The scene has no `camera` command (the scene file).
     #[error("{}: no camera command", .0.display())]
     NoCamera(std::path::PathBuf),
@@ -423,16 +443,34 @@ impl Scene {
             bvh: if high { "high" } else { "medium" },
             spheres: if embree_spheres { "embree" } else { "strata" },
         };
+        use crate::scene::desc::EnvironmentDesc;
         let sky = match &desc.environment {
-            Some(crate::scene::desc::EnvironmentDesc::Constant(l)) => Some(crate::light::sky::Sky::new(*l)),
+            Some(EnvironmentDesc::Constant(l)) => Some(crate::light::sky::Sky::new(*l)),
             _ => None,
         };
+        let envmap = match &desc.environment {
+            Some(EnvironmentDesc::Envmap { image, scale, to_world }) => Some(
+                crate::light::envmap::Envmap::new(image, *scale, *to_world)
+                    .map_err(|err| BuildError::Envmap { file: desc.source.clone(), err })?,
+            ),
+            _ => None,
+        };
+        let delta = desc
+            .delta_lights
+            .iter()
+            .map(|d| {
+                crate::light::delta::DeltaLight::new(d)
+                    .map_err(|err| BuildError::Delta { file: desc.source.clone(), err })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             desc,
             camera,
             lights,
             emitters,
             sky,
+            envmap,
+            delta,
             materials,
             tri_material,
             tri_normal,
@@ -450,6 +488,11 @@ impl Scene {
             accel,
             _device: device,
         })
+    }
+
+    /// Whether next events have anything to sample: area lights, the environment or delta lights.
+    pub fn has_nee_lights(&self) -> bool {
+        !self.emitters.is_empty() || self.sky.is_some() || self.envmap.is_some() || !self.delta.is_empty()
     }
 
     /// Offset distance for secondary-ray origins at points `p`: scales with the magnitude of the
