@@ -22,7 +22,7 @@
 //!
 //! Every function is scalar; the x8 form runs it per lane (bit-identical by construction).
 
-use crate::scene::desc::{DeltaLightDesc, RgbImage};
+use super::desc::{DeltaLightDesc, RgbImage};
 use crate::simd::{mask_from_bools, Mask8, Vec3x8, F8};
 use glam::{Mat4, Vec3};
 use std::sync::Arc;

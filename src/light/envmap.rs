@@ -14,7 +14,7 @@
 //! solid angle. Wherever the radiance is non-zero some corner is, so the pdf is positive there:
 //! the estimator is unbiased whatever the image.
 
-use crate::scene::desc::RgbImage;
+use super::desc::RgbImage;
 use crate::simd::{mask_to_bools, Mask8, Vec3x8, F8};
 use glam::{Mat3, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -277,8 +277,9 @@ mod tests {
         let texels: Vec<Vec3> = (0..3).flat_map(|y| (0..4).map(move |x| Vec3::new(x as f32, y as f32, 1.0))).collect();
         let e = Envmap::new(&RgbImage { width: 4, height: 3, texels }, 2.0, glam::Mat4::IDENTITY).unwrap();
         let close = |a: Vec3, b: Vec3| assert!((a - b).length() < 1e-5, "{a} vs {b}");
-        close(e.radiance(Vec3::Y), Vec3::new(0.0, 0.0, 2.0));
-        close(e.radiance(Vec3::NEG_Y), Vec3::new(0.0, 4.0, 2.0));
+        // (At the poles the column depends on the sign of zero in atan2, as in Mitsuba.)
+        assert_eq!(glam::Vec3Swizzles::yz(e.radiance(Vec3::Y)), glam::Vec2::new(0.0, 2.0));
+        assert_eq!(glam::Vec3Swizzles::yz(e.radiance(Vec3::NEG_Y)), glam::Vec2::new(4.0, 2.0));
         close(e.radiance(Vec3::NEG_Z), Vec3::new(3.0, 2.0, 2.0));
         let s = std::f32::consts::FRAC_1_SQRT_2;
         close(e.radiance(Vec3::new(s, 0.0, -s)), Vec3::new(0.0, 2.0, 2.0));

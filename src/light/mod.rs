@@ -2,6 +2,7 @@
 //! sampling, exact polygonal irradiance, the constant environment light ([`sky`]), the image one
 //! ([`envmap`]) and Mitsuba's delta lights ([`delta`]: point, directional, spot, projector).
 pub mod delta;
+pub mod desc;
 pub mod emitters;
 pub mod envmap;
 pub mod polygonal;

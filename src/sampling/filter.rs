@@ -15,7 +15,23 @@
 //! then the step average of `f`: against the exact `f` its effect on a pixel's expected value is
 //! second order in the step (`r / 256` pixels), far below any Monte Carlo error.
 
-use crate::scene::sensor::PixelFilter;
+/// The pixel reconstruction filter (Mitsuba's `rfilter`), applied by filter importance sampling
+/// of the pixel jitter ([`FilterWarp`]): a pixel sample lands at `centre + offset` with the offset drawn in
+/// proportion to the filter (each axis on its own, truncated to the image as Mitsuba's film
+/// without `sample_border` truncates it), so the expected pixel value equals Mitsuba's
+/// splatted and weight-normalized one.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum PixelFilter {
+    /// `box` of radius 0.5: uniform jitter over the pixel (every `.test` scene)
+    #[default]
+    Box,
+    /// `gaussian`: `max(0, exp(-x^2 / (2 s^2)) - exp(-r^2 / (2 s^2)))` per axis with
+    /// `r = 4 s` (Mitsuba's default filter, `stddev` 0.5)
+    Gaussian {
+        /// standard deviation in pixels (Mitsuba's `stddev`, default 0.5)
+        stddev: f32,
+    },
+}
 
 /// Steps of the tabulated CDF over `[-r, r]`.
 const BINS: usize = 512;

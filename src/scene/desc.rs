@@ -6,7 +6,7 @@
 //! ellipsoid). Radiance in linear RGB.
 
 pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
-pub use crate::scene::emitter::{DeltaLightDesc, EnvironmentDesc, RgbImage};
+pub use crate::light::desc::{DeltaLightDesc, EnvironmentDesc, RgbImage};
 pub use crate::scene::sensor::{FovAxis, PixelFilter, Projection, SensorDesc};
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;

@@ -1,7 +1,6 @@
 //! Scene description, parsing and building.
 pub mod build;
 pub mod desc;
-pub mod emitter;
 pub mod error;
 pub mod gather;
 pub mod limits;

@@ -88,20 +88,4 @@ pub struct SensorDesc {
 /// Mitsuba's default `near_clip`.
 pub const DEFAULT_NEAR_CLIP: f32 = 0.01;
 
-/// The pixel reconstruction filter (Mitsuba's `rfilter`), applied by filter importance sampling
-/// of the pixel jitter: a pixel sample lands at `centre + offset` with the offset drawn in
-/// proportion to the filter (each axis on its own, truncated to the image as Mitsuba's film
-/// without `sample_border` truncates it), so the expected pixel value equals Mitsuba's
-/// splatted and weight-normalized one.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub enum PixelFilter {
-    /// `box` of radius 0.5: uniform jitter over the pixel (every `.test` scene)
-    #[default]
-    Box,
-    /// `gaussian`: `max(0, exp(-x^2 / (2 s^2)) - exp(-r^2 / (2 s^2)))` per axis with
-    /// `r = 4 s` (Mitsuba's default filter, `stddev` 0.5)
-    Gaussian {
-        /// standard deviation in pixels (Mitsuba's `stddev`, default 0.5)
-        stddev: f32,
-    },
-}
+pub use crate::sampling::filter::PixelFilter;

@@ -79,7 +79,9 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
             eprintln!("strata: note: {name} has no light; added {what} (disable with --no-default-light)");
         }
     }
-    if desc.environment.is_some() && desc.integrator != crate::scene::desc::IntegratorKind::PathTracer {
+    use crate::scene::desc::IntegratorKind;
+    let outside = desc.environment.is_some() || !desc.delta_lights.is_empty();
+    if outside && !matches!(desc.integrator, IntegratorKind::PathTracer | IntegratorKind::Direct) {
         return Err(SessionError::SkyNeedsPathTracer { integrator: desc.integrator.name() });
     }
     Ok(desc)

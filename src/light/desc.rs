@@ -2,7 +2,9 @@
 //! `directional`, `projector` (delta lights, [`DeltaLightDesc`]) and `constant`, `envmap`
 //! (the environment, [`EnvironmentDesc`]; at most one per scene, as in Mitsuba). Plain data in
 //! Mitsuba's units and conventions, so a front end copies the properties one to one; the
-//! renderer's side is `light::delta` and `light::environment`.
+//! renderer's side is [`super::delta`], [`super::sky`] and [`super::envmap`]. They live in
+//! `light/` (as the material descriptions live in `bsdf/`) so that the light layer does not import
+//! the scene; `scene::desc` re-exports them.
 //!
 //! Images ([`RgbImage`]) are linear RGB texels, row 0 the image's top row; texture coordinates
 //! `(u, v)` address them as Mitsuba's `bitmap` texture does (`(0, 0)` the top-left corner of the
@@ -88,7 +90,7 @@ pub enum DeltaLightDesc {
     },
     /// Mitsuba `projector`: a perspective projection of `irradiance` from `to_world`'s origin
     /// along its +z, with horizontal field of view `fov_x_deg` (the front end resolves `fov` and
-    /// `fov_axis` against the image's aspect, [`crate::scene::sensor::FovAxis::fov_x_deg`]), times
+    /// `fov_axis` against the image's aspect, `scene::sensor::FovAxis::fov_x_deg`), times
     /// `scale`: the irradiance on the plane at z = 1 is `pi * scale * irradiance(uv)`.
     Projector {
         /// light-to-world
