@@ -6,6 +6,8 @@
 //! ellipsoid). Radiance in linear RGB.
 
 pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
+pub use crate::light::desc::{DeltaLightDesc, EnvironmentDesc, RgbImage};
+pub use crate::scene::sensor::{FovAxis, PixelFilter, Projection, SensorDesc};
 use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
@@ -222,8 +224,14 @@ pub struct SceneDesc {
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
     pub directional_lights: Vec<DirectionalLightDesc>,
-    /// constant environment light's radiance (`--sky`; path tracer only), None: black background
-    pub sky: Option<Vec3>,
+    /// the light at infinity: `constant` (`--sky`) or `envmap`; None: black background
+    pub environment: Option<EnvironmentDesc>,
+    /// a Mitsuba sensor; when given it replaces `camera`
+    pub sensor: Option<SensorDesc>,
+    /// the pixel filter (box: uniform jitter, every `.test` scene)
+    pub filter: PixelFilter,
+    /// point, spot, directional and projector lights (Mitsuba's), sampled at every next event
+    pub delta_lights: Vec<DeltaLightDesc>,
     /// the material each emissive triangle also reflects with (index into `materials`), by
     /// index; `u32::MAX` or a missing entry (the table may be shorter, and is empty for `.test`
     /// and OBJ scenes): black, emitting only
@@ -285,9 +293,51 @@ impl SceneDesc {
             h.vec3(t.radiance);
         }
         // Only when present, so that the hash of a scene without a sky is unchanged.
-        if let Some(sky) = self.sky {
-            h.word(0x736b_7900);
-            h.vec3(sky);
+        match &self.environment {
+            None => {}
+            Some(EnvironmentDesc::Constant(sky)) => {
+                h.word(0x736b_7900);
+                h.vec3(*sky);
+            }
+            Some(EnvironmentDesc::Envmap { image, scale, to_world }) => {
+                h.word(0x656e_7600);
+                let _ = std::fmt::Write::write_fmt(
+                    &mut h,
+                    format_args!("{:?}", (image.width, image.height, scale, to_world)),
+                );
+                image.texels.iter().for_each(|&t| h.vec3(t));
+            }
+        }
+        // The Mitsuba-side fields, likewise only when set.
+        if self.sensor.is_some() || self.filter != PixelFilter::Box {
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
+        }
+        for l in &self.delta_lights {
+            match l {
+                DeltaLightDesc::Spot { texture: Some(t), .. } | DeltaLightDesc::Projector { irradiance: t, .. } => {
+                    t.texels.iter().for_each(|&t| h.vec3(t));
+                }
+                _ => {}
+            }
+            let short = match l {
+                DeltaLightDesc::Spot { to_world, intensity, cutoff_deg, beam_width_deg, texture } => {
+                    format!(
+                        "spot{:?}",
+                        (
+                            to_world,
+                            intensity,
+                            cutoff_deg,
+                            beam_width_deg,
+                            texture.as_ref().map(|t| (t.width, t.height))
+                        )
+                    )
+                }
+                DeltaLightDesc::Projector { to_world, irradiance, scale, fov_x_deg } => {
+                    format!("projector{:?}", (to_world, irradiance.width, irradiance.height, scale, fov_x_deg))
+                }
+                other => format!("{other:?}"),
+            };
+            let _ = std::fmt::Write::write_str(&mut h, &short);
         }
         // Only when present, so that the hash of a scene without normals is unchanged.
         if !self.triangle_normals.is_empty() {
@@ -349,7 +399,10 @@ impl Default for SceneDesc {
             triangle_attrs: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
-            sky: None,
+            environment: None,
+            sensor: None,
+            filter: PixelFilter::Box,
+            delta_lights: Vec::new(),
             emissive_materials: Vec::new(),
             sampler: None,
         }

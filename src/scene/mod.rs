@@ -7,4 +7,5 @@ pub mod limits;
 pub mod mesh;
 pub mod obj;
 pub mod parse;
+pub mod sensor;
 pub mod xml;

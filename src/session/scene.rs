@@ -79,14 +79,16 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     let name = opts.scene.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
     let interior_light = if obj && opts.camera.is_none() { frame_obj(&mut desc, opts, &name) } else { None };
     if let Some(sky) = opts.sky {
-        desc.sky = Some(sky);
+        desc.environment = Some(crate::scene::desc::EnvironmentDesc::Constant(sky));
     }
-    if obj && !opts.no_default_light && !super::checks::has_emitter(&desc) && desc.sky.is_none() {
+    if obj && !opts.no_default_light && !super::checks::has_emitter(&desc) && desc.environment.is_none() {
         if let Some(what) = super::checks::add_default_light(&mut desc, interior_light) {
             eprintln!("strata: note: {name} has no light; added {what} (disable with --no-default-light)");
         }
     }
-    if desc.sky.is_some() && desc.integrator != crate::scene::desc::IntegratorKind::PathTracer {
+    use crate::scene::desc::IntegratorKind;
+    let outside = desc.environment.is_some() || !desc.delta_lights.is_empty();
+    if outside && !matches!(desc.integrator, IntegratorKind::PathTracer | IntegratorKind::Direct) {
         return Err(SessionError::SkyNeedsPathTracer { integrator: desc.integrator.name() });
     }
     Ok(desc)

@@ -1,5 +1,5 @@
 //! `<film type="hdrfilm">`: `width`, `height` (default 768 x 576), a full-frame crop, and its
-//! nested `rfilter` (Mitsuba's default is gaussian). Output format settings are strata's own.
+//! nested `rfilter` (default: Mitsuba's gaussian). Output format settings are strata's own.
 
 use super::{Build, Plugin, Run};
 use crate::scene::error::SceneError;
@@ -33,11 +33,8 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     }
     match p.object("rfilter")? {
         Some(f) => b.run_scene(f)?,
-        None => {
-            return Err(p.elem.at.err(
-                "the film has no <rfilter>, so Mitsuba's default gaussian applies, which is not supported yet: it needs Gaussian filter importance sampling (add <rfilter type=\"box\"/> for a box filter)",
-            ))
-        }
+        // Mitsuba's default filter.
+        None => b.desc.filter = crate::scene::desc::PixelFilter::Gaussian { stddev: 0.5 },
     }
     Ok(())
 }

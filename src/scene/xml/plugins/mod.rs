@@ -5,28 +5,43 @@
 mod area;
 mod constant;
 mod cube;
+mod cylinder;
 mod diffuse;
 mod direct;
+mod directional;
+mod disk;
+mod envmap;
 mod hdrfilm;
+mod instance;
 mod integrator_moment;
 mod obj;
+mod orthographic;
 mod path;
 mod perspective;
+mod ply;
+mod point;
+mod projector;
 mod rectangle;
 mod rfilter_box;
+mod rfilter_gaussian;
 mod sampler;
+mod sdfgrid;
+mod serialized;
+mod shapegroup;
 mod sphere;
+mod spot;
 mod twosided;
 
 use super::doc::{Elem, Loc};
-use super::props::Props;
+use super::props::{Color, Props};
 use super::shape::ShapeOut;
-use crate::scene::desc::{Material, SceneDesc};
+use crate::scene::desc::{EnvironmentDesc, Material, RgbImage, SceneDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// What a plugin makes.
 pub enum Run {
@@ -56,18 +71,16 @@ const fn refused(tag: &'static str, kind: &'static str, why: &'static str) -> Pl
     Plugin { tag, kind, run: Run::Refused(why) }
 }
 
-const LIGHTS: &str = "needs the `lights` work of issue 29 (emitters and cameras)";
-const MESHES: &str = "needs the `meshes` work of issue 29 (mesh loaders and generators)";
-const TEXTURES: &str = "needs the `textures` work of issue 29";
+const TEXTURES: &str = "as a material's texture, needs textured materials at hits (the `textures` work of issue 29)";
 const BSDFS: &str = "needs the BSDFs of issue 30";
 
 /// Every plugin the XML front end knows, one line each.
 pub const PLUGINS: &[Plugin] = &[
     perspective::PLUGIN,
-    refused("sensor", "orthographic", LIGHTS),
+    orthographic::PLUGIN,
     hdrfilm::PLUGIN,
     rfilter_box::PLUGIN,
-    refused("rfilter", "gaussian", "needs Gaussian filter importance sampling (the `lights` work of issue 29)"),
+    rfilter_gaussian::PLUGIN,
     sampler::INDEPENDENT,
     sampler::STRATIFIED,
     sampler::MULTIJITTER,
@@ -78,23 +91,23 @@ pub const PLUGINS: &[Plugin] = &[
     integrator_moment::PLUGIN,
     refused("integrator", "ptracer", "needs the particle tracer of issue 29"),
     obj::PLUGIN,
+    ply::PLUGIN,
+    serialized::PLUGIN,
     rectangle::PLUGIN,
+    disk::PLUGIN,
     cube::PLUGIN,
+    cylinder::PLUGIN,
     sphere::PLUGIN,
-    refused("shape", "ply", MESHES),
-    refused("shape", "serialized", MESHES),
-    refused("shape", "disk", MESHES),
-    refused("shape", "cylinder", MESHES),
-    refused("shape", "shapegroup", MESHES),
-    refused("shape", "instance", MESHES),
-    refused("shape", "sdfgrid", MESHES),
+    sdfgrid::PLUGIN,
+    shapegroup::PLUGIN,
+    instance::PLUGIN,
     area::PLUGIN,
+    point::PLUGIN,
+    spot::PLUGIN,
+    directional::PLUGIN,
+    projector::PLUGIN,
     constant::PLUGIN,
-    refused("emitter", "point", LIGHTS),
-    refused("emitter", "spot", LIGHTS),
-    refused("emitter", "directional", LIGHTS),
-    refused("emitter", "envmap", LIGHTS),
-    refused("emitter", "projector", LIGHTS),
+    envmap::PLUGIN,
     diffuse::PLUGIN,
     twosided::PLUGIN,
     refused("bsdf", "conductor", BSDFS),
@@ -114,6 +127,7 @@ pub const PLUGINS: &[Plugin] = &[
     refused("texture", "bitmap", TEXTURES),
     refused("texture", "checkerboard", TEXTURES),
     refused("texture", "mesh_attribute", TEXTURES),
+    refused("texture", "rawconstant", TEXTURES),
 ];
 
 /// The registry entry of `e` (by tag and type), or a file:line error naming the supported types.
@@ -145,10 +159,8 @@ pub struct Build<'e> {
     pub limits: &'e Limits,
     /// `<path>` directories and the scene's, for file names
     pub search: Vec<PathBuf>,
-    /// the sensor's `fov`, axis and to_world, resolved once the film's size is known
-    pub pending_camera: Option<perspective::Pending>,
-    /// interned materials
-    materials: HashMap<[u32; 6], u32>,
+    /// interned materials (by their Debug text: every field)
+    materials: HashMap<String, u32>,
 }
 
 impl<'e> Build<'e> {
@@ -161,7 +173,7 @@ impl<'e> Build<'e> {
             integrator: crate::scene::desc::IntegratorKind::PathTracer,
             ..SceneDesc::default()
         };
-        Self { desc, warnings: Vec::new(), ids, limits, search, pending_camera: None, materials: HashMap::new() }
+        Self { desc, warnings: Vec::new(), ids, limits, search, materials: HashMap::new() }
     }
 
     /// A file named in the scene, found as Mitsuba's resolver finds it.
@@ -180,7 +192,7 @@ impl<'e> Build<'e> {
 
     /// The index of `m` in the scene's materials (added once).
     pub fn intern(&mut self, m: Material) -> u32 {
-        let key = [m.diffuse.x, m.diffuse.y, m.diffuse.z, m.specular.x, m.specular.y, m.specular.z].map(f32::to_bits);
+        let key = format!("{m:?}");
         let n = self.desc.materials.len() as u32;
         *self.materials.entry(key).or_insert_with(|| {
             self.desc.materials.push(m);
@@ -227,6 +239,13 @@ impl<'e> Build<'e> {
 
     /// A shape: its geometry, material and area emitter, placed in the scene.
     pub fn shape(&mut self, e: &'e Elem) -> Result<(), SceneError> {
+        let (out, material, emitter) = self.shape_parts(e)?;
+        super::shape::place(self, out, material, emitter, &e.at)
+    }
+
+    /// A shape's geometry (through its `to_world`), its material index and its area emitter,
+    /// with its unused properties reported; not placed.
+    pub fn shape_parts(&mut self, e: &'e Elem) -> Result<(ShapeOut, u32, Option<(Vec3, Loc)>), SceneError> {
         let p = lookup(e)?;
         let props = Props::new(e, self.ids)?;
         let out = match p.run {
@@ -242,9 +261,69 @@ impl<'e> Build<'e> {
             None => None,
         };
         props.ignore("id");
-        super::shape::place(self, out, material, emitter, &e.at)?;
         self.warnings.extend(props.unused());
+        Ok((out, self.intern(material), emitter))
+    }
+
+    /// The file named by the plugin's `filename` string, resolved.
+    pub fn file(&self, p: &Props) -> Result<PathBuf, SceneError> {
+        let name = p
+            .string("filename")?
+            .ok_or_else(|| p.elem.at.err(format!("{} needs a `filename` string", p.elem.what())))?;
+        Ok(self.resolve(name))
+    }
+
+    /// An emitter's colour property `name` (rgb, spectrum or float; Mitsuba's default, a
+    /// uniform spectrum of 1, when absent).
+    pub fn emitter_rgb(&self, p: &Props, name: &str) -> Result<Vec3, SceneError> {
+        match p.color(name, true)? {
+            Some(Color::Rgb(c)) => Ok(c),
+            Some(Color::Texture(t)) => {
+                Err(t.at.err(format!("a textured `{name}` is not supported for {}", p.elem.what())))
+            }
+            None => Ok(super::values::spectrum_default_emitter()),
+        }
+    }
+
+    /// Sets the scene's one environment emitter.
+    pub fn set_environment(&mut self, p: &Props, env: EnvironmentDesc) -> Result<(), SceneError> {
+        if self.desc.environment.is_some() {
+            return Err(p
+                .elem
+                .at
+                .err("a second environment emitter (constant or envmap) is not supported (Mitsuba allows one)"));
+        }
+        self.desc.environment = Some(env);
         Ok(())
+    }
+
+    /// Decodes an image file for an emitter (8-bit sRGB decoded unless `raw`).
+    pub fn load_image(&self, p: &Props, path: &std::path::Path, raw: bool) -> Result<Arc<RgbImage>, SceneError> {
+        let opts = crate::texture::BitmapOptions { raw, ..Default::default() };
+        let bmp = crate::texture::Bitmap::load(path, &opts, &crate::texture::BitmapLimits::default())
+            .map_err(|e| p.elem.at.err(format!("{}: {e}", p.elem.what())))?;
+        let texels = bmp.texels().iter().map(|&t| Vec3::from(t)).collect();
+        Ok(Arc::new(RgbImage { width: bmp.width(), height: bmp.height(), texels }))
+    }
+
+    /// The image of a `<texture type="bitmap">` used by an emitter (`filename`, `raw`; bilinear,
+    /// repeat as the emitters look it up).
+    pub fn bitmap_image(&mut self, t: &'e Elem) -> Result<Arc<RgbImage>, SceneError> {
+        if t.attr("type") != Some("bitmap") {
+            return Err(t.at.err(format!("an emitter's texture must be a bitmap, not {}", t.what())));
+        }
+        let p = Props::new(t, self.ids)?;
+        let path = self.file(&p)?;
+        let raw = p.bool("raw", false)?;
+        if p.string("filter_type")?.is_some_and(|f| f != "bilinear")
+            || p.string("wrap_mode")?.is_some_and(|w| w != "repeat")
+        {
+            return Err(t.at.err("an emitter's bitmap is looked up bilinearly with repeat wrapping; other filter_type/wrap_mode are not supported"));
+        }
+        p.ignore("id");
+        let img = self.load_image(&p, &path, raw)?;
+        self.warnings.extend(p.unused());
+        Ok(img)
     }
 
     /// A warning at `at`.

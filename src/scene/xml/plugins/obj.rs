@@ -1,4 +1,5 @@
-//! `<shape type="obj">`: a Wavefront OBJ (`filename`), its MTL ignored as Mitsuba ignores it.
+//! `<shape type="obj">`: a Wavefront OBJ (`filename`, `flip_tex_coords` default true), read as
+//! Mitsuba reads it (its MTL ignored).
 
 use super::{Build, Plugin, Run};
 use crate::scene::error::SceneError;
@@ -9,22 +10,8 @@ use crate::scene::xml::shape::{self, ShapeOut};
 pub const PLUGIN: Plugin = Plugin { tag: "shape", kind: "obj", run: Run::Shape(run) };
 
 fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<ShapeOut, SceneError> {
-    let name = p.string("filename")?.ok_or_else(|| p.elem.at.err("<shape type=\"obj\"> needs a `filename` string"))?;
-    let path = b.resolve(name);
-    let m = crate::scene::obj::load_bounded(&path, b.limits.max_file_bytes)
-        .map_err(|e| p.elem.at.err(format!("cannot load {}: {e}", path.display())))?;
-    let mut normals = vec![glam::Vec3::ZERO; m.positions.len()];
-    // Mitsuba keeps one normal per vertex: the OBJ's per-corner normals, per position.
-    for (f, ns) in m.faces.iter().zip(&m.face_normals) {
-        for (&vi, &ni) in f.iter().zip(ns) {
-            if let Some(&n) = m.normals.get(ni as usize) {
-                normals[vi as usize] = n;
-            }
-        }
-    }
-    if m.face_normals.is_empty() {
-        normals.clear();
-    }
-    p.refuse("flip_tex_coords", "texture coordinates arrive with the `textures` work of issue 29")?;
-    shape::mesh(p, m.positions, normals, m.faces)
+    let path = b.file(p)?;
+    let flip = p.bool("flip_tex_coords", true)?;
+    let m = crate::scene::mesh::obj::load_obj(&path, flip, b.limits).map_err(|e| shape::load_error(p, e))?;
+    shape::mesh(p, m)
 }
