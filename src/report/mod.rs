@@ -22,6 +22,7 @@ pub mod metrics;
 pub mod plot;
 pub mod slope;
 pub mod table;
+pub mod ztest;
 
 pub use bars::{stacked_bars_svg, Bar};
 pub use metrics::{efficiency, mse, rel_mse, student_t_quantile, EightBit, ReferenceInfo, RunStats};

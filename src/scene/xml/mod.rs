@@ -90,9 +90,7 @@ pub fn load(path: &Path, limits: &Limits, defines: &[(String, String)]) -> Resul
         b.desc.importance_sampling = crate::scene::desc::ImportanceSampling::Brdf;
         b.desc.russian_roulette = true;
     }
-    let mut desc = b.desc;
-    desc.light_selection.get_or_insert(crate::light::select::LightSelection::Uniform);
-    Ok(Loaded { desc, warnings: b.warnings })
+    Ok(Loaded { desc: b.desc, warnings: b.warnings })
 }
 
 /// Every element with an `id` (anywhere), for `<ref>`; a duplicate id is an error.
