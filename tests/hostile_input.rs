@@ -563,3 +563,5 @@ mod outputs;
 mod resources;
 #[path = "hostile/run.rs"]
 mod run;
+#[path = "hostile/xml.rs"]
+mod xml;

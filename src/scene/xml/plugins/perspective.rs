@@ -11,11 +11,12 @@ use crate::scene::xml::props::Props;
 pub const PLUGIN: Plugin = Plugin { tag: "sensor", kind: "perspective", run: Run::Scene(run) };
 
 fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
-    let fov_deg = match (p.has("fov"), p.string("focal_length")?) {
+    let (fov_deg, default_axis) = match (p.has("fov"), p.string("focal_length")?) {
         (true, Some(_)) => return Err(p.elem.at.err("give `fov` or `focal_length`, not both")),
-        (true, None) => p.float("fov", 0.0)?,
+        (true, None) => (p.float("fov", 0.0)?, "x"),
         (false, f) => {
-            // Mitsuba's default is 50mm on a 36mm-wide frame, along x.
+            // Mitsuba's default is 50mm; a focal length is measured on the diagonal of a 36 x 24 mm
+            // frame.
             let f = f.unwrap_or("50mm");
             let mm: f32 = f
                 .trim()
@@ -25,13 +26,14 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
             if !(mm > 0.0) {
                 return Err(p.elem.at.err(format!("focal_length \"{f}\" must be positive")));
             }
-            2.0 * (36.0 / (2.0 * mm)).atan().to_degrees()
+            let diagonal = (36.0f32 * 36.0 + 24.0 * 24.0).sqrt();
+            (2.0 * (diagonal / (2.0 * mm)).atan().to_degrees(), "diagonal")
         }
     };
     if !(fov_deg > 0.0 && fov_deg < 180.0) {
         return Err(p.elem.at.err(format!("fov {fov_deg} must be in (0, 180) degrees")));
     }
-    let axis = p.string("fov_axis")?.unwrap_or("x");
+    let axis = p.string("fov_axis")?.unwrap_or(default_axis);
     let fov_axis = FovAxis::parse(axis)
         .ok_or_else(|| p.elem.at.err(format!("fov_axis \"{axis}\" is not one of x, y, diagonal, smaller, larger")))?;
     p.refuse("principal_point_offset_x", "off-centre projections are not supported")?;
