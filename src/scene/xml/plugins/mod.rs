@@ -71,7 +71,7 @@ const fn refused(tag: &'static str, kind: &'static str, why: &'static str) -> Pl
     Plugin { tag, kind, run: Run::Refused(why) }
 }
 
-const TEXTURES: &str = "as a material's texture, needs textured materials at hits (the `textures` work of issue 29)";
+const TEXTURES: &str = "needs textured materials at hits (the `textures` work of issue 29)";
 const BSDFS: &str = "needs the BSDFs of issue 30";
 
 /// Every plugin the XML front end knows, one line each.
