@@ -68,7 +68,8 @@ pub fn rgb(e: &Elem) -> Result<Vec3, SceneError> {
     }
 }
 
-/// Mitsuba's XYZ to linear sRGB matrix (rows).
+/// Mitsuba's XYZ to linear sRGB matrix (rows), its published digits.
+#[allow(clippy::excessive_precision)]
 const XYZ_TO_SRGB: [[f32; 3]; 3] =
     [[3.240479, -1.537150, -0.498535], [-0.969256, 1.875991, 0.041556], [0.055648, -0.204043, 1.057311]];
 

@@ -147,6 +147,9 @@ pub fn lookup(e: &Elem) -> Result<&'static Plugin, SceneError> {
     Err(e.at.err(format!("unknown {} type \"{kind}\" (supported: {})", e.tag, known.join(", "))))
 }
 
+/// A shape's geometry, its material index and its area emitter (radiance, where declared).
+pub type ShapeParts = (ShapeOut, u32, Option<(Vec3, Loc)>);
+
 /// The state of one scene's conversion: the scene being filled, warnings, the ids.
 pub struct Build<'e> {
     /// the scene
@@ -245,7 +248,7 @@ impl<'e> Build<'e> {
 
     /// A shape's geometry (through its `to_world`), its material index and its area emitter,
     /// with its unused properties reported; not placed.
-    pub fn shape_parts(&mut self, e: &'e Elem) -> Result<(ShapeOut, u32, Option<(Vec3, Loc)>), SceneError> {
+    pub fn shape_parts(&mut self, e: &'e Elem) -> Result<ShapeParts, SceneError> {
         let p = lookup(e)?;
         let props = Props::new(e, self.ids)?;
         let out = match p.run {
