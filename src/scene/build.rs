@@ -624,8 +624,8 @@ mod tests {
         assert!((o - Vec3::new(2.0, 1.0, 2.75)).length() < 1e-5, "{o}");
         let xs = [0.0, 0.5, 63.99, 32.0, 10.25, 7.0, 50.5, 33.3];
         let (o8, d8) = cam.rays8(F8::new(xs), F8::new(xs.map(|x| x * 0.5)));
-        for i in 0..8 {
-            let (o, d) = cam.ray(xs[i], xs[i] * 0.5);
+        for (i, &x) in xs.iter().enumerate() {
+            let (o, d) = cam.ray(x, x * 0.5);
             assert_eq!(o8.lane(i).to_array().map(f32::to_bits), o.to_array().map(f32::to_bits), "lane {i}");
             assert_eq!(d8.lane(i), d);
         }

@@ -30,13 +30,7 @@ pub fn parse_obj(path: &Path, bytes: &[u8], flip_tex_coords: bool, limits: &Limi
     if let Some((line, msg)) = crate::scene::obj::locate_obj_error(&text) {
         return Err(bad(Location::Line(line), msg));
     }
-    let opts = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
+    let opts = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
     let loaded = std::panic::catch_unwind(|| {
         tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| Err(tobj::LoadError::OpenFileFailed))
     });
