@@ -5,6 +5,7 @@
 //! Layer: above `scene` and `sampler`, below `integrator` and `render` (both import it).
 
 use crate::sampler::{PointSet, SamplerKind, Stream};
+use crate::sampling::filter::FilterWarp;
 use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
 
 /// Sampler dimension of the camera (pixel) jitter.
@@ -160,7 +161,37 @@ impl Camera<'_> {
             let k = if centre && stratified { centre_swap(s, self.pixel_set.n()) } else { s };
             point(k)
         };
-        let dir = self.lens.dirs8(pk.x + jx, pk.y + jy);
-        (Vec3x8::splat(self.lens.eye), dir)
+        let (x, y) = match &self.lens.filter {
+            None => (pk.x + jx, pk.y + jy),
+            Some(f) => filtered(f, pk, (jx, jy), self.lens.width as f32, self.lens.height as f32),
+        };
+        self.lens.rays8(x, y)
+    }
+}
+
+/// Image positions of the pixels of `pk` for the jitter `(jx, jy)` under the filter warp `f`:
+/// the pixel centre plus an offset per axis drawn from the filter truncated to the image.
+#[inline(never)]
+fn filtered(f: &FilterWarp, pk: &PixelPacket, (jx, jy): (F8, F8), w: f32, h: f32) -> (F8, F8) {
+    let one = |c: f32, u: f32, n: f32| {
+        let centre = c + 0.5;
+        centre + f.sample(u, -centre, n - centre)
+    };
+    let (px, py, ux, uy) = (pk.x.to_array(), pk.y.to_array(), jx.to_array(), jy.to_array());
+    (F8::new(std::array::from_fn(|i| one(px[i], ux[i], w))), F8::new(std::array::from_fn(|i| one(py[i], uy[i], h))))
+}
+
+impl Camera<'_> {
+    /// The image position of pixel `(px, py)`'s sample with jitter `(jx, jy)` (scalar twin of the
+    /// filtered jitter of [`Camera::rays_with`]).
+    pub fn position(&self, px: u32, py: u32, jx: f32, jy: f32) -> (f32, f32) {
+        match &self.lens.filter {
+            None => (px as f32 + jx, py as f32 + jy),
+            Some(f) => {
+                let (cx, cy) = (px as f32 + 0.5, py as f32 + 0.5);
+                let (w, h) = (self.lens.width as f32, self.lens.height as f32);
+                (cx + f.sample(jx, -cx, w - cx), cy + f.sample(jy, -cy, h - cy))
+            }
+        }
     }
 }

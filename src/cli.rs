@@ -281,8 +281,13 @@ impl RenderCmd {
 
 #[derive(clap::Args)]
 pub(crate) struct RenderArgs {
-    /// Scene file (.test, or .obj for a whole-scene OBJ); omitted: the built-in Cornell box.
+    /// Scene file (.test, .obj for a whole-scene OBJ, or .xml for a Mitsuba 3 scene); omitted:
+    /// the built-in Cornell box.
     pub(crate) scene: Option<PathBuf>,
+    /// A parameter of a Mitsuba XML scene, NAME=VALUE (repeatable; Mitsuba's flag): replaces
+    /// `$NAME` in the scene, over its `<default name="NAME">`.
+    #[arg(short = 'D', value_name = "NAME=VALUE", help_heading = SCENE, value_parser = parse_define)]
+    pub(crate) define: Vec<(String, String)>,
     /// Camera "ex ey ez cx cy cz ux uy uz fovy" (the format's camera arguments), replacing the
     /// scene's (for an .obj, the automatic one, which is printed as a --camera line to edit).
     #[arg(long, help_heading = SCENE, value_parser = session::parse_camera, allow_hyphen_values = true)]
@@ -484,6 +489,7 @@ impl RenderArgs {
             allow_other_build: self.allow_other_build,
             up: self.up,
             sky: self.sky,
+            defines: self.define,
             rendering: None,
         }
     }
@@ -604,6 +610,15 @@ pub(crate) fn parse_up(s: &str) -> Result<strata::scene::obj::frame::UpAxis, Val
 }
 
 /// `R` or `R,G,B` (or `R G B`): finite radiances >= 0.
+pub(crate) fn parse_define(s: &str) -> Result<(String, String), ValueError> {
+    let (name, value) = s.split_once('=').ok_or_else(|| expected("NAME=VALUE", s))?;
+    let ok = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !ok {
+        return Err(expected("a parameter name of letters, digits and _ before =", s));
+    }
+    Ok((name.to_string(), value.to_string()))
+}
+
 pub(crate) fn parse_sky(s: &str) -> Result<glam::Vec3, ValueError> {
     let bad = || expected("a radiance R or R,G,B of finite numbers >= 0", s);
     let v: Vec<f32> = s

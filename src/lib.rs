@@ -28,3 +28,4 @@ pub mod sampling;
 pub mod scene;
 pub mod session;
 pub mod simd;
+pub mod texture;

@@ -559,3 +559,5 @@ mod resources;
 mod robust;
 #[path = "hostile/run.rs"]
 mod run;
+#[path = "hostile/xml.rs"]
+mod xml;

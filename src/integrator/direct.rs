@@ -32,6 +32,9 @@ use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::IntegratorKind;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 
+#[path = "direct_env.rs"]
+mod env;
+
 /// First sampler dimension of light sampling (see [`LIGHT_POINT`]).
 pub const DIM_LIGHT_BASE: u32 = 16;
 
@@ -68,7 +71,7 @@ struct Buffers {
 
 impl Estimator for Direct {
     const KIND: IntegratorKind = IntegratorKind::Direct;
-    const DIMS: &'static [Dim] = &[CAMERA, LIGHT_POINT, LIGHT_CHOICE];
+    const DIMS: &'static [Dim] = &[CAMERA, LIGHT_POINT, LIGHT_CHOICE, env::ENVIRONMENT];
     type Scratch = DirectScratch;
 
     fn tile<L: LobeSet>(
@@ -129,8 +132,24 @@ fn shade<L: LobeSet>(
     out: &mut [Vec3x8],
 ) {
     if it.light_selection != LightSelection::All {
-        return shade_one::<L>(it, ctx, hits, sc, s, out);
+        shade_one::<L>(it, ctx, hits, sc, s, out);
+    } else {
+        shade_all::<L>(it, ctx, hits, sc, s, out);
     }
+    if ctx.scene.sky.is_some() || ctx.scene.envmap.is_some() || !ctx.scene.delta.is_empty() {
+        env::shade_outside::<L>(it, ctx, hits, &sc.shade, &sc.eps, s, out);
+    }
+}
+
+/// `direct` under `all`: every area light, group by group (see the module docs).
+fn shade_all<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    hits: &[SurfaceHit8],
+    sc: &mut Buffers,
+    s: u32,
+    out: &mut [Vec3x8],
+) {
     let TileCtx { scene, pks, tracer, samples: smp } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
@@ -208,21 +227,21 @@ fn shading_lanes(scene: &Scene, hits: &[SurfaceHit8], sc: &mut Buffers) {
 /// One light dimension of pixel sample `s` drawn from the integrator's light table, over all
 /// spp x N light samples of the pixel (light sample k of pixel sample s is the table's sample
 /// `s N + k`): used unless the layout is a per-sample grid ([`Integrator::light_streams`]).
-struct LightTable {
+pub(super) struct LightTable {
     dim: PathDim,
     first: u32,
 }
 
 impl LightTable {
     /// Dimension `dim` for pixel sample `s`.
-    fn new(it: &Integrator, smp: &Samples, dim: u32, s: u32) -> Self {
+    pub(super) fn new(it: &Integrator, smp: &Samples, dim: u32, s: u32) -> Self {
         let n = it.light_table.set().n();
         Self { dim: smp.table_dim(true, n, dim), first: s.wrapping_mul(it.light_set.n()) }
     }
 
     /// Light sample `k` of the pixels `pixel`.
     #[inline]
-    fn point(&self, smp: &Samples, pixel: U8, k: u32) -> (F8, F8) {
+    pub(super) fn point(&self, smp: &Samples, pixel: U8, k: u32) -> (F8, F8) {
         let index = U8::splat(self.first.wrapping_add(k));
         smp.table_point(&self.dim, true, Phase::SamplerLight, pixel, index)
     }
@@ -309,7 +328,7 @@ fn shade_one<L: LobeSet>(
 }
 
 /// What a light sample adds at a shading packet before visibility (see [`light_term`]).
-struct LightTerm {
+pub(super) struct LightTerm {
     /// the BSDF value for the direction to the light
     f: Vec3x8,
     /// cos(th_i) cos(th_l) / d^2
@@ -324,7 +343,7 @@ struct LightTerm {
 /// The light term of light points `ls` at hits `sh` on lanes `active`; None where it lights no
 /// lane.
 #[inline]
-fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) -> Option<LightTerm> {
+pub(super) fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) -> Option<LightTerm> {
     let to = ls.y - sh.p;
     let d2 = to.length_squared();
     let inv_d = F8::ONE / d2.sqrt();
@@ -347,9 +366,27 @@ fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) ->
     Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
 }
 
+/// The BSDF value and cos(th_i) for the unit directions `wi` at hits `sh` on lanes `active`, and
+/// the lanes lit (cos(th_i) > 0, and above the geometric surface on smooth-shaded lanes); None
+/// where no lane is lit (for lights at a direction rather than a point: environment, delta).
+#[inline]
+fn light_term_f<L: LobeSet>(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Option<(Vec3x8, F8, Mask8)> {
+    let cos_i = sh.n.dot(wi);
+    let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+    let lit = active & cos_i.simd_gt(F8::ZERO) & leaves;
+    if lit.none() {
+        return None;
+    }
+    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
+    let frame = Frame8::from_normal(sh.n);
+    let strategy = crate::scene::desc::ImportanceSampling::Cosine;
+    let f = material(sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
+    Some((f, lit.select(cos_i, F8::ZERO), lit))
+}
+
 /// Traces a batch of shadow packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the
 /// lanes of packet j whose shadow ray reached the light.
-fn trace_shadow_batch(
+pub(super) fn trace_shadow_batch(
     tracer: &mut Tracer,
     shadow: &mut [(Ray8, Mask8)],
     contrib: &[Vec3x8],

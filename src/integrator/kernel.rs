@@ -105,7 +105,7 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         },
         "point_lights": d.point_lights.len(),
         "directional_lights": d.directional_lights.len(),
-        "sky": d.sky.map(|s| s.to_array()),
+        "sky": match &d.environment { Some(crate::scene::desc::EnvironmentDesc::Constant(s)) => Some(s.to_array()), _ => None },
         "integrator": kind.name(),
         "nee": if path { Some(format!("{nee:?}").to_lowercase()) } else { None },
         "russian_roulette": path && rr,

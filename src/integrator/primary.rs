@@ -69,4 +69,19 @@ fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>
         ctx.scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced), sh);
         out.push(masked(sh.emitted + sh.le, sh.valid));
     }
+    // Camera rays that leave the scene see the environment (none in `.test` scenes).
+    let scene = ctx.scene;
+    if scene.sky.is_some() || scene.envmap.is_some() {
+        for ((rh, traced), (sh, o)) in wave.rh.iter().zip(wave.hits.iter().zip(out.iter_mut())) {
+            let missed = *traced & !sh.valid;
+            if missed.none() {
+                continue;
+            }
+            *o += match (&scene.sky, &scene.envmap) {
+                (Some(sky), _) => masked(Vec3x8::splat(sky.radiance), missed),
+                (None, Some(env)) => env.radiance_pdf_x8(rh.ray.dir(), missed).0,
+                (None, None) => Vec3x8::ZERO,
+            };
+        }
+    }
 }

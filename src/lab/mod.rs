@@ -6,6 +6,7 @@
 pub mod checks;
 pub mod compare;
 pub mod experiments;
+pub mod mitsuba;
 pub mod progress;
 pub mod report_page;
 

@@ -1,6 +1,10 @@
 //! Lights: every area light (quad lights and emissive triangles) with light selection and point
-//! sampling, exact polygonal irradiance, and the constant environment light ([`sky`]).
+//! sampling, exact polygonal irradiance, the constant environment light ([`sky`]), the image one
+//! ([`envmap`]) and Mitsuba's delta lights ([`delta`]: point, directional, spot, projector).
+pub mod delta;
+pub mod desc;
 pub mod emitters;
+pub mod envmap;
 pub mod polygonal;
 pub mod select;
 pub mod sky;

@@ -24,6 +24,7 @@ pub mod plot;
 pub mod slope;
 pub mod student_t;
 pub mod table;
+pub mod ztest;
 
 pub use bars::{stacked_bars_svg, Bar};
 pub use metrics::{efficiency, mse, rel_mse, EightBit, ReferenceInfo, RunStats};

@@ -13,6 +13,7 @@
 //!   `wide` fuses them ([`fmadd`]), so twins without transcendentals agree bit for bit; `wide`'s
 //!   polynomial `ln`, `exp`, `exp_m1`, `ln_1p`, `sin_cos` differ from std's by a few ulp.
 
+pub mod filter;
 mod warp;
 pub use warp::*;
 

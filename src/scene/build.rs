@@ -17,14 +17,15 @@
 
 use crate::accel::{self, INVALID_ID};
 use crate::light::emitters::{Emitter, Emitters};
-use crate::scene::desc::{CameraDesc, Material, SceneDesc};
+use crate::scene::desc::{CameraDesc, Material, Projection, SceneDesc, SensorDesc};
 use crate::simd::{Vec3x8, F8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
 pub use super::gather::SurfaceHit8;
 
-/// Pinhole camera, look-at, full vertical field of view.
-#[derive(Clone, Copy, Debug)]
+/// The camera: the `.test` look-at pinhole (full vertical field of view), or a Mitsuba sensor
+/// ([`Lens`]), with the pixel filter's jitter warp.
+#[derive(Clone, Debug)]
 pub struct Camera {
     /// eye position
     pub eye: Vec3,
@@ -40,9 +41,114 @@ pub struct Camera {
     pub width: u32,
     /// image height in pixels
     pub height: u32,
+    /// the lens: the look-at pinhole above, or a Mitsuba sensor
+    pub lens: Lens,
+    /// the pixel filter's jitter warp, None for the box filter (uniform jitter)
+    pub filter: Option<crate::sampling::filter::FilterWarp>,
+}
+
+/// How image positions become rays.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lens {
+    /// the `.test` look-at pinhole ([`Camera::dirs8`], every ray from `eye`)
+    Pinhole,
+    /// Mitsuba `perspective`: the direction through image position (x, y) is
+    /// `base + ax (2x/W - 1) + ay (2y/H - 1)` (world space, camera z = 1), the ray starts at
+    /// `origin + near * direction`
+    Perspective {
+        /// the pinhole
+        origin: Vec3,
+        /// `to_world` applied to camera +z
+        base: Vec3,
+        /// world vector per unit of `2x/W - 1`
+        ax: Vec3,
+        /// world vector per unit of `2y/H - 1`
+        ay: Vec3,
+        /// near clip distance along camera z
+        near: f32,
+    },
+    /// Mitsuba `orthographic`: rays along `dir` from `centre + ax (2x/W - 1) + ay (2y/H - 1)`
+    Orthographic {
+        /// `to_world` applied to camera (0, 0, near)
+        centre: Vec3,
+        /// unit direction, `to_world` applied to camera +z
+        dir: Vec3,
+        /// world vector per unit of `2x/W - 1`
+        ax: Vec3,
+        /// world vector per unit of `2y/H - 1`
+        ay: Vec3,
+    },
 }
 
 impl Camera {
+    /// Camera of a Mitsuba sensor for a `width` x `height` image (see `scene::sensor` for the
+    /// conventions: image x runs along camera -x, image y along camera -y).
+    pub fn from_sensor(s: &SensorDesc, width: u32, height: u32) -> Self {
+        let aspect = width as f64 / height as f64;
+        let m = s.to_world;
+        let (cx, cy, cz) = (m.x_axis.truncate(), m.y_axis.truncate(), m.z_axis.truncate());
+        let lens = match s.projection {
+            Projection::Perspective { fov_deg, fov_axis } => {
+                let fov_x = fov_axis.fov_x_deg(f64::from(fov_deg), aspect);
+                let tx = (fov_x.to_radians() * 0.5).tan();
+                let ty = tx / aspect;
+                Lens::Perspective {
+                    origin: m.w_axis.truncate(),
+                    base: cz,
+                    ax: -cx * tx as f32,
+                    ay: -cy * ty as f32,
+                    near: s.near_clip,
+                }
+            }
+            Projection::Orthographic => Lens::Orthographic {
+                centre: m.transform_point3(Vec3::new(0.0, 0.0, s.near_clip)),
+                dir: cz.normalize_or(Vec3::Z),
+                ax: -cx,
+                ay: -cy / aspect as f32,
+            },
+        };
+        let eye = m.w_axis.truncate();
+        let look = cz.normalize_or(Vec3::Z);
+        Self { eye, look, right: -cx, up: cy, plane_dist: 1.0, width, height, lens, filter: None }
+    }
+
+    /// The camera's rays (origins, unit directions) through image positions (x, y) in pixels,
+    /// y down: the pinhole's [`Camera::dirs8`] from `eye`, or the Mitsuba sensor's.
+    #[inline]
+    pub fn rays8(&self, x: F8, y: F8) -> (Vec3x8, Vec3x8) {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let sx = x * F8::splat(2.0 / w) - F8::ONE;
+        let sy = y * F8::splat(2.0 / h) - F8::ONE;
+        match self.lens {
+            Lens::Pinhole => (Vec3x8::splat(self.eye), self.dirs8(x, y)),
+            Lens::Perspective { origin, base, ax, ay, near } => {
+                let d = Vec3x8::splat(ay).mul_add(sy, Vec3x8::splat(ax).mul_add(sx, Vec3x8::splat(base)));
+                (d.mul_add(F8::splat(near), Vec3x8::splat(origin)), d.normalize_or_zero())
+            }
+            Lens::Orthographic { centre, dir, ax, ay } => {
+                let o = Vec3x8::splat(ay).mul_add(sy, Vec3x8::splat(ax).mul_add(sx, Vec3x8::splat(centre)));
+                (o, Vec3x8::splat(dir))
+            }
+        }
+    }
+
+    /// Scalar twin of [`Camera::rays8`] (the same operations, fused alike, so the same bits per
+    /// lane).
+    pub fn ray(&self, x: f32, y: f32) -> (Vec3, Vec3) {
+        use crate::sampling::{mul_add3, normalize_or_zero};
+        let (w, h) = (self.width as f32, self.height as f32);
+        let sx = x * (2.0 / w) - 1.0;
+        let sy = y * (2.0 / h) - 1.0;
+        match self.lens {
+            Lens::Pinhole => (self.eye, self.dir(x, y)),
+            Lens::Perspective { origin, base, ax, ay, near } => {
+                let d = mul_add3(ay, sy, mul_add3(ax, sx, base));
+                (mul_add3(d, near, origin), normalize_or_zero(d))
+            }
+            Lens::Orthographic { centre, dir, ax, ay } => (mul_add3(ay, sy, mul_add3(ax, sx, centre)), dir),
+        }
+    }
+
     /// Camera of `desc` for a `width` x `height` image.
     pub fn new(desc: &CameraDesc, width: u32, height: u32) -> Self {
         let look = (desc.center - desc.eye).normalize_or(Vec3::NEG_Z);
@@ -53,7 +159,17 @@ impl Camera {
         }
         let up = right.cross(look);
         let half = (desc.fovy_deg.to_radians() * 0.5).tan().max(1e-6);
-        Self { eye: desc.eye, look, right, up, plane_dist: 1.0 / half, width, height }
+        Self {
+            eye: desc.eye,
+            look,
+            right,
+            up,
+            plane_dist: 1.0 / half,
+            width,
+            height,
+            lens: Lens::Pinhole,
+            filter: None,
+        }
     }
 
     /// Unnormalized-then-normalized directions through image positions (x, y) in pixels, y down.
@@ -88,8 +204,12 @@ pub struct Scene {
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
-    /// the constant environment light (`--sky`), if any
+    /// the constant environment light (`--sky`, Mitsuba's `constant`), if any
     pub sky: Option<crate::light::sky::Sky>,
+    /// the image environment light (Mitsuba's `envmap`), if any
+    pub envmap: Option<crate::light::envmap::Envmap>,
+    /// point, directional, spot and projector lights, sampled at every next event
+    pub delta: Vec<crate::light::delta::DeltaLight>,
     /// materials (desc materials, then one black material per light)
     pub materials: Vec<Material>,
     /// per triangle: material index
@@ -133,6 +253,22 @@ pub enum BuildError {
     /// Embree refused something.
     #[error("{0}")]
     Accel(#[from] accel::AccelError),
+    /// A delta light that cannot be built.
+    #[error("{}: {err}", .file.display())]
+    Delta {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// what is wrong
+        err: crate::light::delta::DeltaLightError,
+    },
+    /// An environment map that cannot be built.
+    #[error("{}: {err}", .file.display())]
+    Envmap {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// what is wrong
+        err: crate::light::envmap::EnvmapError,
+    },
     /// The scene has no `camera` command (the scene file).
     #[error("{}: no camera command", .0.display())]
     NoCamera(std::path::PathBuf),
@@ -188,8 +324,12 @@ impl Scene {
     /// edges vanishes or is not finite) of either kind are dropped and counted in
     /// [`Scene::degenerate_dropped`].
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
-        let cam_desc = desc.camera.ok_or_else(|| BuildError::NoCamera(desc.source.clone()))?;
-        let camera = Camera::new(&cam_desc, desc.width, desc.height);
+        let mut camera = match (&desc.sensor, desc.camera) {
+            (Some(s), _) => Camera::from_sensor(s, desc.width, desc.height),
+            (None, Some(c)) => Camera::new(&c, desc.width, desc.height),
+            (None, None) => return Err(BuildError::NoCamera(desc.source.clone())),
+        };
+        camera.filter = crate::sampling::filter::FilterWarp::new(desc.filter);
         let mut materials = desc.materials.clone();
         let mut vertices = Vec::with_capacity(desc.triangles.len() * 3 + desc.quad_lights.len() * 4);
         let mut indices = Vec::with_capacity(desc.triangles.len() + desc.quad_lights.len() * 2);
@@ -228,7 +368,7 @@ impl Scene {
             lights.push(light);
         }
         let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
-        for t in &desc.emissive_triangles {
+        for (k, t) in desc.emissive_triangles.iter().enumerate() {
             let e = Emitter::triangle(t.v, t.radiance);
             if !(e.area > 0.0 && e.area.is_finite()) || is_degenerate(&t.v) {
                 degenerate_dropped += 1;
@@ -238,7 +378,9 @@ impl Scene {
             let base = vertices.len() as u32;
             vertices.extend_from_slice(&t.v);
             indices.push([base, base + 1, base + 2]);
-            tri_material.push(black);
+            // A Mitsuba area light also reflects with its shape's BSDF.
+            let reflects = desc.emissive_materials.get(k).copied().filter(|&m| (m as usize) < materials.len());
+            tri_material.push(reflects.unwrap_or(black));
             tri_light.push((lights.len() + tri_emitters.len()) as u32);
             tri_emitters.push(e);
         }
@@ -315,13 +457,34 @@ impl Scene {
             bvh: if high { "high" } else { "medium" },
             spheres: if embree_spheres { "embree" } else { "strata" },
         };
-        let sky = desc.sky.map(crate::light::sky::Sky::new);
+        use crate::scene::desc::EnvironmentDesc;
+        let sky = match &desc.environment {
+            Some(EnvironmentDesc::Constant(l)) => Some(crate::light::sky::Sky::new(*l)),
+            _ => None,
+        };
+        let envmap = match &desc.environment {
+            Some(EnvironmentDesc::Envmap { image, scale, to_world }) => Some(
+                crate::light::envmap::Envmap::new(image, *scale, *to_world)
+                    .map_err(|err| BuildError::Envmap { file: desc.source.clone(), err })?,
+            ),
+            _ => None,
+        };
+        let delta = desc
+            .delta_lights
+            .iter()
+            .map(|d| {
+                crate::light::delta::DeltaLight::new(d)
+                    .map_err(|err| BuildError::Delta { file: desc.source.clone(), err })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             desc,
             camera,
             lights,
             emitters,
             sky,
+            envmap,
+            delta,
             materials,
             tri_material,
             tri_normal,
@@ -339,6 +502,11 @@ impl Scene {
             accel,
             _device: device,
         })
+    }
+
+    /// Whether next events have anything to sample: area lights, the environment or delta lights.
+    pub fn has_nee_lights(&self) -> bool {
+        !self.emitters.is_empty() || self.sky.is_some() || self.envmap.is_some() || !self.delta.is_empty()
     }
 
     /// Offset distance for secondary-ray origins at points `p`: scales with the magnitude of the
@@ -405,5 +573,73 @@ mod tests {
         assert!((top.dot(cam.look).acos().to_degrees() - 22.5).abs() < 1e-3);
         assert!(top.dot(cam.up) > 0.0, "y grows downwards in the image");
         assert!(cam.dir(639.0, 240.0).dot(cam.right) > 0.0, "x grows to the right");
+    }
+
+    /// Mitsuba's `lookat`: columns (left, up, dir, origin) with left = normalize(up x dir).
+    fn lookat(origin: Vec3, target: Vec3, up: Vec3) -> Mat4 {
+        let dir = (target - origin).normalize();
+        let left = up.normalize().cross(dir).normalize();
+        let new_up = dir.cross(left);
+        Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0))
+    }
+
+    #[test]
+    fn mitsuba_perspective_looks_along_z_with_image_x_to_the_right() {
+        use crate::scene::desc::{FovAxis, Projection, SensorDesc};
+        let m = lookat(Vec3::new(0.0, 1.0, 5.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Y);
+        let s = SensorDesc {
+            to_world: m,
+            projection: Projection::Perspective { fov_deg: 40.0, fov_axis: FovAxis::X },
+            near_clip: 0.5,
+        };
+        let cam = Camera::from_sensor(&s, 200, 100);
+        let (o, d) = cam.ray(100.0, 50.0);
+        assert!((d - Vec3::NEG_Z).length() < 1e-6, "{d}");
+        assert!((o - Vec3::new(0.0, 1.0, 4.5)).length() < 1e-5, "near clip: {o}");
+        // Looking down -z with y up, image right is world +x, image down world -y.
+        let (_, right) = cam.ray(199.0, 50.0);
+        let (_, top) = cam.ray(100.0, 0.0);
+        assert!(right.x > 0.0 && top.y > 0.0, "{right} {top}");
+        // fov along x: the left and right edges are 20 degrees off the axis.
+        let (_, edge) = cam.ray(200.0, 50.0);
+        assert!((edge.dot(d).acos().to_degrees() - 20.0).abs() < 1e-3);
+        // The same field of view measured along y, for this 2:1 image.
+        let y = FovAxis::Y.fov_x_deg(40.0, 2.0);
+        let want = 2.0 * (20f64.to_radians().tan() * 2.0).atan().to_degrees();
+        assert!((y - want).abs() < 1e-9);
+        assert_eq!(FovAxis::Smaller.fov_x_deg(40.0, 2.0), y);
+        assert_eq!(FovAxis::Larger.fov_x_deg(40.0, 2.0), 40.0);
+        assert_eq!(FovAxis::Smaller.fov_x_deg(40.0, 0.5), 40.0);
+        let diag = FovAxis::Diagonal.fov_x_deg(40.0, 1.0);
+        assert!((diag - 2.0 * (20f64.to_radians().tan() / 2f64.sqrt()).atan().to_degrees()).abs() < 1e-9);
+        // x8 equals scalar per lane, bit for bit.
+        let xs = [0.0, 0.5, 199.99, 100.0, 10.25, 7.0, 150.5, 33.3];
+        let ys = [0.0, 99.99, 0.5, 50.0, 13.75, 40.0, 99.0, 3.5];
+        let (o8, d8) = cam.rays8(F8::new(xs), F8::new(ys));
+        for i in 0..8 {
+            let (o, d) = cam.ray(xs[i], ys[i]);
+            assert_eq!(o8.lane(i).to_array().map(f32::to_bits), o.to_array().map(f32::to_bits), "lane {i}");
+            assert_eq!(d8.lane(i).to_array().map(f32::to_bits), d.to_array().map(f32::to_bits), "lane {i}");
+        }
+    }
+
+    #[test]
+    fn mitsuba_orthographic_view_is_to_worlds_scaled_unit_square() {
+        use crate::scene::desc::{Projection, SensorDesc};
+        let m = lookat(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y) * Mat4::from_scale(Vec3::new(2.0, 2.0, 1.0));
+        let s = SensorDesc { to_world: m, projection: Projection::Orthographic, near_clip: 0.25 };
+        let cam = Camera::from_sensor(&s, 64, 32);
+        let (o, d) = cam.ray(32.0, 16.0);
+        assert!((d - Vec3::NEG_Z).length() < 1e-6 && (o - Vec3::new(0.0, 0.0, 2.75)).length() < 1e-6, "{o} {d}");
+        // Half-extent 2 along x, 2 / aspect = 1 along y; image right is +x, image top +y.
+        let (o, _) = cam.ray(64.0, 0.0);
+        assert!((o - Vec3::new(2.0, 1.0, 2.75)).length() < 1e-5, "{o}");
+        let xs = [0.0, 0.5, 63.99, 32.0, 10.25, 7.0, 50.5, 33.3];
+        let (o8, d8) = cam.rays8(F8::new(xs), F8::new(xs.map(|x| x * 0.5)));
+        for (i, &x) in xs.iter().enumerate() {
+            let (o, d) = cam.ray(x, x * 0.5);
+            assert_eq!(o8.lane(i).to_array().map(f32::to_bits), o.to_array().map(f32::to_bits), "lane {i}");
+            assert_eq!(d8.lane(i), d);
+        }
     }
 }

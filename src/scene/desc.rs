@@ -6,7 +6,9 @@
 //! ellipsoid). Radiance in linear RGB.
 
 pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
-use glam::{Mat4, Vec3};
+pub use crate::light::desc::{DeltaLightDesc, EnvironmentDesc, RgbImage};
+pub use crate::scene::sensor::{FovAxis, PixelFilter, Projection, SensorDesc};
+use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
 /// Which integrator a scene asks for (`integrator` command).
@@ -90,6 +92,24 @@ pub struct TriangleDesc {
     pub v: [Vec3; 3],
     /// index into `SceneDesc::materials`
     pub material: u32,
+}
+
+/// A named attribute of the triangles `first..first + count` of `SceneDesc::triangles` (one mesh).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleAttrDesc {
+    /// Mitsuba's name with its prefix (`vertex_color`, `face_weight`)
+    pub name: String,
+    /// values per corner or per face (1 or 3)
+    pub dims: u32,
+    /// true: `dims` values per corner (3 corners per triangle, in the order of its `v`), to be
+    /// interpolated barycentrically; false: `dims` values per triangle
+    pub per_corner: bool,
+    /// the first triangle
+    pub first: u32,
+    /// how many triangles
+    pub count: u32,
+    /// `count * dims` (per face) or `count * 3 * dims` (per corner) values
+    pub data: Vec<f32>,
 }
 
 /// A unit sphere at the origin mapped by `object_to_world` (= M * T(c) * S(r)).
@@ -188,6 +208,14 @@ pub struct SceneDesc {
     /// the corner order of its `v`; `[Vec3::ZERO; 3]` or a missing entry (the table may be shorter
     /// than `triangles`, and is empty when no triangle has normals) means none: faceted shading
     pub triangle_normals: Vec<[Vec3; 3]>,
+    /// per-corner texture coordinates of `triangles[i]` at index i, in the corner order of its `v`
+    /// (Mitsuba meshes' uvs, `scene::mesh`); the table may be shorter than `triangles` and is empty
+    /// when no triangle has uvs: a missing entry means none (uv (0, 0) at every point, as Mitsuba
+    /// gives a mesh without uvs)
+    pub triangle_uvs: Vec<[Vec2; 3]>,
+    /// named per-vertex or per-face attributes over runs of `triangles` (Mitsuba's
+    /// `vertex_color`, `face_weight`, ...; read by the `mesh_attribute` texture); empty: none
+    pub triangle_attrs: Vec<TriangleAttrDesc>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -198,8 +226,21 @@ pub struct SceneDesc {
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
     pub directional_lights: Vec<DirectionalLightDesc>,
-    /// constant environment light's radiance (`--sky`; path tracer only), None: black background
-    pub sky: Option<Vec3>,
+    /// the light at infinity: `constant` (`--sky`) or `envmap`; None: black background
+    pub environment: Option<EnvironmentDesc>,
+    /// a Mitsuba sensor; when given it replaces `camera`
+    pub sensor: Option<SensorDesc>,
+    /// the pixel filter (box: uniform jitter, every `.test` scene)
+    pub filter: PixelFilter,
+    /// point, spot, directional and projector lights (Mitsuba's), sampled at every next event
+    pub delta_lights: Vec<DeltaLightDesc>,
+    /// the material each emissive triangle also reflects with (index into `materials`), by
+    /// index; `u32::MAX` or a missing entry (the table may be shorter, and is empty for `.test`
+    /// and OBJ scenes): black, emitting only
+    pub emissive_materials: Vec<u32>,
+    /// the scene's sampler (a Mitsuba `<sampler>`); None: the session's default. `--sampler`
+    /// overrides it
+    pub sampler: Option<crate::sampler::SamplerKind>,
 }
 
 impl SceneDesc {
@@ -254,14 +295,79 @@ impl SceneDesc {
             h.vec3(t.radiance);
         }
         // Only when present, so that the hash of a scene without a sky is unchanged.
-        if let Some(sky) = self.sky {
-            h.word(0x736b_7900);
-            h.vec3(sky);
+        match &self.environment {
+            None => {}
+            Some(EnvironmentDesc::Constant(sky)) => {
+                h.word(0x736b_7900);
+                h.vec3(*sky);
+            }
+            Some(EnvironmentDesc::Envmap { image, scale, to_world }) => {
+                h.word(0x656e_7600);
+                let _ = std::fmt::Write::write_fmt(
+                    &mut h,
+                    format_args!("{:?}", (image.width, image.height, scale, to_world)),
+                );
+                image.texels.iter().for_each(|&t| h.vec3(t));
+            }
+        }
+        // The Mitsuba-side fields, likewise only when set.
+        if self.sensor.is_some() || self.filter != PixelFilter::Box {
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
+        }
+        for l in &self.delta_lights {
+            match l {
+                DeltaLightDesc::Spot { texture: Some(t), .. } | DeltaLightDesc::Projector { irradiance: t, .. } => {
+                    t.texels.iter().for_each(|&t| h.vec3(t));
+                }
+                _ => {}
+            }
+            let short = match l {
+                DeltaLightDesc::Spot { to_world, intensity, cutoff_deg, beam_width_deg, texture } => {
+                    format!(
+                        "spot{:?}",
+                        (
+                            to_world,
+                            intensity,
+                            cutoff_deg,
+                            beam_width_deg,
+                            texture.as_ref().map(|t| (t.width, t.height))
+                        )
+                    )
+                }
+                DeltaLightDesc::Projector { to_world, irradiance, scale, fov_x_deg } => {
+                    format!("projector{:?}", (to_world, irradiance.width, irradiance.height, scale, fov_x_deg))
+                }
+                other => format!("{other:?}"),
+            };
+            let _ = std::fmt::Write::write_str(&mut h, &short);
         }
         // Only when present, so that the hash of a scene without normals is unchanged.
         if !self.triangle_normals.is_empty() {
             h.word(self.triangle_normals.len() as u32);
             self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
+        }
+        // Only when present, so that `.test` and OBJ scenes keep their hash.
+        if !self.emissive_materials.is_empty() {
+            h.word(0x656d_6d00);
+            self.emissive_materials.iter().for_each(|&m| h.word(m));
+        }
+        if let Some(s) = self.sampler {
+            h.word(0x736d_7000);
+            let _ = std::fmt::Write::write_str(&mut h, s.name());
+        }
+        // Likewise uvs and attributes (Mitsuba meshes only).
+        if !self.triangle_uvs.is_empty() {
+            h.word(0x7576_0000);
+            h.word(self.triangle_uvs.len() as u32);
+            self.triangle_uvs.iter().flatten().for_each(|uv| uv.to_array().iter().for_each(|x| h.word(x.to_bits())));
+        }
+        for a in &self.triangle_attrs {
+            h.word(0x6174_7200);
+            let _ = std::fmt::Write::write_str(&mut h, &a.name);
+            [a.dims, u32::from(a.per_corner), a.first, a.count, a.data.len() as u32]
+                .into_iter()
+                .for_each(|w| h.word(w));
+            a.data.iter().for_each(|x| h.word(x.to_bits()));
         }
         h.0
     }
@@ -292,9 +398,16 @@ impl Default for SceneDesc {
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),
             triangle_normals: Vec::new(),
+            triangle_uvs: Vec::new(),
+            triangle_attrs: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
-            sky: None,
+            environment: None,
+            sensor: None,
+            filter: PixelFilter::Box,
+            delta_lights: Vec::new(),
+            emissive_materials: Vec::new(),
+            sampler: None,
         }
     }
 }

@@ -4,5 +4,8 @@ pub mod desc;
 pub mod error;
 pub mod gather;
 pub mod limits;
+pub mod mesh;
 pub mod obj;
 pub mod parse;
+pub mod sensor;
+pub mod xml;

@@ -53,7 +53,7 @@ pub enum SessionError {
         hint: String,
     },
     /// `--max-depth` outside its range.
-    #[error("--sky needs the path tracer (the scene's integrator is {integrator}); add --integrator pathtracer")]
+    #[error("--sky (and any environment or delta light) needs the path tracer or direct (the scene's integrator is {integrator}); add --integrator pathtracer")]
     /// A sky with an integrator that does not trace paths.
     SkyNeedsPathTracer {
         /// the integrator's name

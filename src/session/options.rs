@@ -94,6 +94,8 @@ pub struct RenderOptions {
     pub up: Option<crate::scene::obj::frame::UpAxis>,
     /// `--sky R[,G,B]`: a constant environment light of this radiance (path tracer)
     pub sky: Option<glam::Vec3>,
+    /// `-D NAME=VALUE`: parameters of a Mitsuba XML scene (`$NAME`), over its `<default>`s
+    pub defines: Vec<(String, String)>,
     /// set while the pass loop runs (a signal then stops after the pass and checkpoints; outside
     /// it the binary exits at once with code 130)
     pub rendering: Option<Arc<AtomicBool>>,
@@ -126,7 +128,7 @@ pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::Li
 /// the course-convention defaults.
 fn course_or_obj<T>(opts: &RenderOptions, course: T, obj: T) -> T {
     match &opts.scene {
-        Some(p) if super::scene::is_obj(p) => obj,
+        Some(p) if super::scene::is_obj(p) || crate::scene::xml::is_xml(p) => obj,
         _ => course,
     }
 }

@@ -20,6 +20,13 @@ pub fn parse_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     let limits = opts.limits;
     Ok(match &opts.scene {
         Some(p) if is_obj(p) => crate::scene::obj::scene_from_obj(p, &limits)?,
+        Some(p) if crate::scene::xml::is_xml(p) => {
+            let loaded = crate::scene::xml::load(p, &limits, &opts.defines)?;
+            for w in &loaded.warnings {
+                eprintln!("strata: warning: {w}");
+            }
+            loaded.desc
+        }
         Some(p) => parse::parse_file(p, &limits)?,
         None => parse::parse_str(DEFAULT_SCENE, Path::new("<built-in cornell>"), &limits)?,
     })
@@ -72,14 +79,16 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     let name = opts.scene.as_deref().map(|p| p.display().to_string()).unwrap_or_default();
     let interior_light = if obj && opts.camera.is_none() { frame_obj(&mut desc, opts, &name) } else { None };
     if let Some(sky) = opts.sky {
-        desc.sky = Some(sky);
+        desc.environment = Some(crate::scene::desc::EnvironmentDesc::Constant(sky));
     }
-    if obj && !opts.no_default_light && !super::checks::has_emitter(&desc) && desc.sky.is_none() {
+    if obj && !opts.no_default_light && !super::checks::has_emitter(&desc) && desc.environment.is_none() {
         if let Some(what) = super::checks::add_default_light(&mut desc, interior_light) {
             eprintln!("strata: note: {name} has no light; added {what} (disable with --no-default-light)");
         }
     }
-    if desc.sky.is_some() && desc.integrator != crate::scene::desc::IntegratorKind::PathTracer {
+    use crate::scene::desc::IntegratorKind;
+    let outside = desc.environment.is_some() || !desc.delta_lights.is_empty();
+    if outside && !matches!(desc.integrator, IntegratorKind::PathTracer | IntegratorKind::Direct) {
         return Err(SessionError::SkyNeedsPathTracer { integrator: desc.integrator.name() });
     }
     Ok(desc)
@@ -124,6 +133,15 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         }
     }
     let desc = load_scene(opts)?;
+    // A Mitsuba scene's <sampler> stands where --sampler is not given.
+    let with_scene_sampler;
+    let opts = match (opts.sampler, desc.sampler) {
+        (None, Some(k)) => {
+            with_scene_sampler = RenderOptions { sampler: Some(k), ..opts.clone() };
+            &with_scene_sampler
+        }
+        _ => opts,
+    };
     super::checks::check_outputs(opts, &super::output_stem(opts, &desc), &desc.inputs)?;
     let spp = opts.spp.unwrap_or(desc.spp).max(1);
     if spp > opts.limits.max_spp {

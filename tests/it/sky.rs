@@ -159,13 +159,13 @@ fn cli_sky_refusals() {
     // An integrator that does not trace paths.
     let dir = tmpdir("sky-cli");
     let r = strata()
-        .args(["render", "--sky", "1", "--integrator", "direct", "--spp", "1", "--size", "8x8", "-q", "-o"])
+        .args(["render", "--sky", "1", "--integrator", "raytracer", "--spp", "1", "--size", "8x8", "-q", "-o"])
         .arg(dir.join("x"))
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(1), "{err}");
-    assert!(err.contains("--sky needs the path tracer"), "{err}");
+    assert!(err.contains("--sky (and any environment or delta light) needs the path tracer or direct"), "{err}");
     assert!(!dir.join("x.png").exists());
     // Accepted: R,G,B, recorded in the statistics' scene features.
     let stats = dir.join("s.json");

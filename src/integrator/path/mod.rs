@@ -204,7 +204,8 @@ fn path_tile<L: LobeSet>(
         let dims = LIGHT_POINT.at(v - 1);
         // Dims 0 and 1 (light point, light choice) are light dimensions, 2 and 3 the others.
         let dk: [PathDim; 4] = std::array::from_fn(|j| smp.table_dim(j < 2, it.spp, dims + j as u32));
-        let dsky = scene.sky.as_ref().map(|_| smp.table_dim(true, it.spp, SKY.at(v - 1)));
+        let has_env = scene.sky.is_some() || scene.envmap.is_some();
+        let dsky = has_env.then(|| smp.table_dim(true, it.spp, SKY.at(v - 1)));
         let mut b = Bounce { it, smp, scene, v, max_v, dk: &dk, dsky, keep_prev, next, next_prev, shadow };
         for (ci, (r, traced)) in rh.iter().enumerate() {
             // A packet without a traced lane hits nothing: no emission, no continuation.
@@ -215,6 +216,10 @@ fn path_tile<L: LobeSet>(
             let missed = *traced & !sh.valid;
             if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
                 let le = sky::escaped(it, sky, v, paths.get(PDF, ci), missed);
+                add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
+            }
+            if let Some(env) = scene.envmap.as_ref().filter(|_| missed.any()) {
+                let le = sky::escaped_envmap(it, env, v, r.ray.dir(), paths.get(PDF, ci), missed);
                 add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
             }
             if sh.valid.none() {
@@ -338,12 +343,14 @@ impl Bounce<'_> {
         let is_light = F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
         // Shading frame: the normal faces wo, so wo.z > 0 in local coordinates.
         let shade = sh.valid & !is_light;
-        let nee_here = nee != Nee::Off && (n_lights > 0 || scene.sky.is_some()) && v < max_v;
+        let nee_here = nee != Nee::Off && scene.has_nee_lights() && v < max_v;
+        // Delta lights are reached by next events only, whatever the NEE mode.
+        let delta_here = !scene.delta.is_empty() && v < max_v;
         let bounce_here = match nee {
             Nee::On => v + 1 < max_v,
             _ => v < max_v,
         };
-        if shade.none() || (!nee_here && !bounce_here) {
+        if shade.none() || (!nee_here && !bounce_here && !delta_here) {
             return;
         }
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
@@ -362,6 +369,16 @@ impl Bounce<'_> {
 
         if nee_here {
             self.sky_next_event::<L>(vx, &frame, wo, &mat, o, shade, leaves);
+        }
+        if delta_here {
+            let shadow = &mut *self.shadow;
+            let push = |lit: Mask8, wi: Vec3x8, tfar: F8, c: Vec3x8| {
+                let pack = Pack::of(lit);
+                let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, tfar, c.x, c.y, c.z];
+                shadow.write(S_SLOT, &pack, &row);
+                shadow.advance(&pack);
+            };
+            sky::delta_next_events::<L>(it, scene, sh.p, &frame, wo, &mat, beta, shade, leaves, push);
         }
         if nee_here && n_lights > 0 {
             let u_choice = if own_choice {
@@ -510,11 +527,14 @@ impl Bounce<'_> {
         shade: Mask8,
         leaves: impl Fn(Vec3x8) -> Mask8,
     ) {
-        let (Some(sky), Some(dim)) = (self.scene.sky.as_ref(), self.dsky.as_ref()) else { return };
+        let Some(dim) = self.dsky.as_ref() else { return };
         let uw = self.smp.table_point(dim, true, Phase::SamplerPath, vx.pixel, vx.s);
-        let Some((lit, wi, c)) = sky::next_event::<L>(self.it, sky, uw, frame, wo, mat, vx.beta, shade, leaves) else {
-            return;
+        let event = match (self.scene.sky.as_ref(), self.scene.envmap.as_ref()) {
+            (Some(sky), _) => sky::next_event::<L>(self.it, sky, uw, frame, wo, mat, vx.beta, shade, leaves),
+            (None, Some(env)) => sky::envmap_next_event::<L>(self.it, env, uw, frame, wo, mat, vx.beta, shade, leaves),
+            (None, None) => None,
         };
+        let Some((lit, wi, c)) = event else { return };
         let inf = F8::splat(f32::INFINITY);
         let pack = Pack::of(lit);
         let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, inf, c.x, c.y, c.z];

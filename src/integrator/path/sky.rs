@@ -1,11 +1,15 @@
-//! The path tracer's two hooks for the constant environment light ([`crate::light::sky`]): the
-//! radiance of escaped rays, and the sky's next event at a shaded vertex. Its sample points come
+//! The path tracer's hooks for the lights outside the light selection: the constant environment
+//! light ([`crate::light::sky`]) and the envmap ([`crate::light::envmap`]), each with the radiance
+//! of escaped rays and a next event at a shaded vertex (MIS against the BSDF), and the delta
+//! lights ([`crate::light::delta`]: a next event each, weight 1). Its sample points come
 //! from their own dimensions, `DIM_SKY_BASE + (v - 1)` for vertex v, so a scene with a sky keeps
 //! every other dimension of the path (and a scene without one renders exactly as before).
 
 use crate::bsdf::{LobeSet, Material8};
 use crate::integrator::settings::Integrator;
+use crate::light::envmap::Envmap;
 use crate::light::sky::Sky;
+use crate::sampling::power_heuristic_x8;
 use crate::scene::desc::Nee;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 
@@ -50,4 +54,93 @@ pub(super) fn next_event<L: LobeSet>(
     let weight = Sky::nee_weight_x8(it.path.nee == Nee::Mis, pdf_b, lit);
     let g = lit.select(wi_l.z / pdf * weight, F8::ZERO);
     Some((lit, wi, beta.mul_elem(f).mul_elem(Vec3x8::splat(sky.radiance)).scale(g)))
+}
+
+/// Envmap radiance, weighted by the next-event mode as [`escaped`] weighs the sky's, brought by
+/// the rays of vertex `v` that left the scene (`missed`) along `dir`, sampled with `pdf`.
+#[inline]
+pub(super) fn escaped_envmap(it: &Integrator, env: &Envmap, v: u32, dir: Vec3x8, pdf: F8, missed: Mask8) -> Vec3x8 {
+    let (le, p_env) = env.radiance_pdf_x8(dir, missed);
+    let w = if v == 1 || it.path.nee == Nee::Off {
+        missed.select(F8::ONE, F8::ZERO)
+    } else if it.path.nee == Nee::Mis {
+        power_heuristic_x8(pdf, p_env, missed)
+    } else {
+        F8::ZERO
+    };
+    le.scale(w)
+}
+
+/// The envmap's next event at the shaded lanes `shade` (as [`next_event`] for the sky): one
+/// direction drawn from the map's distribution, MIS-weighted against the BSDF.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn envmap_next_event<L: LobeSet>(
+    it: &Integrator,
+    env: &Envmap,
+    (u, w): (F8, F8),
+    frame: &Frame8,
+    wo: Vec3x8,
+    mat: &Material8,
+    beta: Vec3x8,
+    shade: Mask8,
+    leaves: impl Fn(Vec3x8) -> Mask8,
+) -> Option<(Mask8, Vec3x8, Vec3x8)> {
+    let (wi, pdf, le) = {
+        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+        env.sample_x8(u, w, shade)
+    };
+    let wi_l = frame.to_local(wi);
+    let lit = shade & wi_l.z.simd_gt(F8::ZERO) & pdf.simd_gt(F8::ZERO) & leaves(wi);
+    if lit.none() {
+        return None;
+    }
+    let (f, pdf_b) = {
+        let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
+        mat.eval_pdf_k::<L>(it.path.strategy, wo, wi_l, lit)
+    };
+    let weight = if it.path.nee == Nee::Mis { power_heuristic_x8(pdf, pdf_b, lit) } else { F8::ONE };
+    let g = lit.select(wi_l.z / pdf * weight, F8::ZERO);
+    Some((lit, wi, beta.mul_elem(f).mul_elem(le).scale(g)))
+}
+
+/// The delta lights' next events at the shaded lanes `shade` of a vertex at `p` (throughput
+/// `beta`): each light once, weight 1 (no BSDF sampling can reach a delta light). Calls `push`
+/// with (lit lanes, unit direction, shadow-ray length, contribution) per light that lights a lane.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn delta_next_events<L: LobeSet>(
+    it: &Integrator,
+    scene: &crate::scene::build::Scene,
+    p: Vec3x8,
+    frame: &Frame8,
+    wo: Vec3x8,
+    mat: &Material8,
+    beta: Vec3x8,
+    shade: Mask8,
+    leaves: impl Fn(Vec3x8) -> Mask8,
+    mut push: impl FnMut(Mask8, Vec3x8, F8, Vec3x8),
+) {
+    for light in &scene.delta {
+        let (wi, dist, li, ok) = {
+            let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+            light.sample_x8(p, shade)
+        };
+        let wi_l = frame.to_local(wi);
+        let lit = ok & wi_l.z.simd_gt(F8::ZERO) & leaves(wi);
+        if lit.none() {
+            continue;
+        }
+        let f = {
+            let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
+            mat.eval_pdf_k::<L>(it.path.strategy, wo, wi_l, lit).0
+        };
+        // The shadow ray stops short of the light (a point; infinity for directional).
+        let tfar = match light.position() {
+            Some(y) => dist - scene.offset_eps(Vec3x8::splat(y)),
+            None => F8::splat(f32::INFINITY),
+        };
+        let c = beta.mul_elem(f).mul_elem(li).scale(lit.select(wi_l.z, F8::ZERO));
+        push(lit, wi, tfar, c);
+    }
 }

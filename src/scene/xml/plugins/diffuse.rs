@@ -1,0 +1,30 @@
+//! `<bsdf type="diffuse">`: Lambertian `reflectance` (rgb, spectrum or float; default 0.5).
+//! strata shades it on both sides (as `twosided` of it).
+
+use super::{Build, Plugin, Run};
+use crate::scene::desc::Material;
+use crate::scene::error::SceneError;
+use crate::scene::xml::props::{Color, Props};
+use glam::Vec3;
+
+/// Registry entry.
+pub const PLUGIN: Plugin = Plugin { tag: "bsdf", kind: "diffuse", run: Run::Bsdf(run) };
+
+/// Mitsuba's material of a shape without a BSDF: diffuse, reflectance 0.5.
+pub fn default_material() -> Material {
+    lambert(Vec3::splat(0.5))
+}
+
+/// A Lambertian material of reflectance `r` (the BRDF is `r / pi`).
+pub fn lambert(r: Vec3) -> Material {
+    Material { diffuse: r, ambient: Vec3::ZERO, ..Material::default() }
+}
+
+fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+    p.ignore("id");
+    match p.color("reflectance", false)? {
+        Some(Color::Rgb(c)) => Ok(lambert(c)),
+        Some(Color::Texture(t)) => Err(t.at.err("a textured reflectance needs the `textures` work of issue 29")),
+        None => Ok(default_material()),
+    }
+}

@@ -1,0 +1,336 @@
+//! The plugin registry: one line per Mitsuba plugin (`tag`, `type`, what reads it), and the
+//! plugins the renderer does not do yet with the reason that names the missing feature. Each
+//! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
+
+mod area;
+mod constant;
+mod cube;
+mod cylinder;
+mod diffuse;
+mod direct;
+mod directional;
+mod disk;
+mod envmap;
+mod hdrfilm;
+mod instance;
+mod integrator_moment;
+mod obj;
+mod orthographic;
+mod path;
+mod perspective;
+mod ply;
+mod point;
+mod projector;
+mod rectangle;
+mod rfilter_box;
+mod rfilter_gaussian;
+mod sampler;
+mod sdfgrid;
+mod serialized;
+mod shapegroup;
+mod sphere;
+mod spot;
+mod twosided;
+
+use super::doc::{Elem, Loc};
+use super::props::{Color, Props};
+use super::shape::ShapeOut;
+use crate::scene::desc::{EnvironmentDesc, Material, RgbImage, SceneDesc};
+use crate::scene::error::SceneError;
+use crate::scene::limits::Limits;
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// What a plugin makes.
+pub enum Run {
+    /// writes into the scene (sensor, film, filter, sampler, integrator, top-level emitter)
+    Scene(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<(), SceneError>),
+    /// a surface material
+    Bsdf(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Material, SceneError>),
+    /// a shape's geometry (placed by the caller with its material and emitter)
+    Shape(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<ShapeOut, SceneError>),
+    /// an area emitter's radiance
+    Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Vec3, SceneError>),
+    /// known to Mitsuba, not rendered yet: the missing feature
+    Refused(&'static str),
+}
+
+/// One registry entry.
+pub struct Plugin {
+    /// element tag (`shape`, `bsdf`, ...)
+    pub tag: &'static str,
+    /// `type` attribute
+    pub kind: &'static str,
+    /// what reads it
+    pub run: Run,
+}
+
+const fn refused(tag: &'static str, kind: &'static str, why: &'static str) -> Plugin {
+    Plugin { tag, kind, run: Run::Refused(why) }
+}
+
+const TEXTURES: &str = "needs textured materials at hits (the `textures` work of issue 29)";
+const BSDFS: &str = "needs the BSDFs of issue 30";
+
+/// Every plugin the XML front end knows, one line each.
+pub const PLUGINS: &[Plugin] = &[
+    perspective::PLUGIN,
+    orthographic::PLUGIN,
+    hdrfilm::PLUGIN,
+    rfilter_box::PLUGIN,
+    rfilter_gaussian::PLUGIN,
+    sampler::INDEPENDENT,
+    sampler::STRATIFIED,
+    sampler::MULTIJITTER,
+    sampler::LDSAMPLER,
+    sampler::SOBOL,
+    path::PLUGIN,
+    direct::PLUGIN,
+    integrator_moment::PLUGIN,
+    refused("integrator", "ptracer", "needs the particle tracer of issue 29"),
+    obj::PLUGIN,
+    ply::PLUGIN,
+    serialized::PLUGIN,
+    rectangle::PLUGIN,
+    disk::PLUGIN,
+    cube::PLUGIN,
+    cylinder::PLUGIN,
+    sphere::PLUGIN,
+    sdfgrid::PLUGIN,
+    shapegroup::PLUGIN,
+    instance::PLUGIN,
+    area::PLUGIN,
+    point::PLUGIN,
+    spot::PLUGIN,
+    directional::PLUGIN,
+    projector::PLUGIN,
+    constant::PLUGIN,
+    envmap::PLUGIN,
+    diffuse::PLUGIN,
+    twosided::PLUGIN,
+    refused("bsdf", "conductor", BSDFS),
+    refused("bsdf", "roughconductor", BSDFS),
+    refused("bsdf", "dielectric", BSDFS),
+    refused("bsdf", "roughdielectric", BSDFS),
+    refused("bsdf", "thindielectric", BSDFS),
+    refused("bsdf", "plastic", BSDFS),
+    refused("bsdf", "roughplastic", BSDFS),
+    refused("bsdf", "principled", BSDFS),
+    refused("bsdf", "principledthin", BSDFS),
+    refused("bsdf", "blendbsdf", BSDFS),
+    refused("bsdf", "mask", BSDFS),
+    refused("bsdf", "bumpmap", BSDFS),
+    refused("bsdf", "normalmap", BSDFS),
+    refused("bsdf", "null", BSDFS),
+    refused("texture", "bitmap", TEXTURES),
+    refused("texture", "checkerboard", TEXTURES),
+    refused("texture", "mesh_attribute", TEXTURES),
+    refused("texture", "rawconstant", TEXTURES),
+];
+
+/// The registry entry of `e` (by tag and type), or a file:line error naming the supported types.
+pub fn lookup(e: &Elem) -> Result<&'static Plugin, SceneError> {
+    let kind = e.need("type")?;
+    if let Some(p) = PLUGINS.iter().find(|p| p.tag == e.tag && p.kind == kind) {
+        if let Run::Refused(why) = p.run {
+            return Err(e.at.err(format!("{} is not supported yet: it {why}", e.what())));
+        }
+        return Ok(p);
+    }
+    let known: Vec<&str> =
+        PLUGINS.iter().filter(|p| p.tag == e.tag && !matches!(p.run, Run::Refused(_))).map(|p| p.kind).collect();
+    if known.is_empty() {
+        return Err(e.at.err(format!("unknown element <{}>", e.tag)));
+    }
+    Err(e.at.err(format!("unknown {} type \"{kind}\" (supported: {})", e.tag, known.join(", "))))
+}
+
+/// A shape's geometry, its material index and its area emitter (radiance, where declared).
+pub type ShapeParts = (ShapeOut, u32, Option<(Vec3, Loc)>);
+
+/// The state of one scene's conversion: the scene being filled, warnings, the ids.
+pub struct Build<'e> {
+    /// the scene
+    pub desc: SceneDesc,
+    /// `file:line: ...` warnings (unused properties, approximations)
+    pub warnings: Vec<String>,
+    /// objects declared with `id`
+    pub ids: &'e HashMap<String, Elem>,
+    /// resource caps
+    pub limits: &'e Limits,
+    /// `<path>` directories and the scene's, for file names
+    pub search: Vec<PathBuf>,
+    /// interned materials (by their Debug text: every field)
+    materials: HashMap<String, u32>,
+}
+
+impl<'e> Build<'e> {
+    /// A conversion into a fresh scene from `source`.
+    pub fn new(source: PathBuf, ids: &'e HashMap<String, Elem>, limits: &'e Limits, search: Vec<PathBuf>) -> Self {
+        let desc = SceneDesc {
+            source,
+            width: 768,
+            height: 576,
+            integrator: crate::scene::desc::IntegratorKind::PathTracer,
+            ..SceneDesc::default()
+        };
+        Self { desc, warnings: Vec::new(), ids, limits, search, materials: HashMap::new() }
+    }
+
+    /// A file named in the scene, found as Mitsuba's resolver finds it.
+    pub fn resolve(&self, name: &str) -> PathBuf {
+        let p = std::path::Path::new(name);
+        if p.is_absolute() {
+            return p.to_path_buf();
+        }
+        self.search
+            .iter()
+            .rev()
+            .map(|d| d.join(p))
+            .find(|c| c.exists())
+            .unwrap_or_else(|| self.search.first().map_or_else(|| p.to_path_buf(), |d| d.join(p)))
+    }
+
+    /// The index of `m` in the scene's materials (added once).
+    pub fn intern(&mut self, m: Material) -> u32 {
+        let key = format!("{m:?}");
+        let n = self.desc.materials.len() as u32;
+        *self.materials.entry(key).or_insert_with(|| {
+            self.desc.materials.push(m);
+            n
+        })
+    }
+
+    /// Runs the plugin of `e` for its effect on the scene (`Run::Scene`), with its unused
+    /// properties reported.
+    pub fn run_scene(&mut self, e: &'e Elem) -> Result<(), SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        match p.run {
+            Run::Scene(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} cannot appear here", e.what()))),
+        }
+        self.warnings.extend(props.unused());
+        Ok(())
+    }
+
+    /// The material of a `<bsdf>` element.
+    pub fn bsdf(&mut self, e: &'e Elem) -> Result<Material, SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let m = match p.run {
+            Run::Bsdf(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} is not a BSDF", e.what()))),
+        };
+        self.warnings.extend(props.unused());
+        Ok(m)
+    }
+
+    /// The radiance of an `<emitter>` nested in a shape.
+    pub fn area(&mut self, e: &'e Elem) -> Result<Vec3, SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let r = match p.run {
+            Run::Area(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} cannot be attached to a shape (only `area` can)", e.what()))),
+        };
+        self.warnings.extend(props.unused());
+        Ok(r)
+    }
+
+    /// A shape: its geometry, material and area emitter, placed in the scene.
+    pub fn shape(&mut self, e: &'e Elem) -> Result<(), SceneError> {
+        let (out, material, emitter) = self.shape_parts(e)?;
+        super::shape::place(self, out, material, emitter, &e.at)
+    }
+
+    /// A shape's geometry (through its `to_world`), its material index and its area emitter,
+    /// with its unused properties reported; not placed.
+    pub fn shape_parts(&mut self, e: &'e Elem) -> Result<ShapeParts, SceneError> {
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let out = match p.run {
+            Run::Shape(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} is not a shape", e.what()))),
+        };
+        let material = match props.object("bsdf")? {
+            Some(b) => self.bsdf(b)?,
+            None => diffuse::default_material(),
+        };
+        let emitter = match props.object("emitter")? {
+            Some(em) => Some((self.area(em)?, em.at.clone())),
+            None => None,
+        };
+        props.ignore("id");
+        self.warnings.extend(props.unused());
+        Ok((out, self.intern(material), emitter))
+    }
+
+    /// The file named by the plugin's `filename` string, resolved.
+    pub fn file(&self, p: &Props) -> Result<PathBuf, SceneError> {
+        let name = p
+            .string("filename")?
+            .ok_or_else(|| p.elem.at.err(format!("{} needs a `filename` string", p.elem.what())))?;
+        Ok(self.resolve(name))
+    }
+
+    /// An emitter's colour property `name` (rgb, spectrum or float; Mitsuba's default, a
+    /// uniform spectrum of 1, when absent).
+    pub fn emitter_rgb(&self, p: &Props, name: &str) -> Result<Vec3, SceneError> {
+        match p.color(name, true)? {
+            Some(Color::Rgb(c)) => Ok(c),
+            Some(Color::Texture(t)) => {
+                Err(t.at.err(format!("a textured `{name}` is not supported for {}", p.elem.what())))
+            }
+            None => Ok(super::values::spectrum_default_emitter()),
+        }
+    }
+
+    /// Sets the scene's one environment emitter.
+    pub fn set_environment(&mut self, p: &Props, env: EnvironmentDesc) -> Result<(), SceneError> {
+        if self.desc.environment.is_some() {
+            return Err(p
+                .elem
+                .at
+                .err("a second environment emitter (constant or envmap) is not supported (Mitsuba allows one)"));
+        }
+        self.desc.environment = Some(env);
+        Ok(())
+    }
+
+    /// Decodes an image file for an emitter (8-bit sRGB decoded unless `raw`).
+    pub fn load_image(&self, p: &Props, path: &std::path::Path, raw: bool) -> Result<Arc<RgbImage>, SceneError> {
+        let opts = crate::texture::BitmapOptions { raw, ..Default::default() };
+        let bmp = crate::texture::Bitmap::load(path, &opts, &crate::texture::BitmapLimits::default())
+            .map_err(|e| p.elem.at.err(format!("{}: {e}", p.elem.what())))?;
+        let texels = bmp.texels().iter().map(|&t| Vec3::from(t)).collect();
+        Ok(Arc::new(RgbImage { width: bmp.width(), height: bmp.height(), texels }))
+    }
+
+    /// The image of a `<texture type="bitmap">` used by an emitter (`filename`, `raw`; bilinear,
+    /// repeat as the emitters look it up).
+    pub fn bitmap_image(&mut self, t: &'e Elem) -> Result<Arc<RgbImage>, SceneError> {
+        if t.attr("type") != Some("bitmap") {
+            return Err(t.at.err(format!("an emitter's texture must be a bitmap, not {}", t.what())));
+        }
+        let p = Props::new(t, self.ids)?;
+        let path = self.file(&p)?;
+        let raw = p.bool("raw", false)?;
+        if p.string("filter_type")?.is_some_and(|f| f != "bilinear")
+            || p.string("wrap_mode")?.is_some_and(|w| w != "repeat")
+        {
+            return Err(t.at.err("an emitter's bitmap is looked up bilinearly with repeat wrapping; other filter_type/wrap_mode are not supported"));
+        }
+        p.ignore("id");
+        let img = self.load_image(&p, &path, raw)?;
+        self.warnings.extend(p.unused());
+        Ok(img)
+    }
+
+    /// A warning at `at`.
+    pub fn warn(&mut self, at: &Loc, message: impl std::fmt::Display) {
+        self.warnings.push(format!("{}: {message}", at.show()));
+    }
+}

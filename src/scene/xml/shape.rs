@@ -1,0 +1,85 @@
+//! What shape plugins make ([`ShapeOut`]) and its placement in the scene with the shape's
+//! material and area emitter; `to_world`, `flip_normals` and `face_normals` as Mitsuba applies
+//! them (through `scene::mesh`).
+
+use super::doc::Loc;
+use super::plugins::Build;
+use super::props::Props;
+use crate::scene::desc::{EmissiveTriangleDesc, SphereDesc};
+use crate::scene::error::SceneError;
+use crate::scene::mesh::{Mesh, MeshError};
+use glam::{Mat4, Vec3};
+
+/// A shape's geometry.
+pub enum ShapeOut {
+    /// a triangle mesh, world space (or the shape group's space)
+    Mesh(Mesh),
+    /// the unit sphere mapped by this object-to-world matrix
+    Sphere(Mat4),
+    /// nothing to place here (a `shapegroup`, placed by its instances; an `instance`, placed by
+    /// its plugin)
+    Nothing,
+}
+
+/// An object-space mesh through `to_world`, with Mitsuba's `face_normals` (vertex normals
+/// dropped) and `flip_normals`.
+pub fn mesh(p: &Props, mut m: Mesh) -> Result<ShapeOut, SceneError> {
+    m.transform(&p.transform("to_world")?);
+    if p.bool("face_normals", false)? {
+        m.face_normals();
+    }
+    if p.bool("flip_normals", false)? {
+        m.flip_normals();
+    }
+    Ok(ShapeOut::Mesh(m))
+}
+
+/// A mesh loader's error at the shape's element.
+pub fn load_error(p: &Props, e: MeshError) -> SceneError {
+    p.elem.at.err(format!("{}: {e}", p.elem.what()))
+}
+
+/// Places a shape: its triangles with `material` (a material index), or emissive triangles
+/// (that also reflect with `material`) when it carries an area emitter of `radiance`; a sphere
+/// as an ellipsoid.
+pub fn place(
+    b: &mut Build,
+    out: ShapeOut,
+    material: u32,
+    emitter: Option<(Vec3, Loc)>,
+    at: &Loc,
+) -> Result<(), SceneError> {
+    match out {
+        ShapeOut::Nothing => {}
+        ShapeOut::Sphere(m) => {
+            if let Some((_, eat)) = emitter {
+                return Err(eat.err("an area emitter on a sphere is not supported yet: it needs solid-angle sphere light sampling (the `lights` work of issue 29)"));
+            }
+            b.desc.spheres.push(SphereDesc { object_to_world: m, material });
+        }
+        ShapeOut::Mesh(mesh) => {
+            let n = b.desc.triangles.len() + b.desc.emissive_triangles.len() + mesh.indices.len();
+            if n > b.limits.max_primitives {
+                return Err(at.err(format!(
+                    "the scene has more than {} triangles ({})",
+                    b.limits.max_primitives,
+                    crate::scene::limits::limit_hint("max_primitives")
+                )));
+            }
+            match emitter {
+                None => {
+                    b.desc.add_mesh(&mesh, material);
+                }
+                Some((radiance, _)) => {
+                    for f in &mesh.indices {
+                        let v = f.map(|i| mesh.positions[i as usize]);
+                        b.desc.emissive_materials.resize(b.desc.emissive_triangles.len(), u32::MAX);
+                        b.desc.emissive_materials.push(material);
+                        b.desc.emissive_triangles.push(EmissiveTriangleDesc { v, radiance });
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,136 @@
+//! Textures: images and procedural patterns evaluated per lane at surface hits.
+//!
+//! # API (plain Rust; the Mitsuba XML front end builds these types)
+//!
+//! - [`Bitmap`] (`bitmap.rs`): an RGB f32 image. `Bitmap::load(path, &BitmapOptions { raw, filter,
+//!   wrap }, &BitmapLimits::default())` reads PNG, JPEG, BMP, Radiance HDR (the `image` crate) or
+//!   OpenEXR (the `exr` crate); 8/16-bit values are sRGB-decoded to linear unless `raw`; sizes are
+//!   checked from the header before anything is allocated; errors are [`TextureError`]s naming
+//!   the file. `Bitmap::from_texels` makes one in memory. `eval(uv)` and `eval_x8(u, v)` look it
+//!   up (bit-identical per lane) with Mitsuba's filters (`FilterType::{Nearest, Bilinear}`),
+//!   wrap modes (`WrapMode::{Repeat, Mirror, Clamp}`) and texel-centre convention; `width`,
+//!   `height`, `texel(x, y)` and `texels()` give the raw data (for envmap sampling).
+//! - The texture plugins, one file each, gathered in the enum [`Texture`] by one registry line
+//!   each (`textures!` below): [`BitmapTexture`] (`bitmap.rs`: a `Bitmap` with `to_uv`),
+//!   [`Checkerboard`] (`checkerboard.rs`: `color0` 0.4, `color1` 0.2, `to_uv`), [`MeshAttribute`]
+//!   (`mesh_attribute.rs`: a named `vertex_*`/`face_*` attribute times `scale`; the scene binds its
+//!   data with [`MeshAttribute::bind`]), [`RawConstant`] (`rawconstant.rs`: `value` as given).
+//!   [`UvTransform`] is Mitsuba's 3x3 `to_uv` (`UvTransform::from_mat4` takes rows and columns
+//!   0, 1, 3 of the XML's 4x4, as Mitsuba does).
+//! - Evaluation: `Texture::eval(&TexQuery)` for one point and `Texture::eval_x8(&TexQuery8)` for
+//!   eight lanes, bit-identical per lane. A query carries the hit's uv, its triangle index in
+//!   `SceneDesc::triangles` (`NO_TRIANGLE` elsewhere) and Embree's barycentrics `(b1, b2)` (the
+//!   weights of corners 1 and 2). Values are linear RGB; what a scene's material does with them
+//!   is the scene's business (`scene/gather.rs`).
+
+mod query;
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+
+use crate::simd::Vec3x8;
+
+pub use bitmap::{srgb_to_linear, Bitmap, BitmapLimits, BitmapOptions, FilterType, WrapMode};
+pub use mesh_attribute::AttrRun;
+pub use query::{TexQuery, TexQuery8, UvTransform, NO_TRIANGLE};
+
+/// The registry: one line per texture plugin, `file: Type,` (declares `mod file;`, re-exports
+/// `file::Type` and adds the `Texture::Type` variant with its dispatch).
+macro_rules! textures {
+    ($($file:ident: $ty:ident,)*) => {
+        $(mod $file; pub use $file::$ty;)*
+
+        /// A texture of the scene: one variant per plugin.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum Texture {
+            $(
+                #[doc = concat!("The `", stringify!($file), "` plugin.")]
+                $ty($ty),
+            )*
+        }
+
+        impl Texture {
+            /// The value at one point.
+            pub fn eval(&self, q: &TexQuery) -> Vec3 {
+                match self {
+                    $(Self::$ty(t) => t.eval(q),)*
+                }
+            }
+
+            /// The values at eight points (every lane evaluated; bit-identical to `eval` per lane).
+            pub fn eval_x8(&self, q: &TexQuery8) -> Vec3x8 {
+                match self {
+                    $(Self::$ty(t) => t.eval_x8(q),)*
+                }
+            }
+        }
+    };
+}
+
+textures! {
+    bitmap: BitmapTexture,
+    checkerboard: Checkerboard,
+    mesh_attribute: MeshAttribute,
+    rawconstant: RawConstant,
+}
+
+/// What goes wrong making a texture.
+#[derive(Debug, thiserror::Error)]
+pub enum TextureError {
+    /// The file could not be opened or read.
+    #[error("texture {}: {source}", path.display())]
+    Io {
+        /// The image file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file is not an image format strata reads.
+    #[error("texture {}: not a PNG, JPEG, BMP, HDR or OpenEXR image", path.display())]
+    Format {
+        /// The image file.
+        path: PathBuf,
+    },
+    /// The decoder refused the file (truncated, corrupt, unsupported variant).
+    #[error("texture {}: {message}", path.display())]
+    Decode {
+        /// The image file.
+        path: PathBuf,
+        /// The decoder's message.
+        message: String,
+    },
+    /// The header's size is 0 or over the limits (checked before decoding).
+    #[error(
+        "texture {}: {width}x{height} texels is empty or over the limits ({max_side} a side, {max_texels} in all)",
+        path.display()
+    )]
+    TooLarge {
+        /// The image file.
+        path: PathBuf,
+        /// Width from the header.
+        width: u64,
+        /// Height from the header.
+        height: u64,
+        /// The side limit.
+        max_side: u32,
+        /// The texel-count limit.
+        max_texels: u64,
+    },
+    /// An OpenEXR file without R, G, B or Y channels.
+    #[error("texture {}: OpenEXR file without R, G, B (or Y) channels", path.display())]
+    Channels {
+        /// The image file.
+        path: PathBuf,
+    },
+    /// In-memory texels that do not fill `width * height`.
+    #[error("bitmap of {width}x{height} texels given {count} texels")]
+    TexelCount {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Texels given.
+        count: usize,
+    },
+}
