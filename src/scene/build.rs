@@ -117,15 +117,16 @@ impl Camera {
     #[inline]
     pub fn rays8(&self, x: F8, y: F8) -> (Vec3x8, Vec3x8) {
         let (w, h) = (self.width as f32, self.height as f32);
-        let sx = x * F8::splat(2.0 / w) - F8::ONE;
-        let sy = y * F8::splat(2.0 / h) - F8::ONE;
+        let s = || (x * F8::splat(2.0 / w) - F8::ONE, y * F8::splat(2.0 / h) - F8::ONE);
         match self.lens {
             Lens::Pinhole => (Vec3x8::splat(self.eye), self.dirs8(x, y)),
             Lens::Perspective { origin, base, ax, ay, near } => {
+                let (sx, sy) = s();
                 let d = Vec3x8::splat(ay).mul_add(sy, Vec3x8::splat(ax).mul_add(sx, Vec3x8::splat(base)));
                 (d.mul_add(F8::splat(near), Vec3x8::splat(origin)), d.normalize_or_zero())
             }
             Lens::Orthographic { centre, dir, ax, ay } => {
+                let (sx, sy) = s();
                 let o = Vec3x8::splat(ay).mul_add(sy, Vec3x8::splat(ax).mul_add(sx, Vec3x8::splat(centre)));
                 (o, Vec3x8::splat(dir))
             }
