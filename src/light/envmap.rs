@@ -261,8 +261,8 @@ mod tests {
         let mut rng = crate::sampling::chi2::Rng::new(3);
         let us: [[f32; 2]; 8] = std::array::from_fn(|_| rng.u2());
         let (w8, p8, l8) = e.sample_x8(F8::new(us.map(|u| u[0])), F8::new(us.map(|u| u[1])), mask_all());
-        for i in 0..8 {
-            let (w, p, l) = e.sample(us[i][0], us[i][1]);
+        for (i, u) in us.iter().enumerate() {
+            let (w, p, l) = e.sample(u[0], u[1]);
             assert_eq!((w8.lane(i), p8.to_array()[i], l8.lane(i)), (w, p, l));
             assert!((e.pdf(w) - p).abs() <= 1e-3 * p, "{} vs {p}", e.pdf(w));
             assert_eq!(e.radiance(w), l);

@@ -603,8 +603,8 @@ mod tests {
         let xs = [0.0, 0.5, 199.99, 100.0, 10.25, 7.0, 150.5, 33.3];
         let ys = [0.0, 99.99, 0.5, 50.0, 13.75, 40.0, 99.0, 3.5];
         let (o8, d8) = cam.rays8(F8::new(xs), F8::new(ys));
-        for i in 0..8 {
-            let (o, d) = cam.ray(xs[i], ys[i]);
+        for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+            let (o, d) = cam.ray(x, y);
             assert_eq!(o8.lane(i).to_array().map(f32::to_bits), o.to_array().map(f32::to_bits), "lane {i}");
             assert_eq!(d8.lane(i).to_array().map(f32::to_bits), d.to_array().map(f32::to_bits), "lane {i}");
         }
@@ -623,8 +623,8 @@ mod tests {
         assert!((o - Vec3::new(2.0, 1.0, 2.75)).length() < 1e-5, "{o}");
         let xs = [0.0, 0.5, 63.99, 32.0, 10.25, 7.0, 50.5, 33.3];
         let (o8, d8) = cam.rays8(F8::new(xs), F8::new(xs.map(|x| x * 0.5)));
-        for i in 0..8 {
-            let (o, d) = cam.ray(xs[i], xs[i] * 0.5);
+        for (i, &x) in xs.iter().enumerate() {
+            let (o, d) = cam.ray(x, x * 0.5);
             assert_eq!(o8.lane(i).to_array().map(f32::to_bits), o.to_array().map(f32::to_bits), "lane {i}");
             assert_eq!(d8.lane(i), d);
         }
