@@ -161,6 +161,10 @@ impl Camera<'_> {
             let k = if centre && stratified { centre_swap(s, self.pixel_set.n()) } else { s };
             point(k)
         };
+        // The `.test` camera (pinhole, box filter) exactly as it always was: no other work.
+        if self.lens.filter.is_none() && self.lens.lens == crate::scene::build::Lens::Pinhole {
+            return (Vec3x8::splat(self.lens.eye), self.lens.dirs8(pk.x + jx, pk.y + jy));
+        }
         let (x, y) = match &self.lens.filter {
             None => (pk.x + jx, pk.y + jy),
             Some(f) => filtered(f, pk, (jx, jy), self.lens.width as f32, self.lens.height as f32),

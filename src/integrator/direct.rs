@@ -131,7 +131,10 @@ fn shade<L: LobeSet>(
     s: u32,
     out: &mut [Vec3x8],
 ) {
-    if it.light_selection != LightSelection::All {
+    if ctx.scene.emitters.is_empty() {
+        // No area light (only lights outside the selection): nothing to choose from.
+        shading_lanes(ctx.scene, hits, sc);
+    } else if it.light_selection != LightSelection::All {
         shade_one::<L>(it, ctx, hits, sc, s, out);
     } else {
         shade_all::<L>(it, ctx, hits, sc, s, out);

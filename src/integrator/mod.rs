@@ -125,6 +125,9 @@ impl Integrator {
 }
 
 #[cfg(test)]
+mod lights_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 

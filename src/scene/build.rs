@@ -117,15 +117,16 @@ impl Camera {
     #[inline]
     pub fn rays8(&self, x: F8, y: F8) -> (Vec3x8, Vec3x8) {
         let (w, h) = (self.width as f32, self.height as f32);
-        let sx = x * F8::splat(2.0 / w) - F8::ONE;
-        let sy = y * F8::splat(2.0 / h) - F8::ONE;
+        let s = || (x * F8::splat(2.0 / w) - F8::ONE, y * F8::splat(2.0 / h) - F8::ONE);
         match self.lens {
             Lens::Pinhole => (Vec3x8::splat(self.eye), self.dirs8(x, y)),
             Lens::Perspective { origin, base, ax, ay, near } => {
+                let (sx, sy) = s();
                 let d = Vec3x8::splat(ay).mul_add(sy, Vec3x8::splat(ax).mul_add(sx, Vec3x8::splat(base)));
                 (d.mul_add(F8::splat(near), Vec3x8::splat(origin)), d.normalize_or_zero())
             }
             Lens::Orthographic { centre, dir, ax, ay } => {
+                let (sx, sy) = s();
                 let o = Vec3x8::splat(ay).mul_add(sy, Vec3x8::splat(ax).mul_add(sx, Vec3x8::splat(centre)));
                 (o, Vec3x8::splat(dir))
             }
@@ -616,8 +617,8 @@ mod tests {
         let xs = [0.0, 0.5, 199.99, 100.0, 10.25, 7.0, 150.5, 33.3];
         let ys = [0.0, 99.99, 0.5, 50.0, 13.75, 40.0, 99.0, 3.5];
         let (o8, d8) = cam.rays8(F8::new(xs), F8::new(ys));
-        for i in 0..8 {
-            let (o, d) = cam.ray(xs[i], ys[i]);
+        for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+            let (o, d) = cam.ray(x, y);
             assert_eq!(o8.lane(i).to_array().map(f32::to_bits), o.to_array().map(f32::to_bits), "lane {i}");
             assert_eq!(d8.lane(i).to_array().map(f32::to_bits), d.to_array().map(f32::to_bits), "lane {i}");
         }

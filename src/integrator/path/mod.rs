@@ -218,7 +218,7 @@ fn path_tile<L: LobeSet>(
                 let le = sky::escaped(it, sky, v, paths.get(PDF, ci), missed);
                 add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
             }
-            if let Some(env) = scene.envmap.as_ref().filter(|_| missed.any()) {
+            if let Some(env) = scene.envmap.as_ref().filter(|_| has_env && missed.any()) {
                 let le = sky::escaped_envmap(it, env, v, r.ray.dir(), paths.get(PDF, ci), missed);
                 add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
             }
@@ -371,14 +371,7 @@ impl Bounce<'_> {
             self.sky_next_event::<L>(vx, &frame, wo, &mat, o, shade, leaves);
         }
         if delta_here {
-            let shadow = &mut *self.shadow;
-            let push = |lit: Mask8, wi: Vec3x8, tfar: F8, c: Vec3x8| {
-                let pack = Pack::of(lit);
-                let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, tfar, c.x, c.y, c.z];
-                shadow.write(S_SLOT, &pack, &row);
-                shadow.advance(&pack);
-            };
-            sky::delta_next_events::<L>(it, scene, sh.p, &frame, wo, &mat, beta, shade, leaves, push);
+            self.delta_next_events::<L>(vx, &frame, wo, &mat, o, shade);
         }
         if nee_here && n_lights > 0 {
             let u_choice = if own_choice {
@@ -513,6 +506,31 @@ impl Bounce<'_> {
 }
 
 impl Bounce<'_> {
+    /// The delta lights' next events at the shaded lanes `shade` of `vx`
+    /// ([`sky::delta_next_events`]), pushed as shadow rays from `o` (kept out of line: scenes
+    /// without delta lights never run it).
+    #[inline(never)]
+    fn delta_next_events<L: LobeSet>(
+        &mut self,
+        vx: &Vertex,
+        frame: &Frame8,
+        wo: Vec3x8,
+        mat: &crate::bsdf::Material8,
+        o: Vec3x8,
+        shade: Mask8,
+    ) {
+        let sh = vx.sh;
+        let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+        let shadow = &mut *self.shadow;
+        let push = |lit: Mask8, wi: Vec3x8, tfar: F8, c: Vec3x8| {
+            let pack = Pack::of(lit);
+            let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, tfar, c.x, c.y, c.z];
+            shadow.write(S_SLOT, &pack, &row);
+            shadow.advance(&pack);
+        };
+        sky::delta_next_events::<L>(self.it, self.scene, sh.p, frame, wo, mat, vx.beta, shade, leaves, push);
+    }
+
     /// The sky's next event at the shaded lanes `shade` of `vx` ([`sky::next_event`]), pushed as
     /// a shadow ray to infinity from `o`.
     #[allow(clippy::too_many_arguments)]
