@@ -30,13 +30,7 @@ pub fn parse_obj(path: &Path, bytes: &[u8], flip_tex_coords: bool, limits: &Limi
     if let Some((line, msg)) = crate::scene::obj::locate_obj_error(&text) {
         return Err(bad(Location::Line(line), msg));
     }
-    let opts = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
+    let opts = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
     let loaded = std::panic::catch_unwind(|| {
         tobj::load_obj_buf(&mut text.as_bytes(), &opts, |_| Err(tobj::LoadError::OpenFileFailed))
     });
@@ -100,6 +94,14 @@ mod tests {
         assert!(m.normals.is_empty() && m.uvs.len() == 4);
         let m = load("tests/obj/cbox_smallbox.obj");
         assert_eq!(m.indices.len(), 12);
+        let m = load("common/meshes/cbox/luminaire.obj");
+        assert_eq!(m.indices.len(), 2);
+        assert!((m.area() - 130.0 * 105.0).abs() < 0.05, "{}", m.area());
+        for (f, tris) in [("largebox", 12), ("smallbox", 12), ("floor", 2), ("ceiling", 4), ("back", 2)] {
+            let m = load(&format!("common/meshes/cbox/{f}.obj"));
+            m.validate().unwrap();
+            assert_eq!(m.indices.len(), tris, "{f}");
+        }
         for f in ["common/meshes/sphere.obj", "common/meshes/rectangle.obj"] {
             let m = load(f);
             m.validate().unwrap();
