@@ -210,8 +210,8 @@ pub struct SceneDesc {
     pub triangle_normals: Vec<[Vec3; 3]>,
     /// per-corner texture coordinates of `triangles[i]` at index i, in the corner order of its `v`
     /// (Mitsuba meshes' uvs, `scene::mesh`); the table may be shorter than `triangles` and is empty
-    /// when no triangle has uvs: a missing entry means none (uv (0, 0) at every point, as Mitsuba
-    /// gives a mesh without uvs)
+    /// when no triangle has uvs: a missing entry means none (Mitsuba then takes the hit's
+    /// barycentrics (b1, b2), Embree's (u, v), as the uv)
     pub triangle_uvs: Vec<[Vec2; 3]>,
     /// named per-vertex or per-face attributes over runs of `triangles` (Mitsuba's
     /// `vertex_color`, `face_weight`, ...; read by the `mesh_attribute` texture); empty: none

@@ -204,9 +204,9 @@ impl Mesh {
     }
 
     /// Maps the mesh by `m`: positions as points (divided by w when `m` is projective), normals
-    /// by the inverse transpose of the linear part, renormalized (a normal that degenerates
-    /// becomes the triangle-independent zero vector only if `m` is singular). A mirroring `m`
-    /// (negative determinant) also reverses each triangle's winding.
+    /// by the inverse transpose of the linear part, renormalized (zero, read as "no normal", when
+    /// `m` is singular). A mirroring `m` (negative determinant) also reverses each triangle's
+    /// winding.
     pub fn transform(&mut self, m: &Mat4) {
         for p in &mut self.positions {
             *p = m.project_point3(*p);

@@ -94,6 +94,14 @@ mod tests {
         assert!(m.normals.is_empty() && m.uvs.len() == 4);
         let m = load("tests/obj/cbox_smallbox.obj");
         assert_eq!(m.indices.len(), 12);
+        let m = load("common/meshes/cbox/luminaire.obj");
+        assert_eq!(m.indices.len(), 2);
+        assert!((m.area() - 130.0 * 105.0).abs() < 0.05, "{}", m.area());
+        for (f, tris) in [("largebox", 12), ("smallbox", 12), ("floor", 2), ("ceiling", 4), ("back", 2)] {
+            let m = load(&format!("common/meshes/cbox/{f}.obj"));
+            m.validate().unwrap();
+            assert_eq!(m.indices.len(), tris, "{f}");
+        }
         for f in ["common/meshes/sphere.obj", "common/meshes/rectangle.obj"] {
             let m = load(f);
             m.validate().unwrap();

@@ -67,6 +67,8 @@ fn corpus_sphere_attributes() {
 
 #[test]
 fn common_meshes_load() {
+    let m = load("common/meshes/bunny.ply");
+    assert_eq!((m.positions.len(), m.indices.len()), (35947, 69451));
     for f in ["common/meshes/bunny_lowres.ply", "common/meshes/sphere.ply", "common/meshes/teapot.ply"] {
         let m = load(f);
         assert!(!m.indices.is_empty(), "{f}");
