@@ -120,7 +120,8 @@ impl Scene {
         out.ng = ng;
         out.smooth = smooth;
         out.wo = -dir;
-        out.kd = m.kd;
+        out.kd =
+            if self.material_texture.is_empty() { m.kd } else { self.textured_kd(bits, geom, prim, hits, p, m.kd) };
         out.ks = m.ks;
         out.shininess = m.shininess;
         out.roughness = m.roughness;
@@ -341,7 +342,7 @@ impl Lanes3 {
 
 /// The lane indices of the set bits of `bits` (a `move_mask`), in increasing order.
 #[inline]
-fn lanes_of(mut bits: u32) -> impl Iterator<Item = usize> {
+pub(super) fn lanes_of(mut bits: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (bits != 0).then(|| {
             let i = bits.trailing_zeros() as usize;

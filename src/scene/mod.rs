@@ -7,3 +7,4 @@ pub mod limits;
 pub mod mesh;
 pub mod obj;
 pub mod parse;
+pub mod texturing;

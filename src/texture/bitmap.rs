@@ -112,7 +112,8 @@ impl Default for BitmapLimits {
 }
 
 /// An RGB f32 image with its lookup settings (see the module documentation for the conventions).
-#[derive(Debug, Clone, PartialEq)]
+/// Its `Debug` shows the size and settings, not the texels.
+#[derive(Clone, PartialEq)]
 pub struct Bitmap {
     width: u32,
     height: u32,
@@ -120,6 +121,17 @@ pub struct Bitmap {
     texels: Vec<[f32; 3]>,
     filter: FilterType,
     wrap: WrapMode,
+}
+
+impl std::fmt::Debug for Bitmap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bitmap")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("filter", &self.filter)
+            .field("wrap", &self.wrap)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The sRGB transfer function inverted: an encoded value in [0, 1] to linear.

@@ -68,6 +68,24 @@ macro_rules! textures {
     };
 }
 
+impl Texture {
+    /// Feeds everything the texture renders, as 32-bit words, to `word` (for a scene's content
+    /// hash): a bitmap's size, settings and texel bits; the other plugins' fields through `Debug`
+    /// (f32 `Debug` round-trips, so distinct values print differently).
+    pub fn digest(&self, word: &mut dyn FnMut(u32)) {
+        match self {
+            Texture::BitmapTexture(t) => {
+                let b = &t.bitmap;
+                word(0x6269_7400);
+                [b.width(), b.height(), b.filter() as u32, b.wrap() as u32].into_iter().for_each(&mut *word);
+                b.texels().iter().flatten().for_each(|x| word(x.to_bits()));
+                format!("{:?}", t.to_uv).bytes().for_each(|c| word(u32::from(c)));
+            }
+            other => format!("{other:?}").bytes().for_each(|c| word(u32::from(c))),
+        }
+    }
+}
+
 textures! {
     bitmap: BitmapTexture,
     checkerboard: Checkerboard,
