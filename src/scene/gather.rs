@@ -120,8 +120,7 @@ impl Scene {
         out.ng = ng;
         out.smooth = smooth;
         out.wo = -dir;
-        out.kd =
-            if self.material_texture.is_empty() { m.kd } else { self.textured_kd(bits, geom, prim, hits, p, m.kd) };
+        out.kd = m.kd;
         out.ks = m.ks;
         out.shininess = m.shininess;
         out.roughness = m.roughness;
@@ -130,6 +129,9 @@ impl Scene {
         out.ambient = m.ambient;
         out.le = le;
         out.light = light;
+        if !self.material_texture.is_empty() {
+            self.texture_hits(bits, hits, out);
+        }
     }
 
     /// The per-lane fields of hit lanes `valid` that all hit triangle `t`, not a light's: its

@@ -5,6 +5,7 @@
 //! scene has a textured material, so a scene without textures runs none of it.
 
 use super::build::Scene;
+use super::gather::SurfaceHit8;
 use crate::accel::{Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES};
 use crate::simd::{Vec3x8, F8, U8};
 use crate::texture::{TexQuery8, NO_TRIANGLE};
@@ -44,17 +45,13 @@ impl Scene {
         self.material_texture.get(m as usize).copied().filter(|&t| t != NO_TEXTURE)
     }
 
-    /// `kd` with the hit lanes `bits` whose material has a diffuse texture set to its value there
-    /// (points `p`; one texture evaluation, 8 lanes wide, per distinct texture of the packet).
-    pub(super) fn textured_kd(
-        &self,
-        bits: u32,
-        geom: &[u32; 8],
-        prim: &[u32; 8],
-        hits: &Hits8,
-        p: Vec3x8,
-        kd: Vec3x8,
-    ) -> Vec3x8 {
+    /// Sets `out.kd` on the hit lanes `bits` whose material has a diffuse texture to its value
+    /// there (one texture evaluation, 8 lanes wide, per distinct texture of the packet). Out of
+    /// line and cold, so that the gather of an untextured scene keeps its code.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn texture_hits(&self, bits: u32, hits: &Hits8, out: &mut SurfaceHit8) {
+        let (geom, prim, p) = (hits.geom.as_array(), hits.prim.as_array(), out.p);
         let mut tex = [NO_TEXTURE; 8];
         let (mut u, mut v, mut tri) = ([0f32; 8], [0f32; 8], [NO_TRIANGLE; 8]);
         let (bu, bv) = (hits.u.as_array(), hits.v.as_array());
@@ -78,18 +75,18 @@ impl Scene {
         }
         let mut todo: u32 = (0..8).filter(|&i| tex[i] != NO_TEXTURE).map(|i| 1u32 << i).sum();
         if todo == 0 {
-            return kd;
+            return;
         }
         let q = TexQuery8 { u: F8::new(u), v: F8::new(v), tri: U8::new(tri), b1: hits.u, b2: hits.v };
-        let mut out = kd;
+        let mut kd = out.kd;
         while todo != 0 {
             let t = tex[todo.trailing_zeros() as usize];
             let lanes: [bool; 8] = std::array::from_fn(|i| tex[i] == t);
             let value = self.textures[t as usize].eval_x8(&q);
-            out = Vec3x8::select(crate::simd::mask_from_bools(lanes), value, out);
+            kd = Vec3x8::select(crate::simd::mask_from_bools(lanes), value, kd);
             todo &= !(0..8).filter(|&i| lanes[i]).map(|i| 1u32 << i).sum::<u32>();
         }
-        out
+        out.kd = kd;
     }
 }
 

@@ -4,7 +4,6 @@
 use super::*;
 use crate::accel::RayHit8;
 use crate::scene::desc::{SceneDesc, TriangleAttrDesc};
-use crate::scene::gather::SurfaceHit8;
 use crate::scene::{limits::Limits, parse::parse_str};
 use crate::simd::mask_all;
 use crate::texture::{Checkerboard, MeshAttribute, RawConstant, Texture, UvTransform};
