@@ -189,12 +189,12 @@ pub struct Backend {
     pub spheres: &'static str,
 }
 
+/// A scene's textures (mesh attributes bound) and the texture index of each scene material.
+type TexturingTables = (Vec<crate::texture::Texture>, Vec<u32>);
+
 /// The textures of `desc` (mesh attributes bound) and the texture index of each of the
 /// `n_materials` scene materials, or `None` when no material is textured.
-fn texturing_tables(
-    desc: &SceneDesc,
-    n_materials: usize,
-) -> Result<Option<(Vec<crate::texture::Texture>, Vec<u32>)>, BuildError> {
+fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<TexturingTables>, BuildError> {
     use crate::texture::{AttrRun, Texture};
     if desc.diffuse_textures.iter().all(Option::is_none) {
         return Ok(None);

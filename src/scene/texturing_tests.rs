@@ -78,8 +78,7 @@ fn textured_kd_at_real_hits() {
     // Everything but kd is as without textures.
     assert_eq!(f(sh.n.y), f(plain.n.y));
     assert_eq!(f(sh.ks.x), f(plain.ks.x));
-    for i in 0..7 {
-        let (x, z) = XZ[i];
+    for (i, &(x, z)) in XZ.iter().enumerate().take(7) {
         let (geom, prim) = (hits.geom.as_array()[i], hits.prim.as_array()[i] as usize);
         let want = if geom == GEOM_TRIANGLES && prim == 0 {
             // Triangle 0 has uvs: the checker at 2 uv (x/2 + 1/2, z/2 + 1/2) = (x + 1, z + 1).

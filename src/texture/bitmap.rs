@@ -193,6 +193,13 @@ impl Bitmap {
         Vec3::from(self.texels[y as usize * self.width as usize + x as usize])
     }
 
+    /// The mean of the texels (summed in f64).
+    pub fn mean(&self) -> Vec3 {
+        let sum = self.texels.iter().fold([0f64; 3], |a, t| [a[0] + t[0] as f64, a[1] + t[1] as f64, a[2] + t[2] as f64]);
+        let n = self.texels.len() as f64;
+        Vec3::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32)
+    }
+
     /// The filter of lookups.
     pub fn filter(&self) -> FilterType {
         self.filter
