@@ -221,6 +221,18 @@ pub struct Scene {
     /// none; empty when the scene has none (the desc's `triangle_normals` without the dropped
     /// triangles)
     pub tri_corner_normals: Vec<[Vec3; 3]>,
+    /// the scene's textures (`desc.textures`, `mesh_attribute`s bound to `desc.triangle_attrs`)
+    pub textures: Vec<crate::texture::Texture>,
+    /// per material: the index in `textures` of its diffuse texture or
+    /// [`super::texturing::NO_TEXTURE`]; empty when no material is textured (then gather reads
+    /// no texture and builds no uv)
+    pub material_texture: Vec<u32>,
+    /// per scene triangle: its corner uvs, `[ZERO; 3]` for none; empty when the scene has no
+    /// uvs or no textured material
+    pub tri_uv: Vec<[glam::Vec2; 3]>,
+    /// per scene triangle: its index in `desc.triangles` (`NO_TRIANGLE` for lights); empty when
+    /// no material is textured
+    pub tri_source: Vec<u32>,
     /// zero-area triangles (scene and emissive) dropped at build: they can be neither hit nor
     /// sampled, and an exact ray through one would get no usable normal
     pub degenerate_dropped: usize,
@@ -270,6 +282,28 @@ pub enum BuildError {
         /// what is wrong
         err: crate::light::envmap::EnvmapError,
     },
+    /// A material names a texture the scene does not have.
+    #[error("{}: material {material} names texture {texture}, but the scene has {count}", path.display())]
+    TextureIndex {
+        /// The scene file.
+        path: std::path::PathBuf,
+        /// The material index.
+        material: usize,
+        /// The texture index it names.
+        texture: u32,
+        /// How many textures the scene has.
+        count: usize,
+    },
+    /// A `mesh_attribute` texture names an attribute no mesh of the scene has.
+    #[error("{}: mesh_attribute texture reads \"{name}\", which no mesh has (they have: {have})", path.display())]
+    NoAttribute {
+        /// The scene file.
+        path: std::path::PathBuf,
+        /// The attribute's name.
+        name: String,
+        /// The names the meshes have.
+        have: String,
+    },
     /// The scene has no `camera` command (the scene file).
     #[error("{}: no camera command", .0.display())]
     NoCamera(std::path::PathBuf),
@@ -308,6 +342,51 @@ pub struct Backend {
     pub spheres: &'static str,
 }
 
+/// A scene's textures (mesh attributes bound) and the texture index of each scene material.
+type TexturingTables = (Vec<crate::texture::Texture>, Vec<u32>);
+
+/// The textures of `desc` (mesh attributes bound) and the texture index of each of the
+/// `n_materials` scene materials, or `None` when no material is textured.
+fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<TexturingTables>, BuildError> {
+    use crate::texture::{AttrRun, Texture};
+    if desc.diffuse_textures.iter().all(Option::is_none) {
+        return Ok(None);
+    }
+    let mut material_texture = vec![super::texturing::NO_TEXTURE; n_materials];
+    for (m, t) in desc.diffuse_textures.iter().enumerate() {
+        let Some(t) = *t else { continue };
+        if t as usize >= desc.textures.len() || m >= desc.materials.len() {
+            let (path, count) = (desc.source.clone(), desc.textures.len());
+            return Err(BuildError::TextureIndex { path, material: m, texture: t, count });
+        }
+        material_texture[m] = t;
+    }
+    let runs = || {
+        desc.triangle_attrs.iter().map(|a| {
+            let run = AttrRun {
+                first: a.first,
+                count: a.count,
+                dims: a.dims,
+                per_corner: a.per_corner,
+                data: a.data.as_slice().into(),
+            };
+            (a.name.clone(), run)
+        })
+    };
+    let mut textures = desc.textures.clone();
+    for t in &mut textures {
+        if let Texture::MeshAttribute(a) = t {
+            if a.bind(runs()) == 0 {
+                let mut have: Vec<&str> = desc.triangle_attrs.iter().map(|a| a.name.as_str()).collect();
+                have.dedup();
+                let (path, name) = (desc.source.clone(), a.name.clone());
+                return Err(BuildError::NoAttribute { path, name, have: have.join(", ") });
+            }
+        }
+    }
+    Ok(Some((textures, material_texture)))
+}
+
 /// A triangle without a unit normal: zero area (collinear or repeated corners) or non-finite.
 fn is_degenerate(v: &[Vec3; 3]) -> bool {
     (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero() == Vec3::ZERO
@@ -337,6 +416,8 @@ impl Scene {
         let mut tri_material = Vec::with_capacity(indices.capacity());
         let mut tri_light = Vec::with_capacity(indices.capacity());
         let mut tri_corner_normals = Vec::new();
+        let texturing = texturing_tables(&desc, materials.len() + 1)?;
+        let (mut tri_uv, mut tri_source) = (Vec::new(), Vec::new());
         let (mut degenerate_dropped, mut overflow_dropped) = (0, 0);
         for (k, t) in desc.triangles.iter().enumerate() {
             if is_degenerate(&t.v) {
@@ -348,6 +429,13 @@ impl Scene {
                 let none = [Vec3::ZERO; 3];
                 tri_corner_normals.resize(indices.len(), none);
                 tri_corner_normals.push(desc.triangle_normals.get(k).copied().unwrap_or(none));
+            }
+            if texturing.is_some() {
+                if !desc.triangle_uvs.is_empty() {
+                    tri_uv.resize(indices.len(), [glam::Vec2::ZERO; 3]);
+                    tri_uv.push(desc.triangle_uvs.get(k).copied().unwrap_or([glam::Vec2::ZERO; 3]));
+                }
+                tri_source.push(k as u32);
             }
             let base = vertices.len() as u32;
             vertices.extend_from_slice(&t.v);
@@ -478,6 +566,11 @@ impl Scene {
                     .map_err(|err| BuildError::Delta { file: desc.source.clone(), err })
             })
             .collect::<Result<Vec<_>, _>>()?;
+        if texturing.is_some() {
+            // Light triangles carry no texture coordinates.
+            tri_source.resize(indices.len(), crate::texture::NO_TRIANGLE);
+        }
+        let (textures, material_texture) = texturing.unwrap_or_default();
         Ok(Self {
             desc,
             camera,
@@ -490,6 +583,10 @@ impl Scene {
             tri_material,
             tri_normal,
             tri_corner_normals,
+            textures,
+            material_texture,
+            tri_uv,
+            tri_source,
             degenerate_dropped,
             overflow_dropped,
             backend,

@@ -210,12 +210,20 @@ pub struct SceneDesc {
     pub triangle_normals: Vec<[Vec3; 3]>,
     /// per-corner texture coordinates of `triangles[i]` at index i, in the corner order of its `v`
     /// (Mitsuba meshes' uvs, `scene::mesh`); the table may be shorter than `triangles` and is empty
-    /// when no triangle has uvs: a missing entry means none (Mitsuba then takes the hit's
-    /// barycentrics (b1, b2), Embree's (u, v), as the uv)
+    /// when no triangle has uvs: a missing entry or `[Vec2::ZERO; 3]` means none (the uv is then
+    /// the hit's barycentrics `(b1, b2)`, as Mitsuba gives a mesh without uvs)
     pub triangle_uvs: Vec<[Vec2; 3]>,
     /// named per-vertex or per-face attributes over runs of `triangles` (Mitsuba's
     /// `vertex_color`, `face_weight`, ...; read by the `mesh_attribute` texture); empty: none
     pub triangle_attrs: Vec<TriangleAttrDesc>,
+    /// textures (`crate::texture`: Mitsuba's `bitmap`, `checkerboard`, ...), referenced by index
+    /// from `diffuse_textures`; empty: none
+    pub textures: Vec<crate::texture::Texture>,
+    /// per material index: the texture that gives its diffuse reflectance (kd) at hits, or None
+    /// (the table may be shorter than `materials`; empty: no textured material). The material's
+    /// own `diffuse` should still be a representative nonzero value (e.g. the texture's mean):
+    /// only hits read the texture
+    pub diffuse_textures: Vec<Option<u32>>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -369,6 +377,13 @@ impl SceneDesc {
                 .for_each(|w| h.word(w));
             a.data.iter().for_each(|x| h.word(x.to_bits()));
         }
+        // Likewise textures (Mitsuba scenes only).
+        if !self.textures.is_empty() || !self.diffuse_textures.is_empty() {
+            h.word(0x7465_7800);
+            h.word(self.textures.len() as u32);
+            self.textures.iter().for_each(|t| t.digest(&mut |w| h.word(w)));
+            self.diffuse_textures.iter().for_each(|t| h.word(t.unwrap_or(u32::MAX)));
+        }
         h.0
     }
 }
@@ -400,6 +415,8 @@ impl Default for SceneDesc {
             triangle_normals: Vec::new(),
             triangle_uvs: Vec::new(),
             triangle_attrs: Vec::new(),
+            textures: Vec::new(),
+            diffuse_textures: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
             environment: None,

@@ -129,6 +129,9 @@ impl Scene {
         out.ambient = m.ambient;
         out.le = le;
         out.light = light;
+        if !self.material_texture.is_empty() {
+            self.texture_hits(bits, hits, out);
+        }
     }
 
     /// The per-lane fields of hit lanes `valid` that all hit triangle `t`, not a light's: its
@@ -341,7 +344,7 @@ impl Lanes3 {
 
 /// The lane indices of the set bits of `bits` (a `move_mask`), in increasing order.
 #[inline]
-fn lanes_of(mut bits: u32) -> impl Iterator<Item = usize> {
+pub(super) fn lanes_of(mut bits: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (bits != 0).then(|| {
             let i = bits.trailing_zeros() as usize;

@@ -9,3 +9,4 @@ pub mod obj;
 pub mod parse;
 pub mod sensor;
 pub mod xml;
+pub mod texturing;

@@ -105,6 +105,8 @@ pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated
     let replica_spp = spp / replicas;
     let (mut mean, mut m2, mut seeds) = (Vec::<[f64; 3]>::new(), Vec::<[f64; 3]>::new(), Vec::new());
     let mut last: Option<RenderOutput> = None;
+    // The output stem's lock, taken by the first replica and held until the outputs are written.
+    let mut stem_lock = None;
     for r in 0..replicas {
         let mut o = opts.clone();
         o.spp = Some(replica_spp);
@@ -113,7 +115,10 @@ pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated
         if opts.progress {
             eprintln!("strata: reference replica {}/{replicas} ({replica_spp} spp, seed {})", r + 1, o.seed);
         }
-        let out = render_passes(&o)?;
+        let mut out = render_passes(&o, r == 0)?;
+        if r == 0 {
+            stem_lock = out.lock.take();
+        }
         if out.interrupted {
             return Err(SessionError::Replicas {
                 why: format!("interrupted in replica {} of {replicas}; nothing was written", r + 1),
@@ -145,7 +150,8 @@ pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated
             }
         });
     }
-    let out = last.expect("at least two replicas ran");
+    let mut out = last.expect("at least two replicas ran");
+    out.lock = stem_lock;
     let rf = f64::from(replicas);
     let mean_img = mean.iter().map(|m| m.map(|v| v as f32)).collect();
     let variance = m2.iter().map(|q| q.map(|v| (v / (rf - 1.0) / rf).max(0.0) as f32)).collect();

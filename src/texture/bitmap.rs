@@ -112,7 +112,8 @@ impl Default for BitmapLimits {
 }
 
 /// An RGB f32 image with its lookup settings (see the module documentation for the conventions).
-#[derive(Debug, Clone, PartialEq)]
+/// Its `Debug` shows the size and settings, not the texels.
+#[derive(Clone, PartialEq)]
 pub struct Bitmap {
     width: u32,
     height: u32,
@@ -120,6 +121,17 @@ pub struct Bitmap {
     texels: Vec<[f32; 3]>,
     filter: FilterType,
     wrap: WrapMode,
+}
+
+impl std::fmt::Debug for Bitmap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bitmap")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("filter", &self.filter)
+            .field("wrap", &self.wrap)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The sRGB transfer function inverted: an encoded value in [0, 1] to linear.
@@ -179,6 +191,13 @@ impl Bitmap {
     /// Texel `(x, y)` (column, row); panics out of range.
     pub fn texel(&self, x: u32, y: u32) -> Vec3 {
         Vec3::from(self.texels[y as usize * self.width as usize + x as usize])
+    }
+
+    /// The mean of the texels (summed in f64).
+    pub fn mean(&self) -> Vec3 {
+        let sum = self.texels.iter().fold([0f64; 3], |a, t| [a[0] + t[0] as f64, a[1] + t[1] as f64, a[2] + t[2] as f64]);
+        let n = self.texels.len() as f64;
+        Vec3::new((sum[0] / n) as f32, (sum[1] / n) as f32, (sum[2] / n) as f32)
     }
 
     /// The filter of lookups.

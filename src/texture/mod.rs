@@ -68,6 +68,72 @@ macro_rules! textures {
     };
 }
 
+impl Texture {
+    /// A representative value: a bitmap's texel mean, a checkerboard's two colours averaged, a
+    /// constant's value, a mesh attribute's mean over its bound values (times `scale`; 0 before
+    /// binding). For a textured material's own `diffuse` (lobe choice reads it).
+    pub fn mean(&self) -> Vec3 {
+        match self {
+            Texture::BitmapTexture(t) => t.bitmap.mean(),
+            Texture::Checkerboard(c) => (c.color0 + c.color1) * 0.5,
+            Texture::RawConstant(c) => c.value,
+            Texture::MeshAttribute(a) => {
+                let (mut sum, mut n) = (glam::DVec3::ZERO, 0u64);
+                for r in &a.runs {
+                    for v in r.data.chunks_exact(r.dims as usize) {
+                        sum += if r.dims == 3 {
+                            glam::DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
+                        } else {
+                            glam::DVec3::splat(v[0] as f64)
+                        };
+                        n += 1;
+                    }
+                }
+                if n == 0 {
+                    Vec3::ZERO
+                } else {
+                    (sum / n as f64).as_vec3() * a.scale
+                }
+            }
+        }
+    }
+
+    /// Feeds everything the texture renders, as 32-bit words, to `word` (for a scene's content
+    /// hash): a bitmap's size, settings and texel bits; the other plugins' fields through `Debug`
+    /// (f32 `Debug` round-trips, so distinct values print differently).
+    pub fn digest(&self, word: &mut dyn FnMut(u32)) {
+        match self {
+            Texture::BitmapTexture(t) => {
+                let b = &t.bitmap;
+                word(0x6269_7400);
+                [b.width(), b.height(), b.filter() as u32, b.wrap() as u32].into_iter().for_each(&mut *word);
+                b.texels().iter().flatten().for_each(|x| word(x.to_bits()));
+                format!("{:?}", t.to_uv).bytes().for_each(|c| word(u32::from(c)));
+            }
+            other => format!("{other:?}").bytes().for_each(|c| word(u32::from(c))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn means() {
+        let b = Bitmap::from_texels(2, 1, vec![[0.0, 1.0, 2.0], [1.0, 1.0, 0.0]], FilterType::Nearest, WrapMode::Clamp)
+            .unwrap();
+        let t = Texture::BitmapTexture(BitmapTexture { bitmap: b.into(), to_uv: UvTransform::IDENTITY });
+        assert_eq!(t.mean(), Vec3::new(0.5, 1.0, 1.0));
+        assert!((Texture::Checkerboard(Checkerboard::default()).mean() - Vec3::splat(0.3)).abs().max_element() < 1e-7);
+        assert_eq!(Texture::RawConstant(RawConstant { value: Vec3::X }).mean(), Vec3::X);
+        let mut a = MeshAttribute::new("face_w", 2.0);
+        let run = AttrRun { first: 0, count: 2, dims: 1, per_corner: false, data: vec![0.25, 0.75].into() };
+        a.bind([("face_w".to_string(), run)]);
+        assert_eq!(Texture::MeshAttribute(a).mean(), Vec3::ONE);
+    }
+}
+
 textures! {
     bitmap: BitmapTexture,
     checkerboard: Checkerboard,

@@ -1,0 +1,95 @@
+//! Textures at hits: the hit's uv (triangles: their corner uvs interpolated at Embree's
+//! barycentrics, or the barycentrics themselves when the mesh has none, as Mitsuba does; spheres
+//! and ellipsoids: Mitsuba's sphere parameterization in object space) and the textured diffuse
+//! reflectance of the lanes whose material has one. [`Scene::gather`] calls this only when the
+//! scene has a textured material, so a scene without textures runs none of it.
+
+use super::build::Scene;
+use super::gather::SurfaceHit8;
+use crate::accel::{Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES};
+use crate::simd::{Vec3x8, F8, U8};
+use crate::texture::{TexQuery8, NO_TRIANGLE};
+use glam::{Vec2, Vec3};
+
+/// The entry of `Scene::material_texture` of a material without a texture.
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// Mitsuba's uv of a point of the unit sphere (object space): `u = phi / 2pi` with `phi` the
+/// azimuth about +z in [0, 2pi) from +x, `v = theta / pi` with `theta` the angle from +z.
+pub fn sphere_uv(p: Vec3) -> Vec2 {
+    let p = p.normalize_or_zero();
+    let mut phi = p.y.atan2(p.x);
+    if phi < 0.0 {
+        phi += std::f32::consts::TAU;
+    }
+    let theta = p.z.clamp(-1.0, 1.0).acos();
+    Vec2::new(phi * (0.5 * std::f32::consts::FRAC_1_PI), theta * std::f32::consts::FRAC_1_PI)
+}
+
+/// The uv at barycentrics `(b1, b2)` of a triangle with corner uvs `c` (`None`: the barycentrics).
+#[inline]
+pub fn triangle_uv(c: Option<&[Vec2; 3]>, b1: f32, b2: f32) -> Vec2 {
+    match c {
+        Some(c) => {
+            let b0 = (1.0 - b1) - b2;
+            (c[0] * b0 + c[1] * b1) + c[2] * b2
+        }
+        None => Vec2::new(b1, b2),
+    }
+}
+
+impl Scene {
+    /// The texture of material `m`, if any.
+    #[inline]
+    fn texture_of(&self, m: u32) -> Option<u32> {
+        self.material_texture.get(m as usize).copied().filter(|&t| t != NO_TEXTURE)
+    }
+
+    /// Sets `out.kd` on the hit lanes `bits` whose material has a diffuse texture to its value
+    /// there (one texture evaluation, 8 lanes wide, per distinct texture of the packet). Out of
+    /// line and cold, so that the gather of an untextured scene keeps its code.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn texture_hits(&self, bits: u32, hits: &Hits8, out: &mut SurfaceHit8) {
+        let (geom, prim, p) = (hits.geom.as_array(), hits.prim.as_array(), out.p);
+        let mut tex = [NO_TEXTURE; 8];
+        let (mut u, mut v, mut tri) = ([0f32; 8], [0f32; 8], [NO_TRIANGLE; 8]);
+        let (bu, bv) = (hits.u.as_array(), hits.v.as_array());
+        for i in super::gather::lanes_of(bits) {
+            let k = prim[i] as usize;
+            let (m, uv, t) = match geom[i] {
+                GEOM_TRIANGLES => {
+                    let uv = triangle_uv(self.tri_uv.get(k).filter(|c| **c != [Vec2::ZERO; 3]), bu[i], bv[i]);
+                    (self.tri_material[k], uv, self.tri_source.get(k).copied().unwrap_or(NO_TRIANGLE))
+                }
+                GEOM_SPHERES | GEOM_ELLIPSOIDS => {
+                    let table = if geom[i] == GEOM_SPHERES { &self.sphere_point_index } else { &self.ellipsoid_index };
+                    let e = table[k] as usize;
+                    let obj = self.ell_world_to_object[e].transform_point3(p.lane(i));
+                    (self.ell_material[e], sphere_uv(obj), NO_TRIANGLE)
+                }
+                _ => continue,
+            };
+            let Some(t_idx) = self.texture_of(m) else { continue };
+            (tex[i], u[i], v[i], tri[i]) = (t_idx, uv.x, uv.y, t);
+        }
+        let mut todo: u32 = (0..8).filter(|&i| tex[i] != NO_TEXTURE).map(|i| 1u32 << i).sum();
+        if todo == 0 {
+            return;
+        }
+        let q = TexQuery8 { u: F8::new(u), v: F8::new(v), tri: U8::new(tri), b1: hits.u, b2: hits.v };
+        let mut kd = out.kd;
+        while todo != 0 {
+            let t = tex[todo.trailing_zeros() as usize];
+            let lanes: [bool; 8] = std::array::from_fn(|i| tex[i] == t);
+            let value = self.textures[t as usize].eval_x8(&q);
+            kd = Vec3x8::select(crate::simd::mask_from_bools(lanes), value, kd);
+            todo &= !(0..8).filter(|&i| lanes[i]).map(|i| 1u32 << i).sum::<u32>();
+        }
+        out.kd = kd;
+    }
+}
+
+#[cfg(test)]
+#[path = "texturing_tests.rs"]
+mod tests;
