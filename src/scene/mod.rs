@@ -8,5 +8,5 @@ pub mod mesh;
 pub mod obj;
 pub mod parse;
 pub mod sensor;
-pub mod xml;
 pub mod texturing;
+pub mod xml;

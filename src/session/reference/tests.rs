@@ -75,8 +75,9 @@ fn replica_layer_matches_seed_to_seed_mse() {
 #[test]
 fn iid_layer_fails_the_same_check() {
     for sampler in ["stratified", "sobol"] {
-        let films: Vec<Film> =
-            (11..17).map(|seed| render_passes(&opts("three_lights.test", sampler, seed, 128), false).unwrap().film).collect();
+        let films: Vec<Film> = (11..17)
+            .map(|seed| render_passes(&opts("three_lights.test", sampler, seed, 128), false).unwrap().film)
+            .collect();
         let layer = films.iter().map(|f| mean_of(&f.variance_of_mean())).sum::<f64>() / films.len() as f64;
         let ratio = layer / pairwise_half_mse(&films.iter().map(Film::mean).collect::<Vec<_>>());
         eprintln!("{sampler}: i.i.d. layer / seed-to-seed MSE/2 = {ratio:.3}");
