@@ -2,7 +2,7 @@
 //! (`../shared/corpora/mitsuba-tests`, see its SOURCES.md) rendered at Mitsuba's budget (spp =
 //! 2,000,000 / pixels) and tested by [`crate::report::ztest`] against Mitsuba's reference and
 //! variance images. [`CORPUS`] lists every scene with what is expected of it: a pass, or a refusal
-//! naming the missing feature. `tests/mitsuba_corpus.rs` asserts it; `examples/mitsuba_ztest.rs`
+//! naming the missing feature. `tests/it/mitsuba_corpus.rs` asserts it; `examples/mitsuba_ztest.rs`
 //! prints the table.
 
 use super::LabError;
@@ -26,22 +26,21 @@ pub enum Expect {
 }
 
 const BSDFS: Expect = Expect::Refused("issue 30");
-const TEXTURED: Expect = Expect::Refused("textures");
 
 /// Every scene of the corpus (relative to `tests/scenes/`) and what is expected of it.
 pub const CORPUS: &[(&str, Expect)] = &[
-    ("bsdf_spheres/test_arealight_path.xml", TEXTURED),
+    ("bsdf_spheres/test_arealight_path.xml", BSDFS),
     ("bsdf_spheres/test_bumpmap_path.xml", BSDFS),
-    ("bsdf_spheres/test_constant_path.xml", TEXTURED),
-    ("bsdf_spheres/test_envmap_path.xml", TEXTURED),
+    ("bsdf_spheres/test_constant_path.xml", BSDFS),
+    ("bsdf_spheres/test_envmap_path.xml", BSDFS),
     ("bsdf_spheres/test_normalmap_identity_roughconductor_path.xml", BSDFS),
     ("bsdf_spheres/test_normalmap_path.xml", BSDFS),
     ("bsdf_spheres/test_normalmap_roughconductor_path.xml", BSDFS),
-    ("bsdf_spheres/test_pointlight_path.xml", TEXTURED),
+    ("bsdf_spheres/test_pointlight_path.xml", BSDFS),
     ("bsdf_spheres/test_roughdielectric_path.xml", BSDFS),
     ("bsdf_spheres/test_roughplastic_linear_path.xml", BSDFS),
     ("bsdf_spheres/test_roughplastic_nonlinear_path.xml", BSDFS),
-    ("bsdf_spheres/test_textured_diffuse_path.xml", TEXTURED),
+    ("bsdf_spheres/test_textured_diffuse_path.xml", Expect::Pass),
     ("bsdf_spheres/test_textured_roughconductor_path.xml", BSDFS),
     ("bsdf_spheres/test_texturedprincipled1_path.xml", BSDFS),
     ("bsdf_spheres/test_texturedprincipled2_path.xml", BSDFS),
@@ -49,10 +48,10 @@ pub const CORPUS: &[(&str, Expect)] = &[
     ("floating_sphere/test_directional_direct.xml", Expect::Pass),
     ("infinite_mirrors/scene_path.xml", BSDFS),
     ("instancing/test_instancing_path.xml", Expect::Pass),
-    ("mesh_attributes/test_mesh_attributes_1_face_direct.xml", TEXTURED),
-    ("mesh_attributes/test_mesh_attributes_3_face_direct.xml", TEXTURED),
-    ("mesh_attributes/test_mesh_attributes_3_vertex_direct.xml", TEXTURED),
-    ("orthographic_sensor/test_orthographic_path.xml", TEXTURED),
+    ("mesh_attributes/test_mesh_attributes_1_face_direct.xml", BSDFS),
+    ("mesh_attributes/test_mesh_attributes_3_face_direct.xml", Expect::Pass),
+    ("mesh_attributes/test_mesh_attributes_3_vertex_direct.xml", Expect::Pass),
+    ("orthographic_sensor/test_orthographic_path.xml", Expect::Pass),
     ("projector/test_projector_constant_direct.xml", Expect::Pass),
     ("projector/test_projector_textured_direct.xml", Expect::Pass),
     (
@@ -61,9 +60,12 @@ pub const CORPUS: &[(&str, Expect)] = &[
             "about 90 % of pixel channels accepted: the spot's textured cone differs at texel scale (not found yet)",
         ),
     ),
-    ("texture_interp/test_texture_interp_direct.xml", TEXTURED),
+    ("texture_interp/test_texture_interp_direct.xml", Expect::Pass),
     ("various_emitters/test_various_emitters_ptracer.xml", Expect::Refused("particle tracer")),
-    ("various_shapes/test_various_shapes_path.xml", TEXTURED),
+    (
+        "various_shapes/test_various_shapes_path.xml",
+        Expect::Fails("98.3 % of pixel channels accepted at 8 spp: a difference not found yet (suspects: the back faces of mirrored shapes, which strata's diffuse shades and Mitsuba's does not; the sdfgrid mesh)"),
+    ),
 ];
 
 /// The corpus folder: `STRATA_MITSUBA_TESTS`, else `../shared/corpora/mitsuba-tests` beside the

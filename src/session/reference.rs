@@ -78,6 +78,12 @@ impl Replicated {
 /// [`replica_seed`]) and combines them. Refuses what a replicated reference cannot do: an spp that
 /// is not a multiple of the replicas, `--samples`, `--time-budget`, checkpoints.
 pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated, SessionError> {
+    replicas_with_lock(opts, replicas, false)
+}
+
+/// [`render_replicas`]; with `lock`, the output stem's lock is taken by the first replica and
+/// held (in the returned output) until the outputs are written.
+fn replicas_with_lock(opts: &RenderOptions, replicas: u32, lock: bool) -> Result<Replicated, SessionError> {
     let spp = opts.spp.ok_or(SessionError::Replicas { why: "it needs --spp".into() })?;
     if replicas < 2 {
         return Err(SessionError::Replicas {
@@ -115,7 +121,7 @@ pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated
         if opts.progress {
             eprintln!("strata: reference replica {}/{replicas} ({replica_spp} spp, seed {})", r + 1, o.seed);
         }
-        let mut out = render_passes(&o, r == 0)?;
+        let mut out = render_passes(&o, lock && r == 0)?;
         if r == 0 {
             stem_lock = out.lock.take();
         }
@@ -189,7 +195,7 @@ pub fn replicated_metadata(rep: &Replicated, base_seed: u64) -> Metadata {
 /// and the replicas' variance of it as the variance layer) and OUT.png, the `--stats` JSON (with
 /// `replicas`, `replica_spp` and `variance_estimate`) and the `--profile` JSON.
 pub fn run_reference(opts: &RenderOptions, replicas: u32) -> Result<Replicated, SessionError> {
-    let mut rep = render_replicas(opts, replicas)?;
+    let mut rep = replicas_with_lock(opts, replicas, true)?;
     let encode_start = std::time::Instant::now();
     let stem = output_stem(opts, &rep.out.scene.desc);
     let (w, h) = (rep.out.film.width, rep.out.film.height);

@@ -13,9 +13,14 @@ const KNOWN: &[&[&str]] = &[
     // Left for the session after issue 34's (other branches were rewriting these folders then).
     &["bsdf/lobe.rs", "bsdf/material.rs"],
     &["light/tree.rs", "light/wide.rs"],
-    &["scene/build.rs", "scene/gather.rs"],
+    &["scene/build.rs", "scene/gather.rs", "scene/texturing.rs"],
     &["scene/obj/mtl.rs", "scene/obj/read.rs"],
     &["session/options.rs", "session/scene.rs"],
+    // Came with issue 29's XML front end and issue 31's replicated references, written in
+    // parallel with issue 34's clean-up: left for the next session.
+    &["scene/xml/doc.rs", "scene/xml/upgrade.rs"],
+    &["scene/xml/plugins/mod.rs", "scene/xml/shape.rs"],
+    &["session/output.rs", "session/reference.rs"],
 ];
 
 /// Every `.rs` file under `dir`, relative to `root`, with `/` separators.

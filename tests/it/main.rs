@@ -18,6 +18,7 @@ mod golden;
 mod kernels;
 mod layering;
 mod light_selection;
+mod mitsuba_corpus;
 mod normals;
 mod obj;
 mod obj_wild;

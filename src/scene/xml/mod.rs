@@ -64,7 +64,7 @@ pub fn load(path: &Path, limits: &Limits, defines: &[(String, String)]) -> Resul
                 b.bsdf(e)?;
             }
             "texture" => {
-                plugins::lookup(e)?;
+                b.texture(e)?;
             }
             "medium" | "phase" | "volume" => {
                 return Err(e.at.err(format!("<{}> (participating media) is not supported", e.tag)))

@@ -144,10 +144,11 @@ pub fn spectrum_to_srgb(ws: &[f32], vs: &[f32], in_emitter: bool) -> Vec3 {
     }
 }
 
-/// Mitsuba's default emitter radiance in its RGB variants: a uniform spectrum of 1, made
-/// `xyz_to_srgb(1, 1, 1)`.
+/// Mitsuba's default emitter radiance in its RGB variants: a uniform spectrum of 1, which is
+/// RGB (1, 1, 1) there (`mi.load_dict({'type': 'constant'})` in `scalar_rgb`; the
+/// orthographic_sensor reference's background is 1.000 in every channel).
 pub fn spectrum_default_emitter() -> Vec3 {
-    xyz_to_srgb(Vec3::ONE)
+    Vec3::ONE
 }
 
 /// An index of refraction: a number, or one of Mitsuba's names (`bk7`, `water`, `diamond`, ...).

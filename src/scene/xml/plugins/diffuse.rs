@@ -20,11 +20,19 @@ pub fn lambert(r: Vec3) -> Material {
     Material { diffuse: r, ambient: Vec3::ZERO, ..Material::default() }
 }
 
-fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
     match p.color("reflectance", false)? {
         Some(Color::Rgb(c)) => Ok(lambert(c)),
-        Some(Color::Texture(t)) => Err(t.at.err("a textured reflectance needs the `textures` work of issue 29")),
+        Some(Color::Texture(t)) => {
+            // The texture gives the reflectance per hit (`Scene::gather`); the material keeps a
+            // representative value (its mean, or 0.5 where that is not known before the scene is
+            // built, as for a mesh attribute): what reads the material rather than the hit.
+            let i = b.texture(t)?;
+            let mean = b.desc.textures[i as usize].mean();
+            b.pending_texture = Some(i);
+            Ok(lambert(if mean.max_element() > 0.0 { mean } else { Vec3::splat(0.5) }))
+        }
         None => Ok(default_material()),
     }
 }

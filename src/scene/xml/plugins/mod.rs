@@ -30,6 +30,10 @@ mod serialized;
 mod shapegroup;
 mod sphere;
 mod spot;
+mod tex_bitmap;
+mod tex_checkerboard;
+mod tex_mesh_attribute;
+mod tex_rawconstant;
 mod twosided;
 
 use super::doc::{Elem, Loc};
@@ -51,6 +55,8 @@ pub enum Run {
     Bsdf(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Material, SceneError>),
     /// a shape's geometry (placed by the caller with its material and emitter)
     Shape(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<ShapeOut, SceneError>),
+    /// a texture (of a material's reflectance)
+    Texture(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<crate::texture::Texture, SceneError>),
     /// an area emitter's radiance
     Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Vec3, SceneError>),
     /// known to Mitsuba, not rendered yet: the missing feature
@@ -71,7 +77,6 @@ const fn refused(tag: &'static str, kind: &'static str, why: &'static str) -> Pl
     Plugin { tag, kind, run: Run::Refused(why) }
 }
 
-const TEXTURES: &str = "needs textured materials at hits (the `textures` work of issue 29)";
 const BSDFS: &str = "needs the BSDFs of issue 30";
 
 /// Every plugin the XML front end knows, one line each.
@@ -124,10 +129,10 @@ pub const PLUGINS: &[Plugin] = &[
     refused("bsdf", "bumpmap", BSDFS),
     refused("bsdf", "normalmap", BSDFS),
     refused("bsdf", "null", BSDFS),
-    refused("texture", "bitmap", TEXTURES),
-    refused("texture", "checkerboard", TEXTURES),
-    refused("texture", "mesh_attribute", TEXTURES),
-    refused("texture", "rawconstant", TEXTURES),
+    tex_bitmap::PLUGIN,
+    tex_checkerboard::PLUGIN,
+    tex_mesh_attribute::PLUGIN,
+    tex_rawconstant::PLUGIN,
 ];
 
 /// The registry entry of `e` (by tag and type), or a file:line error naming the supported types.
@@ -162,8 +167,12 @@ pub struct Build<'e> {
     pub limits: &'e Limits,
     /// `<path>` directories and the scene's, for file names
     pub search: Vec<PathBuf>,
-    /// interned materials (by their Debug text: every field)
+    /// interned materials (by their Debug text: every field, and the texture index)
     materials: HashMap<String, u32>,
+    /// textures already built, by the address of their element (a `<ref>`ed texture is one entry)
+    textures: HashMap<usize, u32>,
+    /// the reflectance texture of the material the last BSDF plugin made, if textured
+    pub pending_texture: Option<u32>,
 }
 
 impl<'e> Build<'e> {
@@ -176,7 +185,16 @@ impl<'e> Build<'e> {
             integrator: crate::scene::desc::IntegratorKind::PathTracer,
             ..SceneDesc::default()
         };
-        Self { desc, warnings: Vec::new(), ids, limits, search, materials: HashMap::new() }
+        Self {
+            desc,
+            warnings: Vec::new(),
+            ids,
+            limits,
+            search,
+            materials: HashMap::new(),
+            textures: HashMap::new(),
+            pending_texture: None,
+        }
     }
 
     /// A file named in the scene, found as Mitsuba's resolver finds it.
@@ -193,14 +211,40 @@ impl<'e> Build<'e> {
             .unwrap_or_else(|| self.search.first().map_or_else(|| p.to_path_buf(), |d| d.join(p)))
     }
 
-    /// The index of `m` in the scene's materials (added once).
-    pub fn intern(&mut self, m: Material) -> u32 {
-        let key = format!("{m:?}");
+    /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
+    /// once; `SceneDesc::diffuse_textures` stays empty until a material is textured).
+    pub fn intern(&mut self, m: Material, texture: Option<u32>) -> u32 {
+        let key = format!("{m:?}|{texture:?}");
         let n = self.desc.materials.len() as u32;
-        *self.materials.entry(key).or_insert_with(|| {
+        let i = *self.materials.entry(key).or_insert_with(|| {
             self.desc.materials.push(m);
             n
-        })
+        });
+        if let Some(t) = texture {
+            let slots = &mut self.desc.diffuse_textures;
+            slots.resize(slots.len().max(i as usize + 1), None);
+            slots[i as usize] = Some(t);
+        }
+        i
+    }
+
+    /// The index in `SceneDesc::textures` of the `<texture>` element `e` (built once per element).
+    pub fn texture(&mut self, e: &'e Elem) -> Result<u32, SceneError> {
+        let key = e as *const Elem as usize;
+        if let Some(&i) = self.textures.get(&key) {
+            return Ok(i);
+        }
+        let p = lookup(e)?;
+        let props = Props::new(e, self.ids)?;
+        let t = match p.run {
+            Run::Texture(f) => f(self, &props)?,
+            _ => return Err(e.at.err(format!("{} is not a texture", e.what()))),
+        };
+        self.warnings.extend(props.unused());
+        let i = self.desc.textures.len() as u32;
+        self.desc.textures.push(t);
+        self.textures.insert(key, i);
+        Ok(i)
     }
 
     /// Runs the plugin of `e` for its effect on the scene (`Run::Scene`), with its unused
@@ -255,17 +299,19 @@ impl<'e> Build<'e> {
             Run::Shape(f) => f(self, &props)?,
             _ => return Err(e.at.err(format!("{} is not a shape", e.what()))),
         };
+        self.pending_texture = None;
         let material = match props.object("bsdf")? {
             Some(b) => self.bsdf(b)?,
             None => diffuse::default_material(),
         };
+        let texture = self.pending_texture.take();
         let emitter = match props.object("emitter")? {
             Some(em) => Some((self.area(em)?, em.at.clone())),
             None => None,
         };
         props.ignore("id");
         self.warnings.extend(props.unused());
-        Ok((out, self.intern(material), emitter))
+        Ok((out, self.intern(material, texture), emitter))
     }
 
     /// The file named by the plugin's `filename` string, resolved.
