@@ -19,8 +19,8 @@
 //!   (`shape_index`), [`obj::load_obj`] (Mitsuba's reading: one mesh, `flip_tex_coords`), and
 //!   [`sdfgrid::load_sdfgrid`] (a `.vol` SDF grid to triangles; see that module for how exact).
 //! - Generators with Mitsuba's parameterization ([`shapes`]): [`shapes::rectangle`],
-//!   [`shapes::disk`], [`shapes::cube`], [`shapes::cylinder`]; [`shapes::sphere_uv`] gives the uv of
-//!   a point on the analytic unit sphere (rendered as a `SphereDesc`).
+//!   [`shapes::disk`], [`shapes::cube`], [`shapes::cylinder`]. The analytic sphere is rendered as a
+//!   `SphereDesc`; its uv at hits is `scene::texturing::sphere_uv`.
 //! - Into the scene: [`SceneDesc::add_mesh`](crate::scene::desc::SceneDesc::add_mesh) (world-space
 //!   mesh, material index): triangles, per-corner shading normals, and the uv/attribute tables
 //!   (`place.rs`).

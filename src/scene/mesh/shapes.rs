@@ -14,7 +14,7 @@
 //! silhouettes match to well under a pixel at 480x480. Vertex normals are the analytic ones and
 //! uvs are exact at the vertices (linear in between: within the same 7.5e-5 for `r` and
 //! `1/(2 SEGMENTS)` for the disk's angle inside its innermost ring, radius `1/RINGS`).
-//! [`sphere_uv`] is Mitsuba's sphere parameterization for the analytic sphere (`SphereDesc`).
+//! The analytic sphere (`SphereDesc`) gets its uv at hits from `scene::texturing::sphere_uv`.
 
 use super::Mesh;
 use glam::{Mat4, Vec2, Vec3};
@@ -130,19 +130,6 @@ pub fn cylinder(radius: f32, p0: Vec3, p1: Vec3) -> Option<Mesh> {
     let frame = Mat4::from_cols(x.extend(0.0), y.extend(0.0), axis.extend(0.0), p0.extend(1.0));
     m.transform(&(frame * Mat4::from_scale(Vec3::new(radius, radius, length))));
     Some(m)
-}
-
-/// Mitsuba's uv of a point on the analytic sphere, given in the sphere's object space (any
-/// distance from its center, the origin): `(phi / 2pi, theta / pi)` with phi = atan2(y, x) in
-/// [0, 2pi) and theta the angle from +z.
-pub fn sphere_uv(p_object: Vec3) -> Vec2 {
-    let p = p_object.normalize_or(Vec3::Z);
-    let theta = p.z.clamp(-1.0, 1.0).acos();
-    let mut phi = p.y.atan2(p.x);
-    if phi < 0.0 {
-        phi += TAU;
-    }
-    Vec2::new(phi / TAU, theta / PI)
 }
 
 #[cfg(test)]

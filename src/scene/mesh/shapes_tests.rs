@@ -1,6 +1,7 @@
 //! The generators against the analytic shapes: area, normals, uv ranges and values, outline error.
 
 use super::*;
+use crate::scene::texturing::sphere_uv;
 
 fn check_common(m: &Mesh) {
     m.validate().unwrap();

@@ -109,16 +109,7 @@ impl<'a> Reader<'a> {
     /// Finds a file named in the scene: absolute, or relative to a `<path>` directory or the
     /// scene's directory (most recent first), as Mitsuba's resolver does.
     pub fn resolve(&self, name: &str) -> PathBuf {
-        let p = Path::new(name);
-        if p.is_absolute() {
-            return p.to_path_buf();
-        }
-        self.search
-            .iter()
-            .rev()
-            .map(|d| d.join(p))
-            .find(|c| c.exists())
-            .unwrap_or_else(|| self.search.first().map_or_else(|| p.to_path_buf(), |d| d.join(p)))
+        resolve_in(&self.search, name)
     }
 
     /// Parses one file into an unexpanded tree (root `<scene>`, upgraded when it is 0.6).
@@ -258,6 +249,21 @@ fn own(
     }
     let attrs = node.attributes().map(|a| (a.name().to_string(), a.value().to_string())).collect();
     Ok(Elem { tag: node.tag_name().name().to_string(), attrs, children, at })
+}
+
+/// A file named in a scene, found as Mitsuba's resolver finds it: absolute, or the first of the
+/// search directories (most recent first) that has it, else relative to the first directory.
+pub fn resolve_in(search: &[PathBuf], name: &str) -> PathBuf {
+    let p = Path::new(name);
+    if p.is_absolute() {
+        return p.to_path_buf();
+    }
+    search
+        .iter()
+        .rev()
+        .map(|d| d.join(p))
+        .find(|c| c.exists())
+        .unwrap_or_else(|| search.first().map_or_else(|| p.to_path_buf(), |d| d.join(p)))
 }
 
 #[cfg(test)]

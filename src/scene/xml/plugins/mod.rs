@@ -199,16 +199,7 @@ impl<'e> Build<'e> {
 
     /// A file named in the scene, found as Mitsuba's resolver finds it.
     pub fn resolve(&self, name: &str) -> PathBuf {
-        let p = std::path::Path::new(name);
-        if p.is_absolute() {
-            return p.to_path_buf();
-        }
-        self.search
-            .iter()
-            .rev()
-            .map(|d| d.join(p))
-            .find(|c| c.exists())
-            .unwrap_or_else(|| self.search.first().map_or_else(|| p.to_path_buf(), |d| d.join(p)))
+        super::doc::resolve_in(&self.search, name)
     }
 
     /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
