@@ -147,19 +147,27 @@ impl Camera<'_> {
         self.first_sample == FirstSample::Centre && self.pixel_set.kind() != SamplerKind::GRID_CENTER
     }
 
+    /// The point k of the pixel set that pixel sample `s` draws (the same for every packet), or
+    /// None when it draws none (sample 0 through the pixel centre).
+    #[inline]
+    pub fn pixel_k(&self, s: u32) -> Option<u32> {
+        let centre = self.centre();
+        if centre && s == 0 {
+            return None;
+        }
+        // Stratified: the sample whose stratum holds the centre takes sample 0's stratum.
+        let stratified = self.pixel_set.kind() == SamplerKind::STRATIFIED;
+        Some(if centre && stratified { centre_swap(s, self.pixel_set.n()) } else { s })
+    }
+
     /// The rays of packet `pk` for pixel sample `s` (origins and unit directions), with `point(k)`
     /// the pixel set's point k of the packet's pixels ([`Camera::point`], or a point of
     /// [`Camera::stream`]); not called for a sample that does not draw ([`Camera::draws`]).
     #[inline]
     pub fn rays_with(&self, pk: &PixelPacket, s: u32, point: impl FnOnce(u32) -> (F8, F8)) -> (Vec3x8, Vec3x8) {
-        let centre = self.centre();
-        let (jx, jy) = if centre && s == 0 {
-            (F8::splat(0.5), F8::splat(0.5))
-        } else {
-            // Stratified: the sample whose stratum holds the centre takes sample 0's stratum.
-            let stratified = self.pixel_set.kind() == SamplerKind::STRATIFIED;
-            let k = if centre && stratified { centre_swap(s, self.pixel_set.n()) } else { s };
-            point(k)
+        let (jx, jy) = match self.pixel_k(s) {
+            None => (F8::splat(0.5), F8::splat(0.5)),
+            Some(k) => point(k),
         };
         // The `.test` camera (pinhole, box filter) exactly as it always was: no other work.
         if self.lens.filter.is_none() && self.lens.lens == crate::scene::build::Lens::Pinhole {

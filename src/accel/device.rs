@@ -1,6 +1,6 @@
 //! The Embree device and its error callback, which turns Embree's errors into [`AccelError`]s, and
-//! the Embree configuration ([`EmbreeConfig`]): the instruction set is pinned so that every node
-//! traces the same hits.
+//! the Embree configuration ([`EmbreeConfig`]): the instruction set is the best one whose hits are
+//! the same on every CPU that has it (AVX-512), else AVX2.
 
 use embree4_sys as sys;
 use std::ffi::{c_char, c_void, CStr};
@@ -42,7 +42,7 @@ unsafe impl Sync for Device {}
 
 impl Device {
     /// Creates a device with the error callback installed, configured by [`EmbreeConfig::from_env`]
-    /// (the instruction set pinned to AVX2 unless `$STRATA_EMBREE_CONFIG` asks for AVX-512).
+    /// (AVX-512 on a CPU with it, else AVX2, unless `$STRATA_EMBREE_CONFIG` pins one).
     pub fn new() -> Result<Self, AccelError> {
         Self::with_config(EmbreeConfig::from_env()?)
     }
@@ -142,11 +142,23 @@ impl Drop for Device {
 /// The environment variable with extra Embree configuration (`key=value`, comma-separated).
 pub const CONFIG_VAR: &str = "STRATA_EMBREE_CONFIG";
 
-/// The instruction set Embree is pinned to by default: every x86-64-v3 node (the CPUs strata is
-/// built for) has it, and Embree's AVX2 and AVX-512 kernels report different hits (907 of 3072
-/// pixel values of `hw4/cornellBRDF` differ), so letting Embree choose per CPU would make shards
-/// rendered on different nodes disagree.
+/// The instruction set Embree runs by default on a CPU without AVX-512: every x86-64-v3 node (the
+/// CPUs strata is built for) has it. On a CPU with AVX-512 the default is `avx512` instead
+/// ([`default_isa`]): its kernels start reciprocals from `vrcp14ps`/`vrsqrt14ps`, which are
+/// exactly specified, so every AVX-512 CPU reports the same hits, while AVX2 kernels' `vrcpps`
+/// differs between CPU models (`accel/approx.rs`). The two kernels report different hits (907 of
+/// 3072 pixel values of `hw4/cornellBRDF` differ): a cluster that mixes AVX-512 and AVX2-only
+/// nodes pins `isa=avx2` on nodes of one CPU model (`docs/robustness.md`).
 pub const DEFAULT_ISA: &str = "avx2";
+
+/// The default instruction set on a CPU that has AVX-512 (`avx512`) or not ([`DEFAULT_ISA`]).
+pub fn default_isa(avx512: bool) -> &'static str {
+    if avx512 {
+        "avx512"
+    } else {
+        DEFAULT_ISA
+    }
+}
 
 /// Keys of `STRATA_EMBREE_CONFIG` that do not change which hits Embree reports (besides `isa` and
 /// `max_isa`, which enter a render's identity through [`Device::isa`]).
@@ -178,11 +190,12 @@ impl EmbreeConfig {
     /// this parser into Embree's):
     /// `isa` or `max_isa` (`avx2`, `avx512`; lower instruction sets are refused) and the keys that
     /// do not change hits (`verbose`, `threads`, ...); an unknown key is refused. The instruction
-    /// set is `avx2` unless `isa=avx512` (refused on a CPU without AVX-512, `avx512` saying whether
-    /// it has it) or `max_isa=avx512` on a CPU with it.
+    /// set is [`default_isa`] (`avx512` on a CPU with AVX-512, `avx512` saying whether it has it,
+    /// else `avx2`) unless `isa=avx2`/`max_isa=avx2` pins AVX2; `isa=avx512` is refused on a CPU
+    /// without AVX-512, `max_isa=avx512` there gives `avx2`.
     pub fn parse(raw: &str, avx512: bool) -> Result<Self, AccelError> {
         let bad = |m: String| AccelError(format!("{CONFIG_VAR}={raw:?}: {m}"));
-        let mut isa = DEFAULT_ISA;
+        let mut isa = default_isa(avx512);
         let mut isa_key: Option<&str> = None;
         let mut rest = Vec::new();
         let mut verbose = false;
@@ -259,13 +272,19 @@ mod config_tests {
     use super::EmbreeConfig;
 
     #[test]
-    fn the_instruction_set_is_pinned_to_avx2_unless_avx512_is_asked_for() {
+    fn the_instruction_set_is_avx512_where_the_cpu_has_it_unless_avx2_is_pinned() {
         let c = EmbreeConfig::parse("", true).unwrap();
+        assert_eq!((c.isa, c.config.as_str()), ("avx512", "isa=avx512,verbose=0"));
+        let c = EmbreeConfig::parse("", false).unwrap();
         assert_eq!((c.isa, c.config.as_str()), ("avx2", "isa=avx2,verbose=0"));
         assert_eq!(EmbreeConfig::parse("isa=avx512", true).unwrap().isa, "avx512");
         assert_eq!(EmbreeConfig::parse("max_isa=avx512", true).unwrap().isa, "avx512");
         assert_eq!(EmbreeConfig::parse("max_isa=avx512", false).unwrap().isa, "avx2");
+        assert_eq!(EmbreeConfig::parse("isa=avx2", true).unwrap().isa, "avx2");
+        assert_eq!(EmbreeConfig::parse("max_isa=avx2", true).unwrap().isa, "avx2");
         let c = EmbreeConfig::parse("threads=2, verbose=1", true).unwrap();
+        assert_eq!(c.config, "isa=avx512,threads=2,verbose=1");
+        let c = EmbreeConfig::parse("threads=2, verbose=1", false).unwrap();
         assert_eq!(c.config, "isa=avx2,threads=2,verbose=1");
     }
 

@@ -40,7 +40,7 @@ mod tests;
 mod user_geometry;
 
 pub use approx::approx_id;
-pub use device::{cpu_has_avx512, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
+pub use device::{cpu_has_avx512, default_isa, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
 pub use ftz::{set_ftz_daz, timestamp};
 pub use scene::{Hits8, Scene, SceneBuilder};

@@ -99,8 +99,8 @@ impl Header {
         let approx = matches!((approx_of(self), approx_of(want)), (Some(a), Some(b)) if a != b);
         let hint = if approx {
             "; this CPU's approximate reciprocals (vrcpps, used by Embree's AVX2 kernels) differ from the \
-             other's, so their pixels can differ: render every part with STRATA_EMBREE_CONFIG=isa=avx512 \
-             where all nodes have AVX-512 (exactly specified), or on one kind of CPU"
+             other's, so their pixels can differ: render every part on AVX-512 nodes without an isa pin \
+             (Embree's AVX-512 kernels are exactly specified), or with isa=avx2 on one kind of CPU"
         } else {
             ""
         };

@@ -21,6 +21,8 @@ pub struct Wave {
 /// Radiance of pixel samples `samples` of the tile's packets into `out` (sample-major, as
 /// `Estimator::tile`): emission at the camera hits plus what `shade(ctx, hits, s, radiance)`
 /// adds to `radiance` (one entry per packet, holding the emission) at the hits of sample `s`.
+/// Inlined into each integrator's `tile` (and so into `integrator::run`), with the shading closure.
+#[inline(always)]
 pub(super) fn tile(
     ctx: &mut TileCtx,
     wave: &mut Wave,
@@ -55,10 +57,11 @@ fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>
     wave.rh.resize(n, (RayHit8::default(), ctx.pks[0].active));
     wave.hits.truncate(n);
     wave.hits.resize(n, SurfaceHit8::MISS);
-    // Camera packets: coherent primary rays from 4x2 pixel blocks.
+    // Camera packets: coherent primary rays from 4x2 pixel blocks; the point's per-k work once.
+    let at = if wave.cam_streams.is_empty() { None } else { ctx.samples.camera_point_k(s) };
     for (i, (pk, (rh, active))) in ctx.pks.iter().zip(wave.rh.iter_mut()).enumerate() {
         let (org, dir) = match wave.cam_streams.get(i) {
-            Some(stream) => ctx.samples.camera_rays_in(pk, i as u32, stream, s),
+            Some(stream) => ctx.samples.camera_rays_in(pk, i as u32, stream, s, at.as_ref()),
             None => ctx.samples.camera_rays(pk, s),
         };
         *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);

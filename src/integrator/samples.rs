@@ -100,13 +100,30 @@ impl<'a> Samples<'a> {
 
     /// [`Samples::camera_rays`] of packet `i` of the packets of [`Samples::camera_streams`] (`pk`
     /// that packet, `stream` its stream): the same rays, bit for bit.
+    /// `at` is [`Samples::camera_point_k`] of `s`: the per-k work done once for every packet.
     #[inline]
-    pub fn camera_rays_in(&self, pk: &PixelPacket, i: u32, stream: &Stream<U8>, s: u32) -> (Vec3x8, Vec3x8) {
+    pub fn camera_rays_in(
+        &self,
+        pk: &PixelPacket,
+        i: u32,
+        stream: &Stream<U8>,
+        s: u32,
+        at: Option<&PointK>,
+    ) -> (Vec3x8, Vec3x8) {
         self.camera.rays_with(pk, s, |k| {
             let _p = profile::leaf(Phase::SamplerPixel);
             replay::camera_point(i, k);
-            stream.point(k)
+            match at {
+                Some(at) if at.k() == k => stream.point_k(at),
+                _ => stream.point(k),
+            }
         })
+    }
+
+    /// The per-k part of pixel sample `s`'s point in the camera streams (none when it draws
+    /// none), for [`Samples::camera_rays_in`].
+    pub fn camera_point_k(&self, s: u32) -> Option<PointK> {
+        self.camera.pixel_k(s).map(|k| self.camera.pixel_set.point_k(k))
     }
 
     /// The light-layout streams of dimension `dim` for pixel sample `s` of the packets of `pks`

@@ -9,7 +9,7 @@ use super::lanes::Lanes;
 const FMIX1: u32 = 0x85eb_ca6b;
 const FMIX2: u32 = 0xc2b2_ae35;
 /// Odd multiplier (2^32 / golden ratio) spreading a word before it is folded into the state.
-const SPREAD: u32 = 0x9e37_79b9;
+pub(super) const SPREAD: u32 = 0x9e37_79b9;
 
 /// murmur3 finalizer: xorshift-multiply twice, then xorshift.
 #[inline]

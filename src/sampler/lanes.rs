@@ -48,6 +48,20 @@ pub trait Lanes: Copy {
     fn mulhi(self, o: Self) -> Self {
         self.mul_wide(o).1
     }
+    /// Per lane all ones if `self < o` (unsigned), else 0.
+    fn lt_mask(self, o: Self) -> Self {
+        self.lt_select(o, Self::splat(u32::MAX), Self::splat(0))
+    }
+    /// Per lane all ones if the top bit is set, else 0 (an arithmetic shift right by 31).
+    fn sign_mask(self) -> Self;
+    /// Per lane `self >> s` with a per-lane count `s < 32`.
+    fn shr_var(self, s: Self) -> Self;
+    /// Per lane `table[self % 8]`: an 8-entry table look-up.
+    fn lookup8(self, table: [u32; 8]) -> Self;
+    /// Per lane both words of `table[self]` (panics if out of range).
+    fn gather2(self, table: &[[u32; 2]]) -> (Self, Self);
+    /// The largest lane.
+    fn max_lane(self) -> u32;
     /// `f`'s point for these lanes (a run-time point function inside a generic one: file padding).
     fn dyn_point<P: PointFn + ?Sized>(
         f: &P,
@@ -106,6 +120,22 @@ impl Lanes for u32 {
     }
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         f(self)
+    }
+    fn sign_mask(self) -> Self {
+        ((self as i32) >> 31) as u32
+    }
+    fn shr_var(self, s: Self) -> Self {
+        self >> s
+    }
+    fn lookup8(self, table: [u32; 8]) -> Self {
+        table[self as usize & 7]
+    }
+    fn gather2(self, table: &[[u32; 2]]) -> (Self, Self) {
+        let [x, y] = table[self as usize];
+        (x, y)
+    }
+    fn max_lane(self) -> u32 {
+        self
     }
     fn dyn_point<P: PointFn + ?Sized>(f: &P, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> (f32, f32) {
         f.point_1(pixel, sample, dim, k, seed)
@@ -166,6 +196,34 @@ impl Lanes for U8 {
     #[inline]
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         U8::new(self.to_array().map(f))
+    }
+    #[inline]
+    fn lt_mask(self, o: Self) -> Self {
+        self.simd_lt(o)
+    }
+    #[inline]
+    fn sign_mask(self) -> Self {
+        wide::bytemuck::cast::<i32x8, U8>(wide::bytemuck::cast::<U8, i32x8>(self) >> 31)
+    }
+    #[inline]
+    fn shr_var(self, s: Self) -> Self {
+        self >> s
+    }
+    #[inline]
+    fn lookup8(self, table: [u32; 8]) -> Self {
+        crate::simd::permute_lanes(U8::new(table), self)
+    }
+    #[inline]
+    fn gather2(self, table: &[[u32; 2]]) -> (Self, Self) {
+        let (mut x, mut y) = ([0u32; 8], [0u32; 8]);
+        for (l, i) in self.to_array().into_iter().enumerate() {
+            [x[l], y[l]] = table[i as usize];
+        }
+        (U8::new(x), U8::new(y))
+    }
+    #[inline]
+    fn max_lane(self) -> u32 {
+        self.to_array().into_iter().fold(0, u32::max)
     }
     #[inline]
     fn dyn_point<P: PointFn + ?Sized>(f: &P, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {

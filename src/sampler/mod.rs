@@ -405,6 +405,13 @@ pub struct PointK {
     span: Option<[u32; 4]>,
 }
 
+impl PointK {
+    /// The point index k.
+    pub fn k(&self) -> u32 {
+        self.k
+    }
+}
+
 impl Stream<U8> {
     /// [`Stream::point`] of `pk`'s k, bit for bit (`pk` from the same set's
     /// [`PointSet::point_k`]); cheaper when many streams draw the same k.

@@ -46,7 +46,7 @@ use std::sync::OnceLock;
 
 use super::hash::{combine, combine_key, fmix};
 use super::lanes::Lanes;
-use super::layout::{Layout, SetShape};
+use super::layout::{Layout, SetShape, StreamKey};
 use super::sobol::prefix_shuffle;
 use crate::simd::{F8, U8};
 
@@ -73,6 +73,22 @@ impl Layout for Pmj02 {
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
         pmj02(pixel, sample, dim, k, set.n(), seed)
     }
+
+    /// The stream's key (`prefix`) and, packed in `base`, the low 12 bits of its first index
+    /// `sample * n` and above them its base sequence (table and axis swap, 7 bits): only the
+    /// index mod 4096 matters.
+    #[inline]
+    fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
+        let (key, pick) = stream_words(pixel, dim, seed);
+        let first = sample.mul(L::splat(set.n().max(1))).and(L::splat(TABLE_POINTS - 1));
+        StreamKey { prefix: key, base: first.or(pick.shl(LOG_POINTS)), sample, dim, seed }
+    }
+
+    #[inline]
+    fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
+        let index = s.base.add(L::splat(k)).and(L::splat(TABLE_POINTS - 1));
+        table_point(s.prefix, index, s.base.shr(LOG_POINTS))
+    }
 }
 
 /// Point k of the n-point pmj02 set of stream (pixel, sample, dim) under seed: sequence point
@@ -90,21 +106,32 @@ pub fn pmj02_2d_x8(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) ->
 }
 
 fn pmj02<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
+    let (key, pick) = stream_words(pixel, dim, seed);
+    let index = sample.mul(L::splat(n.max(1))).add(k).and(L::splat(TABLE_POINTS - 1));
+    table_point(key, index, pick)
+}
+
+/// The words of stream (pixel, dim, seed): its key and its base sequence `pick` (table and axis
+/// swap) = (the pixel's offset + dim) mod 128, so dims less than 128 apart never share a base
+/// sequence within a pixel.
+#[inline]
+fn stream_words<L: Lanes>(pixel: L, dim: u32, seed: u64) -> (L, L) {
     let key = combine(L::splat(combine_key(TAG_PMJ, seed, dim)), pixel);
+    let offset = combine(L::splat(combine_key(TAG_TABLE, seed, 0)), pixel).shr(32 - LOG_TABLES - 1);
+    (key, offset.add(L::splat(dim)).and(L::splat((TABLES << 1) - 1)))
+}
+
+/// Sequence point `index` (< 4096) of base sequence `pick` under stream key `key`.
+#[inline]
+fn table_point<L: Lanes>(key: L, index: L, pick: L) -> (L::F, L::F) {
     // The index, shuffled per (pixel, dim) keeping every prefix [0, 2^m) (so prefixes stay nets):
     // without it two dims drawing the same index of tables built by the same forced construction
     // are correlated (a pixel's light choice then follows its light point).
-    let index = sample.mul(L::splat(n.max(1))).add(k).and(L::splat(TABLE_POINTS - 1));
     let index = prefix_shuffle(index, combine(key, L::splat(4))).and(L::splat(TABLE_POINTS - 1));
-    // (Table, axis swap) = (pixel's offset + dim) mod 128: dims less than 128 apart never share a
-    // base sequence within a pixel.
-    let offset = combine(L::splat(combine_key(TAG_TABLE, seed, 0)), pixel).shr(32 - LOG_TABLES - 1);
-    let pick = offset.add(L::splat(dim)).and(L::splat((TABLES << 1) - 1));
     // Table from the high bits, axis swap from the lowest bit (as an all-ones/all-zeros mask).
     let slot = pick.shr(1).shl(LOG_POINTS).or(index);
     let swap = pick.and(L::splat(1)).mul(L::splat(u32::MAX));
-    let table = tables();
-    let (x, y) = (slot.map(|s| table[s as usize][0]), slot.map(|s| table[s as usize][1]));
+    let (x, y) = slot.gather2(tables());
     let d = x.xor(y).and(swap);
     let (x, y) = (x.xor(d), y.xor(d));
     let (sx, sy) = (combine(key, L::splat(2)).shr(8), combine(key, L::splat(3)).shr(8));

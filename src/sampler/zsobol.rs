@@ -61,6 +61,26 @@ const PERMS: [u32; 96] = {
     t
 };
 
+/// [`PERMS`] packed for [`perm4`]: permutation p is byte `p % 4` of word `p / 4`, digit d's image
+/// in bits 2d..2d+1 of that byte (words 6 and 7 unused).
+const PACKED: [u32; 8] = {
+    let mut t = [0u32; 8];
+    let mut i = 0;
+    while i < 96 {
+        let (p, d) = (i / 4, i % 4);
+        t[p / 4] |= PERMS[i] << (8 * (p % 4) + 2 * d);
+        i += 1;
+    }
+    t
+};
+
+/// `PERMS[4 p + d]` per lane (p < 24, d < 4) without a per-lane memory look-up: one 8-entry lane
+/// look-up of [`PACKED`] and a per-lane shift.
+#[inline]
+fn perm4<L: Lanes>(p: L, d: L) -> L {
+    p.shr(2).lookup8(PACKED).shr_var(p.and(L::splat(3)).shl(3).or(d.shl(1))).and(L::splat(3))
+}
+
 /// log2 of the per-pixel index block: ceil(log2 n), n >= 1.
 fn block_bits(set: &SetShape) -> u32 {
     32 - (set.n() - 1).leading_zeros()
@@ -91,17 +111,27 @@ fn block_start<L: Lanes>(set: &SetShape, pixel: L, dim: u32, seed: u64) -> L {
     };
     // Only the digits that survive the shift by b matter.
     let levels = (33 - b) / 2;
-    let key = L::splat(combine_key(TAG_ZSOBOL, seed, dim));
-    let mut out = L::splat(0);
+    let key_1 = combine_key(TAG_ZSOBOL, seed, dim);
+    let key = L::splat(key_1);
+    // Levels at and above the highest digit of every lane's m have digit 0 and no digit above:
+    // their prefix, permutation and output digit are the same for every lane (computed once, in
+    // scalar code; in an image the top levels are all such).
+    let top = m.max_lane();
+    let (mut uniform, mut out) = (0u32, L::splat(0));
     for l in (0..levels).rev() {
         let above = levels - 1 - l;
+        if top >> (2 * l) == 0 {
+            let perm = combine(key_1, 1u32 << (2 * above)).mulhi(24);
+            uniform |= PERMS[4 * perm as usize] << (2 * l);
+            continue;
+        }
         // Higher digits plus a marker bit: unique per (level, prefix).
         let prefix = m.shr(2 * l + 2).and(L::splat((1 << (2 * above)) - 1)).or(L::splat(1 << (2 * above)));
         let perm = combine(key, prefix).mulhi(L::splat(24));
         let digit = m.shr(2 * l).and(L::splat(3));
-        out = out.or(perm.shl(2).or(digit).map(|z| PERMS[z as usize]).shl(2 * l));
+        out = out.or(perm4(perm, digit).shl(2 * l));
     }
-    out.shl(b)
+    out.or(L::splat(uniform)).shl(b)
 }
 
 /// Point `k` of the stream whose block starts at `start`.
@@ -142,6 +172,20 @@ mod tests {
 
     fn zsobol(n: u32, width: u32) -> PointSet {
         PointSet::for_image(SamplerKind::parse("zsobol").expect("registered"), n, width)
+    }
+
+    #[test]
+    fn packed_permutations_equal_the_table() {
+        use crate::simd::U8;
+        for p in 0..24u32 {
+            for d in 0..4u32 {
+                assert_eq!(super::perm4(p, d), super::PERMS[(4 * p + d) as usize], "p {p} d {d}");
+            }
+            let d8 = U8::new([0, 1, 2, 3, 3, 2, 1, 0]);
+            let got = super::perm4(U8::splat(p), d8).to_array();
+            let want = d8.to_array().map(|d| super::PERMS[(4 * p + d) as usize]);
+            assert_eq!(got, want, "p {p}");
+        }
     }
 
     #[test]

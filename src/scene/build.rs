@@ -329,7 +329,7 @@ pub fn forced_bvh() -> Result<Option<bool>, BuildError> {
 /// render's identity, so that checkpoints and shards made under different settings never mix.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Backend {
-    /// Embree's instruction set (`avx2` unless `STRATA_EMBREE_CONFIG` asks for `avx512`)
+    /// Embree's instruction set (`avx512` on a CPU with it, else `avx2`, unless `STRATA_EMBREE_CONFIG` pins one)
     pub isa: &'static str,
     /// the Embree library's version
     pub embree: String,
