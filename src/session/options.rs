@@ -121,7 +121,7 @@ pub fn default_first_sample(opts: &RenderOptions) -> crate::camera::FirstSample 
 /// gives `direct` `all` by default whatever the scene kind.)
 pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::LightSelection {
     use crate::light::select::LightSelection;
-    opts.light_selection.unwrap_or(course_or_obj(opts, LightSelection::All, LightSelection::Uniform))
+    opts.light_selection.unwrap_or(course_or_obj(opts, LightSelection::ALL, LightSelection::UNIFORM))
 }
 
 /// `course` for `.test` scenes (and the built-in one), `obj` for `.obj` scenes: the one rule behind

@@ -12,7 +12,6 @@ use std::path::{Path, PathBuf};
 const KNOWN: &[&[&str]] = &[
     // Left for the session after issue 34's (other branches were rewriting these folders then).
     &["bsdf/lobe.rs", "bsdf/material.rs"],
-    &["light/tree.rs", "light/wide.rs"],
     &["scene/build.rs", "scene/gather.rs", "scene/texturing.rs"],
     &["scene/obj/mtl.rs", "scene/obj/read.rs"],
     &["session/options.rs", "session/scene.rs"],
