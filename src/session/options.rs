@@ -128,7 +128,7 @@ pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::Li
 /// the course-convention defaults.
 fn course_or_obj<T>(opts: &RenderOptions, course: T, obj: T) -> T {
     match &opts.scene {
-        Some(p) if super::scene::is_obj(p) || crate::scene::xml::is_xml(p) => obj,
+        Some(p) if crate::scene::obj::is_obj(p) || crate::scene::xml::is_xml(p) => obj,
         _ => course,
     }
 }

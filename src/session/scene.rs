@@ -7,6 +7,7 @@ use crate::integrator::kernel::Kernel;
 use crate::integrator::Integrator;
 use crate::scene::build::Scene;
 use crate::scene::desc::{CameraDesc, SceneDesc};
+use crate::scene::obj::is_obj;
 use crate::scene::parse::{self, Limits};
 use std::path::Path;
 
@@ -107,11 +108,6 @@ fn frame_obj(desc: &mut SceneDesc, opts: &RenderOptions, name: &str) -> Option<c
         eprintln!("strata: note: automatic camera, to edit: {}", f.camera_arg());
     }
     f.interior_light
-}
-
-/// A scene path naming a Wavefront OBJ (extension `.obj`, any case) rather than a `.test` file.
-pub fn is_obj(p: &Path) -> bool {
-    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
 }
 
 /// `--camera "ex ey ez cx cy cz ux uy uz fovy"` (the format's `camera` arguments), checked as the
