@@ -10,7 +10,7 @@ use glam::Vec3;
 
 /// Its entry in the registry [`super::RULES`].
 pub(super) const INFO: RuleInfo =
-    RuleInfo::new("power", "one light in proportion to its power (alias table)", build);
+    RuleInfo::new("power", "one light in proportion to its power, by an alias table", build);
 
 fn build(emitters: &[Emitter]) -> Box<dyn LightRule> {
     let (pmf, alias) = build_alias(emitters);

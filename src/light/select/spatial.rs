@@ -11,7 +11,7 @@ use glam::Vec3;
 /// Its entry in the registry [`super::RULES`].
 pub(super) const INFO: RuleInfo = RuleInfo::new(
     "spatial",
-    "one light by a light tree's importance at the shading point (Conty Estevez & Kulla 2018)",
+    "one light by a light tree's importance at the shading point, after Conty Estevez & Kulla 2018",
     build,
 );
 

@@ -6,7 +6,7 @@ use crate::simd::{mask_to_bools, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 
 /// Its entry in the registry [`super::RULES`].
-pub(super) const INFO: RuleInfo = RuleInfo::new("uniform", "one light, uniformly (pmf 1/N)", build);
+pub(super) const INFO: RuleInfo = RuleInfo::new("uniform", "one light, equal odds: pmf 1/N", build);
 
 fn build(emitters: &[Emitter]) -> Box<dyn LightRule> {
     Box::new(Uniform::new(emitters.len()))

@@ -106,11 +106,11 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
                 return Err(ObjLineError::MtlNumbers { cmd: cmd.into(), n, got: args.len() });
             }
             for (i, a) in args.iter().enumerate() {
-                let (cmd, arg, text) = (cmd.to_string(), i + 1, short(a));
+                let (arg, text) = (i + 1, || short(a));
                 match a.parse::<f32>() {
                     Ok(v) if v.is_finite() && (!non_negative || v >= 0.0) => {}
-                    Ok(_) if non_negative => return Err(ObjLineError::Negative { cmd, arg, text }),
-                    _ => return Err(ObjLineError::NotFinite { cmd, arg, text }),
+                    Ok(_) if non_negative => return Err(ObjLineError::Negative { cmd: cmd.into(), arg, text: text() }),
+                    _ => return Err(ObjLineError::NotFinite { cmd: cmd.into(), arg, text: text() }),
                 }
             }
             Ok(())
