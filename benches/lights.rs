@@ -46,7 +46,7 @@ fn bench(c: &mut Criterion) {
         (0..CALLS).map(|_| (rng.f32(), Vec3::new(rng.f32() * 40.0 - 20.0, 0.0, rng.f32() * 40.0 - 20.0))).collect();
     for n in [10usize, 1000, 10_000] {
         let ls = lights(n, &mut rng);
-        for sel in [LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial] {
+        for sel in [LightSelection::UNIFORM, LightSelection::named("power"), LightSelection::named("spatial")] {
             let t0 = Instant::now();
             let s = LightSampler::new(&ls, sel);
             eprintln!("build {sel} N={n}: {:.2} ms", t0.elapsed().as_secs_f64() * 1e3);

@@ -87,6 +87,8 @@ if [ -n "$python_module" ]; then
     "$venv/bin/python" -m pip install -q $want
     echo "$want" >"$venv/.strata-packages"
   fi
-  echo "setup: building the strata Python module into .venv (maturin develop --release)" >&2
-  (cd "$root/python" && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" maturin develop --release --quiet)
+  # STRATA_PROFILE: the cargo profile (release; scripts/test.sh builds with its own, ci).
+  profile="${STRATA_PROFILE:-release}"
+  echo "setup: building the strata Python module into .venv (maturin develop --profile $profile)" >&2
+  (cd "$root/python" && VIRTUAL_ENV="$venv" PATH="$venv/bin:$PATH" maturin develop --profile "$profile" --quiet)
 fi

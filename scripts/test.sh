@@ -4,8 +4,12 @@
 # --slurm: afterwards, also run scripts/test-slurm.sh (a real one-node Slurm: the job-array
 # recipe of examples/cluster with a requeued task, merged bit-identically; root, about a minute).
 # A full run (no cargo test args) first checks `cargo fmt --check` and
-# `cargo clippy --release --workspace --all-targets -- -D warnings` (the renderer and python/), and
+# `cargo clippy --profile ci --workspace --all-targets -- -D warnings` (the renderer and python/), and
 # after the Rust tests builds the Python module into .venv and runs its pytest suite (python/tests).
+# Everything builds in one cargo profile, `ci` (Cargo.toml: release code without thin LTO and debug
+# info), so clippy, the tests, the binary, the Python module and the Slurm test share the build
+# scripts and dependencies, and the library that the binary, the integration tests and the Python
+# module link is compiled once.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 slurm=
@@ -23,18 +27,18 @@ if [ ${#args[@]} -eq 0 ]; then
   fi
   echo "test: cargo fmt --check" >&2
   cargo fmt --check
-  echo "test: cargo clippy --release --workspace --all-targets -- -D warnings" >&2
-  cargo clippy --release --workspace --all-targets -- -D warnings
+  echo "test: cargo clippy --profile ci --workspace --all-targets -- -D warnings" >&2
+  cargo clippy --profile ci --workspace --all-targets -- -D warnings
 fi
 # --no-fail-fast: one failing test binary does not hide the others' results (the exit status still fails).
-cargo test --release --no-fail-fast ${args[@]+"${args[@]}"}
+cargo test --profile ci --no-fail-fast ${args[@]+"${args[@]}"}
 if [ ${#args[@]} -eq 0 ]; then
   # The Python module (scripts/setup.sh --python builds it into .venv), tested against the binary
   # cargo test just built.
-  "$root/scripts/setup.sh" --python
+  STRATA_PROFILE=ci "$root/scripts/setup.sh" --python
   echo "test: pytest python/tests" >&2
-  STRATA_BIN="$root/target/release/strata" "$root/.venv/bin/python" -m pytest -q "$root/python/tests"
+  STRATA_BIN="$root/target/ci/strata" "$root/.venv/bin/python" -m pytest -q "$root/python/tests"
 fi
 if [ -n "$slurm" ]; then
-  "$root/scripts/test-slurm.sh"
+  STRATA="${STRATA:-$root/target/ci/strata}" "$root/scripts/test-slurm.sh"
 fi

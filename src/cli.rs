@@ -334,7 +334,7 @@ pub(crate) struct RenderArgs {
         SamplerKind::help_list()
     ))]
     pub(crate) light_sampler: Option<SamplerKind>,
-    /// Where a one-light choice (--light-selection uniform, power, spatial) takes its number from:
+    /// Where a one-light choice (a --light-selection other than all) takes its number from:
     /// reuse (the light point's first coordinate, remapped, as Mitsuba does; default) or dimension
     /// (a sampler dimension of its own).
     #[arg(long, help_heading = LIGHTS, value_name = "MODE")]
@@ -342,10 +342,12 @@ pub(crate) struct RenderArgs {
     /// Light samples per light, at least 1 (default: the scene's lightsamples).
     #[arg(long, help_heading = LIGHTS, value_parser = parse_positive::<u32>)]
     pub(crate) light_samples: Option<u32>,
-    /// Path tracer NEE light selection: all (every light, `lightsamples` points each; the CSE168
-    /// convention, default for .test scenes), uniform (one light, equal odds; default for .obj
-    /// scenes), power (one light by emitted power), spatial (one light by the light tree).
-    #[arg(long, help_heading = LIGHTS, value_name = "NAME")]
+    // Light selection; the help lists the rule registry.
+    #[arg(long, help_heading = LIGHTS, value_name = "NAME", help = format!(
+        "Light selection of next-event estimation (direct and the path tracer): {}. Default: all for \
+         .test scenes, uniform for .obj scenes",
+        strata::integrator::LightSelection::help_list()
+    ))]
     pub(crate) light_selection: Option<strata::integrator::LightSelection>,
     /// A constant environment light ("sky") of this radiance, R or R,G,B (path tracer; sampled
     /// at every vertex besides the area lights, NEE and MIS like any light; escaped camera rays

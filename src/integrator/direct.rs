@@ -25,7 +25,7 @@ use super::settings::Integrator;
 use crate::accel::Ray8;
 use crate::bsdf::LobeSet;
 use crate::light::emitters::{Emitter, LightSample8};
-use crate::light::select::{LightChoice, LightSelection};
+use crate::light::select::LightChoice;
 use crate::profile::Phase;
 use crate::sampler::{PathDim, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
@@ -134,7 +134,7 @@ fn shade<L: LobeSet>(
     if ctx.scene.emitters.is_empty() {
         // No area light (only lights outside the selection): nothing to choose from.
         shading_lanes(ctx.scene, hits, sc);
-    } else if it.light_selection != LightSelection::All {
+    } else if it.light_selection.picks_one() {
         shade_one::<L>(it, ctx, hits, sc, s, out);
     } else {
         shade_all::<L>(it, ctx, hits, sc, s, out);
@@ -264,10 +264,10 @@ fn shade_one<L: LobeSet>(
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
     shading_lanes(scene, hits, sc);
-    // One light chosen uniformly: the choice is light 0 with pmf 1 whatever its sample, so the
+    // One light picked for certain: the choice is light 0 with pmf 1 whatever its sample, so the
     // choice dimension is not drawn (every sample is a pure function of its own dimension: the
     // others are unchanged).
-    let one_light = it.light_sampler.selection() == LightSelection::Uniform && it.light_sampler.len() == 1;
+    let one_light = it.light_sampler.certain();
     // The choice from a dimension of its own, or reused from the light point's u (Mitsuba's).
     let own_choice = !one_light && it.light_choice == LightChoice::Dimension;
     let streams = it.light_streams();

@@ -11,6 +11,9 @@ use crate::sampler::{GridTable, PointSet, SamplerKind};
 use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
 
+/// `direct`'s choice among the emissive triangles under `all` (see `triangle_sampler`).
+const POWER: LightSelection = LightSelection::named("power");
+
 /// The samplers asked for (`--sampler`, `--pixel-sampler`, `--light-sampler`); `None` takes the
 /// default. `sampler` sets every dimension, the other two override theirs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -68,7 +71,7 @@ pub struct Integrator {
     pub kernel: Kernel,
     /// where pixel sample 0 goes ([`FirstSample`]; `new` gives `Jittered`)
     pub first_sample: FirstSample,
-    /// how NEE chooses lights (`new` gives [`LightSelection::Uniform`]; see
+    /// how NEE chooses lights (`new` gives [`LightSelection::UNIFORM`]; see
     /// [`Integrator::set_light_selection`])
     pub light_selection: LightSelection,
     /// where a one-light choice takes its number from (`--light-choice`; default reuse)
@@ -101,13 +104,13 @@ impl Integrator {
             max_depth: d.max_depth,
             kernel: Kernel::for_scene(scene),
             first_sample: FirstSample::Jittered,
-            light_selection: LightSelection::Uniform,
+            light_selection: LightSelection::UNIFORM,
             light_choice: LightChoice::Reuse,
-            light_sampler: std::sync::Arc::new(LightSampler::new(&scene.emitters.list, LightSelection::Uniform)),
+            light_sampler: std::sync::Arc::new(LightSampler::new(&scene.emitters.list, LightSelection::UNIFORM)),
             triangle_sampler: std::sync::Arc::new(LightSampler::over_range(
                 &scene.emitters.list,
                 scene.emitters.n_quads..scene.emitters.list.len(),
-                LightSelection::Power,
+                POWER,
             )),
         }
     }

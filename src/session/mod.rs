@@ -31,6 +31,7 @@ pub mod replay;
 pub mod scene;
 pub mod stats;
 
+pub use crate::scene::obj::is_obj;
 pub use error::SessionError;
 pub use options::{default_first_sample, default_quantize, RenderOptions, DEFAULT_CHECKPOINT_EVERY, DEFAULT_SCENE};
 pub use output::{metadata, output_stem, run_render};
@@ -38,5 +39,5 @@ pub use pass::{render_to_film, stop_on_signals, RenderOutput};
 pub use profile::{profile_table, run_profile, run_profile_capped, Profile};
 pub use rays::{rates_table, run_rays};
 pub use replay::{KindReplay, SamplerReplay};
-pub use scene::{is_obj, load_scene, parse_camera, parse_scene, prepare, scene_hash};
+pub use scene::{load_scene, parse_camera, parse_scene, prepare, scene_hash};
 pub use stats::{stats_json, summary};

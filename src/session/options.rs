@@ -121,14 +121,14 @@ pub fn default_first_sample(opts: &RenderOptions) -> crate::camera::FirstSample 
 /// gives `direct` `all` by default whatever the scene kind.)
 pub fn default_light_selection(opts: &RenderOptions) -> crate::light::select::LightSelection {
     use crate::light::select::LightSelection;
-    opts.light_selection.unwrap_or(course_or_obj(opts, LightSelection::All, LightSelection::Uniform))
+    opts.light_selection.unwrap_or(course_or_obj(opts, LightSelection::ALL, LightSelection::UNIFORM))
 }
 
 /// `course` for `.test` scenes (and the built-in one), `obj` for `.obj` scenes: the one rule behind
 /// the course-convention defaults.
 fn course_or_obj<T>(opts: &RenderOptions, course: T, obj: T) -> T {
     match &opts.scene {
-        Some(p) if super::scene::is_obj(p) || crate::scene::xml::is_xml(p) => obj,
+        Some(p) if crate::scene::obj::is_obj(p) || crate::scene::xml::is_xml(p) => obj,
         _ => course,
     }
 }

@@ -39,6 +39,10 @@ pub fn camera_text(c: Option<&crate::scene::desc::CameraDesc>) -> String {
     )
 }
 
+/// `strata.variance` of a render: the i.i.d. formula over its samples.
+pub const VARIANCE_IID: &str =
+    "iid: sample variance / n over the render's samples (exact for independent samples; overstated for stratified and low-discrepancy ones)";
+
 /// Metadata written into the EXR header of a render ([`header_metadata`] and the thread count).
 pub fn metadata(out: &RenderOutput) -> Metadata {
     let mut m = header_metadata(&out.header);
@@ -46,7 +50,7 @@ pub fn metadata(out: &RenderOutput) -> Metadata {
     // The camera, so that `compare` can refuse a reference of another view.
     m.push(("strata.camera".into(), camera_text(out.scene.desc.camera.as_ref())));
     // How the variance layer was estimated (`strata reference` replaces it: replicas).
-    m.push(("strata.variance".into(), super::reference::VARIANCE_IID.into()));
+    m.push(("strata.variance".into(), VARIANCE_IID.into()));
     m
 }
 

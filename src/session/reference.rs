@@ -28,10 +28,6 @@ pub fn default_replicas(spp: u32) -> u32 {
     (2..=DEFAULT_REPLICAS).rev().find(|&r| spp.is_multiple_of(r)).unwrap_or(1)
 }
 
-/// `strata.variance` of a render: the i.i.d. formula over its samples.
-pub const VARIANCE_IID: &str =
-    "iid: sample variance / n over the render's samples (exact for independent samples; overstated for stratified and low-discrepancy ones)";
-
 /// The seed of replica `r` of a reference with base seed `base`: a SplitMix64 finalizer of both,
 /// so replicas' streams are independent of each other and of `compare`'s runs (`run_seed`).
 pub fn replica_seed(base: u64, r: u32) -> u64 {

@@ -35,7 +35,8 @@ fn replay_calls_the_sampler_exactly_as_often_as_the_render() {
     let _g = crate::profile::TEST_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use crate::light::select::LightSelection;
     use IntegratorKind::*;
-    let cases = [(RayTracer, None), (AnalyticDirect, None), (Direct, None), (Direct, Some(LightSelection::Power))];
+    let cases =
+        [(RayTracer, None), (AnalyticDirect, None), (Direct, None), (Direct, Some(LightSelection::named("power")))];
     for (kind, selection) in cases.into_iter().chain([(PathTracer, None)]) {
         for sampler in [None, Some(SamplerKind::SOBOL)] {
             let o = RenderOptions { light_selection: selection, ..opts(kind, sampler) };

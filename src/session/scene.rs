@@ -7,6 +7,7 @@ use crate::integrator::kernel::Kernel;
 use crate::integrator::Integrator;
 use crate::scene::build::Scene;
 use crate::scene::desc::{CameraDesc, SceneDesc};
+use crate::scene::obj::is_obj;
 use crate::scene::parse::{self, Limits};
 use std::path::Path;
 
@@ -109,11 +110,6 @@ fn frame_obj(desc: &mut SceneDesc, opts: &RenderOptions, name: &str) -> Option<c
     f.interior_light
 }
 
-/// A scene path naming a Wavefront OBJ (extension `.obj`, any case) rather than a `.test` file.
-pub fn is_obj(p: &Path) -> bool {
-    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
-}
-
 /// `--camera "ex ey ez cx cy cz ux uy uz fovy"` (the format's `camera` arguments), checked as the
 /// `.test` parser checks them.
 pub fn parse_camera(s: &str) -> Result<CameraDesc, SessionError> {
@@ -198,7 +194,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     // every light) and the default of the scene's kind for the path tracer.
     let selection = opts.light_selection.or(scene.desc.light_selection).unwrap_or_else(|| {
         if scene.desc.integrator == crate::scene::desc::IntegratorKind::Direct {
-            crate::light::select::LightSelection::All
+            crate::light::select::LightSelection::ALL
         } else {
             super::options::default_light_selection(opts)
         }
@@ -212,7 +208,6 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
 /// `--light-sampler`, `--light-choice`, `--light-selection` for raytracer and analyticdirect, and
 /// `--light-choice` where no light is chosen (selection `all`, fewer than two lights).
 fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Result<(), SessionError> {
-    use crate::light::select::LightSelection;
     use crate::scene::desc::IntegratorKind;
     let refuse = |flag: &'static str, why: String| Err(SessionError::FlagIgnored { flag, why });
     let name = it.kind.name();
@@ -231,10 +226,10 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
         }
     }
     if opts.light_choice.is_some() {
-        if it.light_selection == LightSelection::All {
+        if !it.light_selection.picks_one() {
             return refuse(
                 "--light-choice",
-                format!("{name} with light selection all samples every light: there is no choice"),
+                format!("{name} with light selection {} samples every light: there is no choice", it.light_selection),
             );
         }
         if scene.emitters.len() < 2 {

@@ -73,24 +73,25 @@ fn cases() -> Vec<Case> {
     let manylights = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/manylights.test"));
     let cornell = c.join("hw4/cornellBRDF.test");
     use ImportanceSampling::Brdf;
-    use LightSelection::*;
+    let (all, uniform) = (LightSelection::ALL, LightSelection::UNIFORM);
+    let (power, spatial) = (LightSelection::named("power"), LightSelection::named("spatial"));
     vec![
         // Three lights, direct lighting, every light selection.
-        direct("direct-all sphere", sphere.clone(), All, "direct sphere"),
-        direct("direct-uniform sphere", sphere.clone(), Uniform, "direct sphere"),
-        direct("direct-power sphere", sphere.clone(), Power, "direct sphere"),
-        direct("direct-spatial sphere", sphere, Spatial, "direct sphere"),
+        direct("direct-all sphere", sphere.clone(), all, "direct sphere"),
+        direct("direct-uniform sphere", sphere.clone(), uniform, "direct sphere"),
+        direct("direct-power sphere", sphere.clone(), power, "direct sphere"),
+        direct("direct-spatial sphere", sphere, spatial, "direct sphere"),
         // Many lights (GGX floor), one chosen by power or by the light tree.
-        direct("direct-power manylights", manylights.clone(), Power, "direct manylights"),
-        direct("direct-spatial manylights", manylights.clone(), Spatial, "direct manylights"),
+        direct("direct-power manylights", manylights.clone(), power, "direct manylights"),
+        direct("direct-spatial manylights", manylights.clone(), spatial, "direct manylights"),
         // A GGX floor and Phong spheres under 2500 lights: the path tracer's NEE + MIS (BRDF
         // sampling), every one-light choice. (hw4/ggx.test's roughness-0.01 mirrors of radiance-110
         // lights make fireflies that no per-pixel RMSE of one render at 256 spp averages out.)
-        path("path-mis-uniform manylights", manylights.clone(), Uniform, Nee::Mis, Brdf, 1, "path manylights"),
-        path("path-mis-power manylights", manylights.clone(), Power, Nee::Mis, Brdf, 1, "path manylights"),
-        path("path-mis-spatial manylights", manylights, Spatial, Nee::Mis, Brdf, 1, "path manylights"),
+        path("path-mis-uniform manylights", manylights.clone(), uniform, Nee::Mis, Brdf, 1, "path manylights"),
+        path("path-mis-power manylights", manylights.clone(), power, Nee::Mis, Brdf, 1, "path manylights"),
+        path("path-mis-spatial manylights", manylights, spatial, Nee::Mis, Brdf, 1, "path manylights"),
         // One light, BRDF sampling only (lobe, direction and roulette dimensions).
-        path("path-brdf cornell", cornell, Uniform, Nee::Off, Brdf, 3, "path cornell"),
+        path("path-brdf cornell", cornell, uniform, Nee::Off, Brdf, 3, "path cornell"),
     ]
 }
 
@@ -297,8 +298,8 @@ fn every_sampler_flag_changes_the_path_tracer_and_useless_flags_are_refused() {
     );
     let analytic = RenderOptions { integrator: Some(IntegratorKind::AnalyticDirect), ..base.clone() };
     refused(RenderOptions { light_sampler: k("sobol"), ..analytic.clone() }, "--light-sampler");
-    refused(RenderOptions { light_selection: Some(LightSelection::Power), ..analytic }, "--light-selection");
-    let path_uniform = RenderOptions { light_selection: Some(LightSelection::Uniform), ..base };
+    refused(RenderOptions { light_selection: Some(LightSelection::named("power")), ..analytic }, "--light-selection");
+    let path_uniform = RenderOptions { light_selection: Some(LightSelection::UNIFORM), ..base };
     // With a one-light choice on a one-light scene there is nothing to choose either.
     refused(
         RenderOptions { light_choice: Some(strata::integrator::LightChoice::Reuse), ..path_uniform },

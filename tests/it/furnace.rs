@@ -84,8 +84,8 @@ fn every_sampler_passes_the_furnace() {
         ..Default::default()
     };
     let configs: [(&str, RenderOptions); 4] = [
-        ("direct uniform", RenderOptions { light_selection: Some(LightSelection::Uniform), ..base.clone() }),
-        ("direct all", RenderOptions { light_selection: Some(LightSelection::All), ..base.clone() }),
+        ("direct uniform", RenderOptions { light_selection: Some(LightSelection::UNIFORM), ..base.clone() }),
+        ("direct all", RenderOptions { light_selection: Some(LightSelection::ALL), ..base.clone() }),
         (
             "path mis power",
             RenderOptions {
@@ -93,7 +93,7 @@ fn every_sampler_passes_the_furnace() {
                 nee: Some(Nee::Mis),
                 importance_sampling: Some(ImportanceSampling::Cosine),
                 max_depth: Some(3),
-                light_selection: Some(LightSelection::Power),
+                light_selection: Some(LightSelection::named("power")),
                 ..base.clone()
             },
         ),
@@ -104,7 +104,7 @@ fn every_sampler_passes_the_furnace() {
                 nee: Some(Nee::Mis),
                 importance_sampling: Some(ImportanceSampling::Brdf),
                 max_depth: Some(3),
-                light_selection: Some(LightSelection::Spatial),
+                light_selection: Some(LightSelection::named("spatial")),
                 ..base.clone()
             },
         ),

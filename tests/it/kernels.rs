@@ -81,7 +81,7 @@ fn direct_on_ggx_and_phong_is_kernel_invariant_and_agrees_with_the_path_tracer()
     for (scene, kernel) in [("hw4/ggx.test", "direct<lobes=ggx>"), ("hw4/cornellBRDF.test", "direct<lobes=phong>")] {
         let o = RenderOptions {
             integrator: Some(IntegratorKind::Direct),
-            light_selection: Some(LightSelection::All),
+            light_selection: Some(LightSelection::ALL),
             first_sample: Some(strata::integrator::FirstSample::Jittered),
             ..opts(root.join(scene), 64, 32, 16)
         };

@@ -15,8 +15,10 @@ use strata::session::RenderOptions;
 /// Clamp of the negative control in `strategies_agree_on_many_lights`.
 const CLAMP: f32 = 30.0;
 
-const ALL: [LightSelection; 4] =
-    [LightSelection::All, LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial];
+/// Every registered light-selection rule, in registry order (`all` first).
+fn rules() -> Vec<LightSelection> {
+    LightSelection::every().collect()
+}
 
 /// Per-pixel mean and variance of the mean of one render.
 struct Est {
@@ -144,9 +146,9 @@ fn strategies_agree_on_mis_test() {
     let scene = c.join("hw4/mis.test");
     let size = (96, 64);
     let mut mis = Vec::new();
-    for (k, sel) in ALL.into_iter().enumerate() {
+    for (k, sel) in rules().into_iter().enumerate() {
         // `all` samples five lights per vertex: fewer samples for similar noise and time.
-        let spp = if sel == LightSelection::All { 128 } else { 256 };
+        let spp = if sel == LightSelection::ALL { 128 } else { 256 };
         mis.push(estimate(&scene, size, spp, 10 + k as u64, sel, None));
     }
     let power = mis.remove(2);
@@ -166,9 +168,9 @@ fn strategies_agree_on_mis_test() {
         .replace("roughness 0.0005", "roughness 0.15")
         .replace("roughness 0.008", "roughness 0.1");
     std::fs::write(&rough, text).unwrap();
-    for (k, sel) in ALL.into_iter().enumerate() {
-        let spp = if sel == LightSelection::All { 128 } else { 256 };
-        let block = if sel == LightSelection::Power { 8 } else { 1 };
+    for (k, sel) in rules().into_iter().enumerate() {
+        let spp = if sel == LightSelection::ALL { 128 } else { 256 };
+        let block = if sel == LightSelection::named("power") { 8 } else { 1 };
         let on = estimate(&rough, size, spp, 20 + k as u64, sel, Some(Nee::On));
         let with_mis = estimate(&rough, size, spp, 30 + k as u64, sel, Some(Nee::Mis));
         let g = agreement(&on, &with_mis, block);
@@ -210,18 +212,18 @@ fn strategies_agree_on_many_lights() {
         scene_variant(&scene_dir().join("manylights.test"), "many", &["camera"], "camera 0 1.5 3  0 0 -1  0 1 0  30\n");
     let size = (32, 24);
     let mut mis = Vec::new();
-    for (k, sel) in ALL.into_iter().enumerate() {
+    for (k, sel) in rules().into_iter().enumerate() {
         // `all` traces 2500 shadow rays per vertex. One light of 2500 per sample is heavy-tailed:
         // at 512 spp the per-pixel variance estimates still miss the rare large contributions
         // (image-mean |z| up to ~5 between unbiased strategies), hence 2048.
-        let spp = if sel == LightSelection::All { 16 } else { 2048 };
+        let spp = if sel == LightSelection::ALL { 16 } else { 2048 };
         mis.push(estimate(&scene, size, spp, 30 + k as u64, sel, None));
     }
     // One light of 2500 per sample is heavy-tailed per pixel (the few lights that matter at a
     // point are picked rarely), so 2x2-pixel blocks and a 5% bound (Gaussian: 0.27%).
     assert_all_agree("manylights", &mis, 2, 0.05);
-    for (k, sel) in ALL.into_iter().enumerate() {
-        let spp = if sel == LightSelection::All { 16 } else { 512 };
+    for (k, sel) in rules().into_iter().enumerate() {
+        let spp = if sel == LightSelection::ALL { 16 } else { 512 };
         let on = estimate(&scene, size, spp, 40 + k as u64, sel, Some(Nee::On));
         let g = agreement(&on, &mis[k], 2);
         eprintln!("manylights {sel}: NEE on vs MIS: {g:?}");
@@ -232,7 +234,7 @@ fn strategies_agree_on_many_lights() {
     let o = RenderOptions {
         seed: 50,
         clamp: Some(CLAMP),
-        light_selection: Some(LightSelection::Spatial),
+        light_selection: Some(LightSelection::named("spatial")),
         first_sample: Some(strata::camera::FirstSample::Jittered),
         ..opts(scene, size.0, size.1, 512)
     };
@@ -269,11 +271,11 @@ fn triangles_and_quads() -> PathBuf {
 fn strategies_agree_with_emissive_triangles() {
     let scene = triangles_and_quads();
     let mut mis = Vec::new();
-    for (k, sel) in ALL.into_iter().enumerate() {
+    for (k, sel) in rules().into_iter().enumerate() {
         mis.push(estimate(&scene, (32, 32), 256, 60 + k as u64, sel, None));
     }
     assert_all_agree("emissive triangles", &mis, 1, 0.02);
-    for (k, sel) in ALL.into_iter().enumerate() {
+    for (k, sel) in rules().into_iter().enumerate() {
         let on = estimate(&scene, (32, 32), 256, 70 + k as u64, sel, Some(Nee::On));
         let g = agreement(&on, &mis[k], 1);
         eprintln!("emissive triangles {sel}: NEE on vs MIS: {g:?}");
@@ -334,7 +336,7 @@ fn scene_keyword_and_flag_override() {
     let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(strata::session::stats_json(&out)["light_selection"], "power");
     assert!(strata::session::summary(&out).contains("lights power"), "{}", strata::session::summary(&out));
-    let o = RenderOptions { light_selection: Some(LightSelection::Uniform), ..opts(scene, 8, 8, 1) };
+    let o = RenderOptions { light_selection: Some(LightSelection::UNIFORM), ..opts(scene, 8, 8, 1) };
     let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(strata::session::stats_json(&out)["light_selection"], "uniform");
     let bad = scene_variant(&scene_dir().join("cornell.test"), "kw-bad", &[], "lightselection nearest\n");
@@ -350,9 +352,9 @@ fn scene_keyword_and_flag_override() {
 fn direct_picks_one_light_per_sample() {
     let scene = triangles_and_quads();
     let (size, n) = ((32, 32), 2);
-    let (all, all_rays) = estimate_direct(&scene, size, 64, n, 80, LightSelection::All);
+    let (all, all_rays) = estimate_direct(&scene, size, 64, n, 80, LightSelection::ALL);
     let mut ests = vec![all];
-    for (k, sel) in ALL.into_iter().enumerate().skip(1) {
+    for (k, sel) in rules().into_iter().enumerate().filter(|(_, s)| s.picks_one()) {
         let (e, rays) = estimate_direct(&scene, size, 256, n, 81 + k as u64, sel);
         // One shadow ray per light sample at most (4 lights: `all` traces up to 4 per sample).
         assert!(rays <= u64::from(size.0 * size.1 * 256 * n), "direct {sel}: {rays} shadow rays");

@@ -11,8 +11,10 @@ use strata::integrator::LightSelection;
 use strata::scene::desc::Nee;
 use strata::session::RenderOptions;
 
-const ALL: [LightSelection; 4] =
-    [LightSelection::All, LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial];
+/// Every registered light-selection rule, in registry order (`all` first).
+fn rules() -> Vec<LightSelection> {
+    LightSelection::every().collect()
+}
 
 /// A white (albedo 1) diffuse unit sphere filling most of a 24x24 image, no light of its own.
 fn furnace_scene(dir: &Path) -> PathBuf {
@@ -55,7 +57,7 @@ fn white_furnace_converges_to_the_sky_radiance_in_every_mode() {
     let scene = furnace_scene(&dir);
     let sky = 0.75;
     for nee in [Nee::Off, Nee::On, Nee::Mis] {
-        for sel in ALL {
+        for sel in rules() {
             let o = RenderOptions {
                 sky: Some(glam::Vec3::splat(sky)),
                 nee: Some(nee),
@@ -118,7 +120,7 @@ fn every_light_selection_agrees_with_a_sky_beside_a_quad_light() {
         };
         render(&o)
     };
-    let (ma, va) = run(LightSelection::All, 1);
+    let (ma, va) = run(LightSelection::ALL, 1);
     // The sky changes the image: the floor is brighter than under the quad light alone.
     let no_sky = strata::session::render_to_film(&RenderOptions {
         first_sample: Some(strata::camera::FirstSample::Jittered),
@@ -127,7 +129,10 @@ fn every_light_selection_agrees_with_a_sky_beside_a_quad_light() {
     .unwrap();
     let sum = |m: &[[f64; 3]]| m.iter().map(|p| p[2]).sum::<f64>();
     assert!(sum(&ma) > 1.2 * sum(&means(&no_sky.film)), "the sky adds light");
-    for (k, sel) in [LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial].into_iter().enumerate() {
+    for (k, sel) in [LightSelection::UNIFORM, LightSelection::named("power"), LightSelection::named("spatial")]
+        .into_iter()
+        .enumerate()
+    {
         let (mb, vb) = run(sel, 2 + k as u64);
         let (mut over, mut n, mut d, mut v) = (0, 0, 0.0, 0.0);
         for i in 0..ma.len() {

@@ -27,7 +27,7 @@ use super::stats::RayKind;
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
 use crate::light::emitters::LightSample8;
-use crate::light::select::{LightChoice, LightSelection};
+use crate::light::select::LightChoice;
 use crate::profile::Phase;
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
@@ -316,17 +316,13 @@ impl Bounce<'_> {
             Nee::Mis if v == 1 => F8::ONE,
             Nee::Mis => {
                 let _p = crate::profile::leaf(crate::profile::Phase::Mis);
-                let p_light = match it.light_selection {
+                let pmf = if it.light_selection.picks_one() {
+                    it.light_sampler.pmf_x8(pp, pn, sh.light, is_light)
+                } else {
                     // N points on every light: multi-sample MIS against N p_light.
-                    LightSelection::All => {
-                        let pmf = F8::splat(it.light_set.n().max(1) as f32);
-                        light_pdf_at_hit_pmf(self.scene, sh, vx.rh, is_light, pmf)
-                    }
-                    _ => {
-                        let pmf = it.light_sampler.pmf_x8(pp, pn, sh.light, is_light);
-                        light_pdf_at_hit_pmf(self.scene, sh, vx.rh, is_light, pmf)
-                    }
+                    F8::splat(it.light_set.n().max(1) as f32)
                 };
+                let p_light = light_pdf_at_hit_pmf(self.scene, sh, vx.rh, is_light, pmf);
                 power_heuristic_x8(pdf, p_light, is_light)
             }
         };
@@ -419,18 +415,19 @@ impl Bounce<'_> {
                 shadow.write(S_SLOT, &pack, &[bits(vx.slot), o.x, o.y, o.z, d.x, d.y, d.z, tfar, c.x, c.y, c.z]);
                 shadow.advance(&pack);
             };
-            match it.light_selection {
+            if it.light_sampler.certain() {
                 // The one light (pmf 1), a point on it uniform in area.
-                LightSelection::Uniform if n_lights == 1 => {
+                {
                     let ls = {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                         scene.emitters.list[0].sample_x8(u, w)
                     };
                     push(&ls, None, None, shade)
                 }
+            } else if !it.light_selection.picks_one() {
                 // Every light, N points each (a lattice rotated by (u, w)), each weighted 1/N
                 // and, with MIS, against N p_light.
-                LightSelection::All => {
+                {
                     let n_all = it.light_set.n().max(1);
                     let (scale, mis_n) = if n_all > 1 {
                         (Some(F8::splat(1.0 / n_all as f32)), Some(F8::splat(n_all as f32)))
@@ -448,9 +445,10 @@ impl Bounce<'_> {
                         }
                     }
                 }
+            } else {
                 // One light from the light sampler (uniform 1/N over quads and triangles alike,
                 // power or spatial), the choice reused from u or drawn on its own.
-                LightSelection::Uniform | LightSelection::Power | LightSelection::Spatial => {
+                {
                     let (ls, ok) = {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                         let ls = &it.light_sampler;

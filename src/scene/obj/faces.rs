@@ -1,6 +1,7 @@
 //! OBJ text: logical lines (with `\\` continuations), `v`/`vt`/`vn` records, and faces checked
 //! and triangulated as fans `(c0, ci, ci+1)`.
 
+use super::line_error::ObjLineError;
 use super::{short, NO_NORMAL};
 use glam::Vec3;
 use std::borrow::Cow;
@@ -87,7 +88,7 @@ pub fn parse_obj(text: &str) -> Result<ParsedObj, (usize, String)> {
         let mut tok = uncommented.split_ascii_whitespace();
         let Some(cmd) = tok.next() else { continue };
         let args: Vec<&str> = tok.collect();
-        let r: Result<(), String> = match cmd {
+        let r: Result<(), ObjLineError> = match cmd {
             "v" => floats(cmd, &args, 3, 7, "x y z [w] or x y z r g b").map(|v| {
                 let mut pos = Vec3::new(v[0], v[1], v[2]);
                 if v.len() == 4 {
@@ -108,7 +109,7 @@ pub fn parse_obj(text: &str) -> Result<ParsedObj, (usize, String)> {
                 let n = n.and_then(|n| {
                     let u = n.normalize_or_zero();
                     if u == Vec3::ZERO {
-                        Err(format!("'vn' {} {} {} has zero length", n.x, n.y, n.z))
+                        Err(ObjLineError::ZeroNormal { x: n.x, y: n.y, z: n.z })
                     } else {
                         Ok(u)
                     }
@@ -119,7 +120,7 @@ pub fn parse_obj(text: &str) -> Result<ParsedObj, (usize, String)> {
                         valid_normal.push(true);
                     }
                     Err(m) => {
-                        bad_normal_line.get_or_insert((line, m));
+                        bad_normal_line.get_or_insert((line, m.to_string()));
                         p.normals.push(Vec3::ZERO);
                         valid_normal.push(false);
                     }
@@ -177,7 +178,7 @@ pub fn parse_obj(text: &str) -> Result<ParsedObj, (usize, String)> {
             }
         };
         if let Err(m) = r {
-            return Err((line, m));
+            return Err((line, m.to_string()));
         }
     }
     if p.faces.len() > u32::MAX as usize || p.positions.len() >= u32::MAX as usize {
@@ -214,16 +215,16 @@ pub fn parse_obj(text: &str) -> Result<ParsedObj, (usize, String)> {
 }
 
 /// Numbers of a `v`/`vt`/`vn` line: `min..=max` of them, all finite.
-fn floats(cmd: &str, args: &[&str], min: usize, max: usize, what: &str) -> Result<Vec<f32>, String> {
+fn floats(cmd: &str, args: &[&str], min: usize, max: usize, what: &'static str) -> Result<Vec<f32>, ObjLineError> {
     if args.len() < min || args.len() > max {
         let want = if min == max { format!("{min}") } else { format!("{min} to {max}") };
-        return Err(format!("'{cmd}' expects {want} numbers ({what}), got {}", args.len()));
+        return Err(ObjLineError::VertexNumbers { cmd: cmd.into(), want, what, got: args.len() });
     }
     args.iter()
         .enumerate()
         .map(|(i, a)| match a.parse::<f32>() {
             Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a))),
+            _ => Err(ObjLineError::NotFinite { cmd: cmd.into(), arg: i + 1, text: short(a) }),
         })
         .collect()
 }
@@ -241,18 +242,18 @@ fn face(
     nn: i64,
     out: &mut Vec<(u32, u32)>,
     bad_normal: &mut Option<(usize, String)>,
-) -> Result<(), String> {
+) -> Result<(), ObjLineError> {
     if args.len() < 3 {
-        return Err(format!("face 'f' needs at least 3 vertices, got {}", args.len()));
+        return Err(ObjLineError::FewVertices(args.len()));
     }
     for (j, a) in args.iter().enumerate() {
         let mut parts = a.split('/');
         let (pv, pt, pn) = (parts.next().unwrap_or(""), parts.next(), parts.next());
         if parts.next().is_some() {
-            return Err(format!("face vertex {}: '{}' is not i, i/t, i//n or i/t/n", j + 1, short(a)));
+            return Err(ObjLineError::VertexForm { vertex: j + 1, text: short(a) });
         }
-        let index =
-            |s: &str| s.parse::<i64>().map_err(|_| format!("face vertex {}: '{}' is not an index", j + 1, short(a)));
+        let index = |s: &str| s.parse::<i64>().map_err(|_| ObjLineError::NotAnIndex { vertex: j + 1, text: short(a) });
+        let out_of_range = |what, index, defined| ObjLineError::OutOfRange { vertex: j + 1, what, index, defined };
         let resolve = |i: i64, n: i64| {
             if i > 0 && i <= n {
                 Some(i - 1)
@@ -264,15 +265,12 @@ fn face(
         };
         let i = index(pv)?;
         let Some(v) = resolve(i, nv) else {
-            return Err(format!("face vertex {}: vertex index {i} out of range ({nv} defined so far)", j + 1));
+            return Err(out_of_range("vertex", i, nv));
         };
         if let Some(t) = pt.filter(|t| !t.is_empty()) {
             let i = index(t)?;
             if resolve(i, nt).is_none() {
-                return Err(format!(
-                    "face vertex {}: texture coordinate index {i} out of range ({nt} defined so far)",
-                    j + 1
-                ));
+                return Err(out_of_range("texture coordinate", i, nt));
             }
         }
         let mut normal = NO_NORMAL;
@@ -281,10 +279,7 @@ fn face(
             match resolve(i, nn) {
                 Some(k) => normal = k as u32,
                 None => {
-                    bad_normal.get_or_insert((
-                        0,
-                        format!("face vertex {}: normal index {i} out of range ({nn} defined so far)", j + 1),
-                    ));
+                    bad_normal.get_or_insert((0, out_of_range("normal", i, nn).to_string()));
                 }
             }
         }

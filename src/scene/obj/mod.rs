@@ -44,10 +44,12 @@
 
 mod faces;
 pub mod frame;
+mod line_error;
 mod mtl;
 mod place;
 mod procedural;
 mod read;
+mod text;
 
 pub use faces::{locate_obj_error, parse_obj, ParsedObj};
 pub use mtl::locate_mtl_error;
@@ -63,6 +65,11 @@ use glam::Vec3;
 use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+/// A scene path naming a Wavefront OBJ (extension `.obj`, any case) rather than a `.test` file.
+pub fn is_obj(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+}
+
 /// One MTL material: the fields strata uses, `None` where the MTL does not give them.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MtlMaterial {

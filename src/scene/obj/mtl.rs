@@ -1,7 +1,8 @@
 //! MTL libraries: the checks strata needs ([`locate_mtl_error`]), the repairs `tobj` cannot make,
 //! and the read through `tobj::load_mtl_buf`.
 
-use super::read::read_text;
+use super::line_error::ObjLineError;
+use super::text::read_text;
 use super::{err, short, warn, MtlMaterial, ObjWarning};
 use crate::scene::error::SceneError;
 use glam::Vec3;
@@ -100,23 +101,16 @@ fn commands(text: &str) -> impl Iterator<Item = (usize, &str, Vec<&str>)> {
 pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
     let mut seen_newmtl = false;
     for (line, cmd, args) in commands(text) {
-        let numbers = |n: usize, non_negative: bool| -> Result<(), String> {
+        let numbers = |n: usize, non_negative: bool| -> Result<(), ObjLineError> {
             if args.len() != n {
-                return Err(format!("'{cmd}' expects {n} number{}, got {}", if n == 1 { "" } else { "s" }, args.len()));
+                return Err(ObjLineError::MtlNumbers { cmd: cmd.into(), n, got: args.len() });
             }
             for (i, a) in args.iter().enumerate() {
+                let (arg, text) = (i + 1, || short(a));
                 match a.parse::<f32>() {
                     Ok(v) if v.is_finite() && (!non_negative || v >= 0.0) => {}
-                    Ok(_) if non_negative => {
-                        return Err(format!(
-                            "'{cmd}' argument {}: expected a finite number >= 0, got '{}'",
-                            i + 1,
-                            short(a)
-                        ))
-                    }
-                    _ => {
-                        return Err(format!("'{cmd}' argument {}: expected a finite number, got '{}'", i + 1, short(a)))
-                    }
+                    Ok(_) if non_negative => return Err(ObjLineError::Negative { cmd: cmd.into(), arg, text: text() }),
+                    _ => return Err(ObjLineError::NotFinite { cmd: cmd.into(), arg, text: text() }),
                 }
             }
             Ok(())
@@ -127,7 +121,7 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
                 Ok(())
             }
             "Ka" | "Kd" | "Ks" | "Ke" | "Tf" | "Ns" | "Ni" | "d" | "Tr" if !seen_newmtl => {
-                Err(format!("'{cmd}' before any 'newmtl'"))
+                Err(ObjLineError::BeforeNewmtl { cmd: cmd.into() })
             }
             "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => numbers(if args.len() == 1 { 1 } else { 3 }, true),
             "Ns" => numbers(1, true),
@@ -135,7 +129,7 @@ pub fn locate_mtl_error(text: &str) -> Option<(usize, String)> {
             _ => Ok(()),
         };
         if let Err(m) = r {
-            return Some((line, m));
+            return Some((line, m.to_string()));
         }
     }
     None

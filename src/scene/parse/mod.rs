@@ -209,7 +209,7 @@ impl<'l> Parser<'l> {
             }
             "lightstratify" => self.desc.light_stratify = a.keyword(&on_off)?,
             "lightselection" => {
-                let names = crate::light::select::LIGHT_SELECTIONS.map(|i| (i.name, i.selection));
+                let names: Vec<_> = crate::light::select::LightSelection::every().map(|s| (s.name(), s)).collect();
                 self.desc.light_selection = Some(a.keyword(&names)?);
             }
             "nexteventestimation" => self.desc.nee = a.keyword(Nee::NAMES)?,

@@ -220,9 +220,11 @@ fn settings() {
     assert_eq!((c.eye, c.center, c.up, c.fovy_deg), (Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 30.0));
     assert_eq!(d.light_selection, None);
     use crate::light::select::LightSelection;
-    for (text, sel) in
-        [("all", LightSelection::All), ("Power", LightSelection::Power), ("spatial", LightSelection::Spatial)]
-    {
+    for (text, sel) in [
+        ("all", LightSelection::ALL),
+        ("Power", LightSelection::named("power")),
+        ("spatial", LightSelection::named("spatial")),
+    ] {
         assert_eq!(parse_ok(&format!("lightselection {text}")).light_selection, Some(sel));
     }
 }

@@ -3,6 +3,7 @@
 //! and the registry, `shape.rs` places shapes. [`load`] is the entry point.
 
 pub mod doc;
+pub mod elem;
 pub mod plugins;
 pub mod props;
 pub mod shape;

@@ -3,10 +3,10 @@
 //! them (through `scene::mesh`).
 
 use super::doc::Loc;
-use super::plugins::Build;
 use super::props::Props;
-use crate::scene::desc::{EmissiveTriangleDesc, SphereDesc};
+use crate::scene::desc::{EmissiveTriangleDesc, SceneDesc, SphereDesc};
 use crate::scene::error::SceneError;
+use crate::scene::limits::Limits;
 use crate::scene::mesh::{Mesh, MeshError};
 use glam::{Mat4, Vec3};
 
@@ -39,11 +39,12 @@ pub fn load_error(p: &Props, e: MeshError) -> SceneError {
     p.elem.at.err(format!("{}: {e}", p.elem.what()))
 }
 
-/// Places a shape: its triangles with `material` (a material index), or emissive triangles
-/// (that also reflect with `material`) when it carries an area emitter of `radiance`; a sphere
-/// as an ellipsoid.
+/// Places a shape into `desc` (within `limits`): its triangles with `material` (a material
+/// index), or emissive triangles (that also reflect with `material`) when it carries an area
+/// emitter of `radiance`; a sphere as an ellipsoid.
 pub fn place(
-    b: &mut Build,
+    desc: &mut SceneDesc,
+    limits: &Limits,
     out: ShapeOut,
     material: u32,
     emitter: Option<(Vec3, Loc)>,
@@ -55,27 +56,27 @@ pub fn place(
             if let Some((_, eat)) = emitter {
                 return Err(eat.err("an area emitter on a sphere is not supported yet: it needs solid-angle sphere light sampling (the `lights` work of issue 29)"));
             }
-            b.desc.spheres.push(SphereDesc { object_to_world: m, material });
+            desc.spheres.push(SphereDesc { object_to_world: m, material });
         }
         ShapeOut::Mesh(mesh) => {
-            let n = b.desc.triangles.len() + b.desc.emissive_triangles.len() + mesh.indices.len();
-            if n > b.limits.max_primitives {
+            let n = desc.triangles.len() + desc.emissive_triangles.len() + mesh.indices.len();
+            if n > limits.max_primitives {
                 return Err(at.err(format!(
                     "the scene has more than {} triangles ({})",
-                    b.limits.max_primitives,
+                    limits.max_primitives,
                     crate::scene::limits::limit_hint("max_primitives")
                 )));
             }
             match emitter {
                 None => {
-                    b.desc.add_mesh(&mesh, material);
+                    desc.add_mesh(&mesh, material);
                 }
                 Some((radiance, _)) => {
                     for f in &mesh.indices {
                         let v = f.map(|i| mesh.positions[i as usize]);
-                        b.desc.emissive_materials.resize(b.desc.emissive_triangles.len(), u32::MAX);
-                        b.desc.emissive_materials.push(material);
-                        b.desc.emissive_triangles.push(EmissiveTriangleDesc { v, radiance });
+                        desc.emissive_materials.resize(desc.emissive_triangles.len(), u32::MAX);
+                        desc.emissive_materials.push(material);
+                        desc.emissive_triangles.push(EmissiveTriangleDesc { v, radiance });
                     }
                 }
             }

@@ -3,7 +3,7 @@
 //! BSDF's `diffuse_reflectance` to `reflectance`, and the bitmap texture's `uoffset`/`voffset`/
 //! `uscale`/`vscale` to a `to_uv` transform.
 
-use super::doc::Elem;
+use super::elem::Elem;
 
 /// `maxDepth` -> `max_depth`, `toWorld` -> `to_world`, `fovAxis` -> `fov_axis` (a lower-case run
 /// after an upper-case letter starts a new word; digits stay attached).

@@ -278,7 +278,7 @@ impl<'e> Build<'e> {
     /// A shape: its geometry, material and area emitter, placed in the scene.
     pub fn shape(&mut self, e: &'e Elem) -> Result<(), SceneError> {
         let (out, material, emitter) = self.shape_parts(e)?;
-        super::shape::place(self, out, material, emitter, &e.at)
+        super::shape::place(&mut self.desc, self.limits, out, material, emitter, &e.at)
     }
 
     /// A shape's geometry (through its `to_world`), its material index and its area emitter,

@@ -6,7 +6,10 @@ use super::*;
 use crate::sampling::chi2::{gamma_q, statistic, Rng, CHI2_TESTS, SIGNIFICANCE};
 use crate::simd::{mask_all, mask_from_bools};
 
-const PICKING: [LightSelection; 3] = [LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial];
+/// The registered rules that pick one light.
+fn picking() -> Vec<LightSelection> {
+    LightSelection::every().filter(|s| s.picks_one()).collect()
+}
 
 fn unit(rng: &mut Rng) -> Vec3 {
     loop {
@@ -87,19 +90,24 @@ fn chi2_choice(name: &str, s: &LightSampler, p: Vec3, nrm: Vec3, n_samples: usiz
 #[test]
 fn registry_names_round_trip() {
     assert_eq!(LightSelection::names().collect::<Vec<_>>(), ["all", "uniform", "power", "spatial"]);
-    for info in LIGHT_SELECTIONS {
-        assert_eq!(LightSelection::from_name(info.name), Some(info.selection));
-        assert_eq!(info.name.parse::<LightSelection>(), Ok(info.selection));
-        assert_eq!(info.selection.to_string(), info.name);
-        assert!(!info.description.is_empty());
+    for sel in LightSelection::every() {
+        assert_eq!(LightSelection::from_name(sel.name()), Some(sel));
+        assert_eq!(sel.name().parse::<LightSelection>(), Ok(sel));
+        assert_eq!(LightSelection::named(sel.name()), sel);
+        assert_eq!(sel.to_string(), sel.name());
+        assert!(!sel.description().is_empty());
+        assert!(LightSelection::help_list().contains(&format!("{} ({})", sel.name(), sel.description())));
     }
-    assert_eq!("Spatial".parse::<LightSelection>(), Ok(LightSelection::Spatial));
+    assert_eq!("Spatial".parse::<LightSelection>(), Ok(LightSelection::named("spatial")));
     assert!("tree".parse::<LightSelection>().unwrap_err().to_string().contains("all, uniform, power, spatial"));
-    assert!(!LightSelection::All.picks_one() && LightSelection::Power.picks_one());
+    assert!(!LightSelection::ALL.picks_one() && LightSelection::UNIFORM.picks_one());
 }
 
+/// Every rule of the registry, at several shading points (facing the lights, a random normal,
+/// far away without a receiver cosine, inside the cloud of lights): the frequencies of `sample`
+/// against `pmf` (chi-square). `all` picks nothing and gives every light pmf 1.
 #[test]
-fn chi_square_of_the_choice_against_the_pmf() {
+fn chi_square_of_every_rule_against_its_pmf_at_several_points() {
     let alpha = SIGNIFICANCE / CHI2_TESTS as f64;
     let mut rng = Rng::new(11);
     let lights = random_lights(&mut rng, 60, 3.0);
@@ -107,12 +115,17 @@ fn chi_square_of_the_choice_against_the_pmf() {
         (Vec3::new(0.0, 0.0, 0.0), Vec3::Y),
         (Vec3::new(2.0, -1.0, 0.5), unit(&mut rng)),
         (Vec3::new(8.0, 4.0, -6.0), Vec3::ZERO),
+        (Vec3::new(-1.5, 2.5, 1.0), -Vec3::X),
     ];
-    for sel in PICKING {
+    for sel in LightSelection::every() {
         let s = LightSampler::new(&lights, sel);
-        let pts: &[(Vec3, Vec3)] = if sel == LightSelection::Spatial { &points } else { &points[..1] };
-        for (k, &(p, n)) in pts.iter().enumerate() {
+        for (k, &(p, n)) in points.iter().enumerate() {
             let name = format!("{sel} at point {k}");
+            if !sel.picks_one() {
+                assert_eq!(s.sample(0.5, p, n), None, "{name}");
+                assert!((0..60).all(|i| s.pmf(p, n, i) == 1.0), "{name}");
+                continue;
+            }
             let pv = chi2_choice(&name, &s, p, n, 400_000, 100 + k as u64);
             assert!(pv >= alpha, "{name}: chi-square rejects the choice (p = {pv:.3e} < {alpha:.1e})");
         }
@@ -124,7 +137,7 @@ fn pmf_equals_the_probability_sample_returns_bit_for_bit() {
     let mut rng = Rng::new(5);
     for (n_lights, spread) in [(1, 1.0), (7, 2.0), (300, 10.0)] {
         let lights = random_lights(&mut rng, n_lights, spread);
-        for sel in PICKING {
+        for sel in picking() {
             let s = LightSampler::new(&lights, sel);
             for _ in 0..3000 {
                 let p = (Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - Vec3::ONE) * spread * 1.5;
@@ -135,7 +148,7 @@ fn pmf_equals_the_probability_sample_returns_bit_for_bit() {
                 }
             }
         }
-        let all = LightSampler::new(&lights, LightSelection::All);
+        let all = LightSampler::new(&lights, LightSelection::ALL);
         assert_eq!(all.sample(0.5, Vec3::ZERO, Vec3::Y), None);
         assert!((0..n_lights as u32).all(|i| all.pmf(Vec3::ZERO, Vec3::Y, i) == 1.0));
     }
@@ -150,18 +163,19 @@ fn lost_mass(t: &LightTree, p: Vec3, n: Vec3) -> f64 {
 fn pmfs_sum_to_one() {
     let mut rng = Rng::new(21);
     let lights = random_lights(&mut rng, 500, 5.0);
-    for sel in [LightSelection::Uniform, LightSelection::Power] {
+    for sel in [LightSelection::UNIFORM, LightSelection::named("power")] {
         let s = LightSampler::new(&lights, sel);
         let sum: f64 = (0..500).map(|i| s.pmf(Vec3::ZERO, Vec3::ZERO, i) as f64).sum();
         assert!((sum - 1.0).abs() < 1e-5, "{sel}: {sum}");
     }
-    let s = LightSampler::new(&lights, LightSelection::Spatial);
+    let s = LightSampler::new(&lights, LightSelection::named("spatial"));
+    let tree = LightTree::build(&lights);
     let (mut lossy, mut tested) = (0, 0);
     for _ in 0..400 {
         let p = (Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - Vec3::ONE) * 7.0;
         let n = if rng.f32() < 0.2 { Vec3::ZERO } else { unit(&mut rng) };
         let sum: f64 = (0..500).map(|i| s.pmf(p, n, i) as f64).sum();
-        let lost = lost_mass(&s.tree, p, n);
+        let lost = lost_mass(&tree, p, n);
         assert!((sum + lost - 1.0).abs() < 1e-4, "sum {sum} + lost {lost} at {p}, {n}");
         if lights.iter().any(|e| can_contribute(e, p, n, 0.0)) {
             tested += 1;
@@ -190,7 +204,7 @@ fn every_light_that_can_contribute_has_positive_spatial_pmf() {
                 *e = Emitter::quad(c, t * 0.05, s * 0.05, e.radiance);
             }
         }
-        let s = LightSampler::new(&lights, LightSelection::Spatial);
+        let s = LightSampler::new(&lights, LightSelection::named("spatial"));
         for _ in 0..300 {
             let p = if rng.f32() < 0.3 {
                 // Near a light, sometimes almost in its plane.
@@ -220,7 +234,7 @@ fn x8_matches_scalar_bit_for_bit() {
     let mut rng = Rng::new(44);
     for n_lights in [1, 3, 200] {
         let lights = random_lights(&mut rng, n_lights, 3.0);
-        for sel in [LightSelection::All, LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial] {
+        for sel in LightSelection::every() {
             let s = LightSampler::new(&lights, sel);
             for round in 0..200 {
                 let us: [f32; 8] = std::array::from_fn(|_| rng.f32());
@@ -249,7 +263,7 @@ fn x8_matches_scalar_bit_for_bit() {
 fn degenerate_inputs() {
     let q = |c: Vec3, r: f32| Emitter::quad(c, Vec3::Z * 0.5, Vec3::X * 0.5, Vec3::splat(r)); // emits -y
                                                                                               // No lights.
-    for sel in PICKING {
+    for sel in picking() {
         let s = LightSampler::new(&[], sel);
         assert!(s.is_empty() && s.sample(0.3, Vec3::ZERO, Vec3::Y).is_none() && s.pmf(Vec3::ZERO, Vec3::Y, 0) == 0.0);
         let (i, p) = s.sample_x8(F8::splat(0.5), Vec3x8::ZERO, Vec3x8::ZERO, mask_all());
@@ -257,12 +271,12 @@ fn degenerate_inputs() {
     }
     // One light: below it (facing) pmf 1; above it (behind) spatial gives none, pmf 0.
     let one = [q(Vec3::new(0.0, 2.0, 0.0), 5.0)];
-    for sel in PICKING {
+    for sel in picking() {
         let s = LightSampler::new(&one, sel);
         assert_eq!(s.sample(0.99, Vec3::ZERO, Vec3::Y), Some((0, 1.0)), "{sel}");
         assert_eq!(s.pmf(Vec3::ZERO, Vec3::Y, 0), 1.0);
     }
-    let s = LightSampler::new(&one, LightSelection::Spatial);
+    let s = LightSampler::new(&one, LightSelection::named("spatial"));
     assert_eq!(s.sample(0.5, Vec3::new(0.0, 3.0, 0.0), Vec3::Y), None);
     assert_eq!(s.pmf(Vec3::new(0.0, 3.0, 0.0), Vec3::Y, 0), 0.0);
     // Receiver facing away from the light: nothing can contribute.
@@ -271,7 +285,7 @@ fn degenerate_inputs() {
 
     // Zero-power lights are never chosen; all zero: power falls back to uniform, spatial to none.
     let mixed = [q(Vec3::new(0.0, 2.0, 0.0), 0.0), q(Vec3::new(1.0, 2.0, 0.0), 2.0), q(Vec3::new(2.0, 2.0, 0.0), 0.0)];
-    for sel in [LightSelection::Power, LightSelection::Spatial] {
+    for sel in [LightSelection::named("power"), LightSelection::named("spatial")] {
         let s = LightSampler::new(&mixed, sel);
         for k in 0..1000 {
             let u = (k as f32 + 0.5) / 1000.0;
@@ -280,15 +294,15 @@ fn degenerate_inputs() {
         assert_eq!((s.pmf(Vec3::ZERO, Vec3::Y, 0), s.pmf(Vec3::ZERO, Vec3::Y, 2)), (0.0, 0.0));
     }
     let dark = [q(Vec3::ZERO, 0.0), q(Vec3::X, 0.0)];
-    let s = LightSampler::new(&dark, LightSelection::Power);
+    let s = LightSampler::new(&dark, LightSelection::named("power"));
     assert_eq!((s.sample(0.7, Vec3::ZERO, Vec3::Y), s.pmf(Vec3::ZERO, Vec3::Y, 0)), (Some((1, 0.5)), 0.5));
-    let s = LightSampler::new(&dark, LightSelection::Spatial);
+    let s = LightSampler::new(&dark, LightSelection::named("spatial"));
     assert_eq!((s.sample(0.7, -Vec3::Y, Vec3::Y), s.pmf(-Vec3::Y, Vec3::Y, 0)), (None, 0.0));
 
     // Coincident lights: a tree still builds (median split by index), equal pmfs summing to 1.
     let same = vec![q(Vec3::new(0.0, 2.0, 0.0), 1.0); 100];
-    let s = LightSampler::new(&same, LightSelection::Spatial);
-    assert!(s.tree.path.iter().all(|&(_, d)| d <= 8));
+    let s = LightSampler::new(&same, LightSelection::named("spatial"));
+    assert!(LightTree::build(&same).path.iter().all(|&(_, d)| d <= 8));
     let pmfs: Vec<f32> = (0..100).map(|i| s.pmf(Vec3::ZERO, Vec3::Y, i)).collect();
     let sum: f32 = pmfs.iter().sum();
     assert!((sum - 1.0).abs() < 1e-5 && pmfs.iter().all(|&x| (x - 0.01).abs() < 1e-4), "{sum}");
@@ -297,7 +311,7 @@ fn degenerate_inputs() {
     // plane), the others can; everything stays finite.
     let row: Vec<Emitter> = (0..5).map(|k| q(Vec3::new(k as f32, 2.0, 0.0), 1.0 + k as f32)).collect();
     let p_on = row[2].point(0.5, 0.5);
-    let s = LightSampler::new(&row, LightSelection::Spatial);
+    let s = LightSampler::new(&row, LightSelection::named("spatial"));
     for n in [row[2].normal, -row[2].normal, Vec3::ZERO] {
         let qs: Vec<f32> = (0..5).map(|i| s.pmf(p_on, n, i)).collect();
         assert!(qs.iter().all(|x| x.is_finite() && *x >= 0.0 && *x <= 1.0), "{qs:?}");
@@ -315,8 +329,7 @@ fn degenerate_inputs() {
 fn tree_structure_and_spatial_preference() {
     let mut rng = Rng::new(55);
     let lights = random_lights(&mut rng, 10_000, 50.0);
-    let s = LightSampler::new(&lights, LightSelection::Spatial);
-    let t = &s.tree;
+    let t = &LightTree::build(&lights);
     let live = lights.iter().filter(|e| e.power() > 0.0).count();
     assert_eq!(t.nodes.iter().filter(|n| n.leaf).count(), live);
     assert_eq!(t.nodes.len(), 2 * live - 1);
@@ -334,7 +347,7 @@ fn tree_structure_and_spatial_preference() {
             Emitter::quad(c, Vec3::Z * 0.2, Vec3::X * 0.2, Vec3::ONE)
         })
         .collect();
-    let s = LightSampler::new(&grid, LightSelection::Spatial);
+    let s = LightSampler::new(&grid, LightSelection::named("spatial"));
     let mut gain = Vec::new();
     for i in (0..10_000).step_by(997) {
         let p = grid[i].point(0.5, 0.5) - Vec3::Y * 0.05;
@@ -352,10 +365,10 @@ fn wide_importance_equals_the_binary_bound() {
     use super::wide::WideTree;
     let mut rng = Rng::new(66);
     let lights = random_lights(&mut rng, 300, 4.0);
-    let s = LightSampler::new(&lights, LightSelection::Spatial);
-    let (bin, wide) = (&s.tree.nodes, &s.tree.wide);
+    let tree = LightTree::build(&lights);
+    let (bin, wide) = (&tree.nodes, &tree.wide);
     let mut leaves = 0;
-    fn walk(bin: &[tree::Node], wide: &WideTree, w: usize, k: usize, p: Vec3, n: Vec3, leaves: &mut usize) {
+    fn walk(bin: &[super::node::Node], wide: &WideTree, w: usize, k: usize, p: Vec3, n: Vec3, leaves: &mut usize) {
         let kids = WideTree::frontier(bin, k);
         let imp = WideTree::importance8(&wide.nodes[w], p, n);
         for (c, &got) in imp.iter().enumerate() {
@@ -388,7 +401,7 @@ fn reused_choice_remaps_u_uniformly_per_light() {
     let mut rng = Rng::new(77);
     let lights = random_lights(&mut rng, 12, 3.0);
     let emitters = Emitters::new(lights.clone(), std::iter::empty());
-    for sel in PICKING {
+    for sel in picking() {
         let s = LightSampler::new(&lights, sel);
         let (p, nrm) = (Vec3::new(0.1, 0.2, 0.3), unit(&mut rng));
         let n = 1 << 16;
@@ -398,7 +411,7 @@ fn reused_choice_remaps_u_uniformly_per_light() {
             let Some((l, pmf, r)) = s.sample_remap(u, p, nrm) else { continue };
             assert!((0.0..1.0).contains(&r), "{sel:?}: remapped {r}");
             assert_eq!(pmf.to_bits(), s.pmf(p, nrm, l).to_bits(), "{sel:?}");
-            if sel != LightSelection::Power {
+            if sel != LightSelection::named("power") {
                 assert_eq!(s.sample(u, p, nrm), Some((l, pmf)), "{sel:?} u {u}");
             }
             hist[l as usize][(r * 16.0) as usize] += 1.0;
@@ -429,6 +442,79 @@ fn reused_choice_remaps_u_uniformly_per_light() {
                 }
                 None => assert!(!oka[k]),
             }
+        }
+    }
+}
+
+/// A rule that looks at the shading point, written against the trait alone (tests only): pmf
+/// proportional to `1 / (1 + |p - c_i|^2)`, `c_i` light i's centre. It keeps the trait's x8
+/// functions, which must evaluate each lane at its own point.
+#[derive(Debug)]
+struct Nearest {
+    centers: Vec<Vec3>,
+}
+
+impl Nearest {
+    fn weights(&self, p: Vec3) -> (Vec<f32>, f32) {
+        let w: Vec<f32> = self.centers.iter().map(|c| 1.0 / (1.0 + (p - *c).length_squared())).collect();
+        let sum = w.iter().sum();
+        (w, sum)
+    }
+}
+
+impl LightRule for Nearest {
+    fn sample(&self, u: f32, p: Vec3, n: Vec3) -> Option<(u32, f32)> {
+        self.sample_remap(u, p, n).map(|(i, q, _)| (i, q))
+    }
+    fn sample_remap(&self, u: f32, p: Vec3, _: Vec3) -> Option<(u32, f32, f32)> {
+        let (w, sum) = self.weights(p);
+        let mut lo = 0.0;
+        for (i, &x) in w.iter().enumerate() {
+            let q = x / sum;
+            if u < lo + q || i + 1 == w.len() {
+                return Some((i as u32, q, ((u - lo) / q).clamp(0.0, ONE_MINUS)));
+            }
+            lo += q;
+        }
+        None
+    }
+    fn pmf(&self, p: Vec3, _: Vec3, i: u32) -> f32 {
+        let (w, sum) = self.weights(p);
+        w[i as usize] / sum
+    }
+    fn needs_point(&self) -> bool {
+        true
+    }
+}
+
+/// The trait's x8 functions give a point-dependent rule each lane's own point: `sample_x8`,
+/// `sample_remap_x8` and `pmf_x8` equal the scalar functions lane by lane at eight different
+/// points (a `pmf_x8` that evaluated every lane at p = 0 fails here).
+#[test]
+fn default_x8_functions_use_each_lanes_point() {
+    let mut rng = Rng::new(88);
+    let lights = random_lights(&mut rng, 9, 3.0);
+    let rule = Nearest { centers: lights.iter().map(|e| e.point(0.5, 0.5)).collect() };
+    for round in 0..100 {
+        let us: [f32; 8] = std::array::from_fn(|_| rng.f32());
+        let ps: [Vec3; 8] =
+            std::array::from_fn(|_| (Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - Vec3::ONE) * 4.0);
+        let ns: [Vec3; 8] = std::array::from_fn(|_| unit(&mut rng));
+        let ids: [u32; 8] = std::array::from_fn(|_| (rng.f32() * 9.0) as u32);
+        let on: [bool; 8] = std::array::from_fn(|k| round % 2 == 0 || k % 3 != 1);
+        let active = mask_from_bools(on);
+        let (p8, n8) = (Vec3x8::from_lanes(ps), Vec3x8::from_lanes(ns));
+        let q8 = rule.pmf_x8(p8, n8, U8::new(ids), active).to_array();
+        let (i8, s8) = rule.sample_x8(F8::new(us), p8, n8, active);
+        let (ri8, rq8, rr8) = rule.sample_remap_x8(F8::new(us), p8, n8, active);
+        for l in 0..8 {
+            let q = if on[l] { rule.pmf(ps[l], ns[l], ids[l]) } else { 0.0 };
+            assert_eq!(q8[l].to_bits(), q.to_bits(), "pmf lane {l} at {}", ps[l]);
+            let (i, s) = if on[l] { rule.sample(us[l], ps[l], ns[l]).unwrap() } else { (0, 0.0) };
+            assert_eq!((i8.to_array()[l], s8.to_array()[l].to_bits()), (i, s.to_bits()), "sample lane {l}");
+            let (i, s, r) = if on[l] { rule.sample_remap(us[l], ps[l], ns[l]).unwrap() } else { (0, 0.0, 0.0) };
+            let got = (ri8.to_array()[l], rq8.to_array()[l].to_bits(), rr8.to_array()[l].to_bits());
+            assert_eq!(got, (i, s.to_bits(), r.to_bits()), "sample_remap lane {l}");
         }
     }
 }

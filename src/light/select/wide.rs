@@ -9,14 +9,13 @@
 //! probability of child `c` of a node is `imp[c] / sum(imp)`; the descent and [`WideTree::pmf`]
 //! compute the very same products, so the pmf stays exact.
 
-use super::tree::{Node, COS_FLOOR, COS_SLACK};
+use super::node::{Node, COS_FLOOR, COS_SLACK};
+use super::ONE_MINUS;
 use crate::simd::{Vec3x8, F8};
 use glam::Vec3;
 
 /// Children per node (the lane count).
 const WIDTH: usize = 8;
-/// Largest f32 below 1.
-const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Lane-wise dot product in glam's scalar order, without fused multiply-adds, so that every lane
 /// equals the scalar bound bit for bit.

@@ -1,4 +1,4 @@
-//! The light tree behind [`super::LightSelection::Spatial`]: a binary BVH over the emitters whose
+//! The light tree behind the `spatial` rule ([`super::spatial`]): a binary BVH over the emitters whose
 //! nodes carry a bound of position (bounding sphere of a box), power and emitting directions, and
 //! a stochastic descent that picks a light by an importance bound at the shading point (Conty
 //! Estévez and Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree Splitting"; the
@@ -10,44 +10,20 @@
 //! Sampling runs in the tree collapsed to 8 children per node (`wide.rs`), where one 8-lane
 //! importance evaluation serves a whole node and the pmf recomputes the descent's products.
 
+use super::node::Node;
+#[cfg(test)]
+use super::node::{COS_FLOOR, COS_SLACK};
 use super::wide::WideTree;
 use crate::light::emitters::Emitter;
 use glam::Vec3;
 use std::f32::consts::{FRAC_PI_2, PI};
 
-/// Margin on the cosine bounds (about 0.06 degrees): a node is given importance 0 only when the
-/// best cosine is below `-COS_SLACK`, which absorbs the f32 rounding of the bound itself (the
-/// worst term is `sqrt(1 - cos^2)` near `cos = +-1`, off by up to ~3e-4).
-pub(super) const COS_SLACK: f32 = 1e-3;
-/// Floor of a cosine factor that passed the slack test, so that the importance stays positive.
-pub(super) const COS_FLOOR: f32 = 1e-6;
 /// Extra angle added to every orientation cone at build time (radians).
 const CONE_SLACK: f32 = 1e-5;
 /// Buckets per axis of the binned SAOH split.
 const BUCKETS: usize = 12;
 /// Depth from which splits are by median count, so that paths fit in 64 bits.
 const MEDIAN_DEPTH: u32 = 40;
-
-/// A node of the light tree (depth-first order: the left child of node `k` is `k + 1`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Node {
-    /// centre of the bounding sphere (centre of the node's box)
-    pub center: Vec3,
-    /// radius of the bounding sphere (half the box diagonal, inflated for rounding)
-    pub radius: f32,
-    /// node power relative to the whole tree's (in (0, 1])
-    pub phi: f32,
-    /// axis of the cone of emitting normals
-    pub axis: Vec3,
-    /// cosine of the cone's half angle theta_o
-    pub cos_o: f32,
-    /// sine of theta_o
-    pub sin_o: f32,
-    /// right child for an interior node, light index for a leaf
-    pub link: u32,
-    /// leaf (one emitter)
-    pub leaf: bool,
-}
 
 /// Light tree over the positive-power emitters of a scene.
 #[derive(Clone, Debug, Default, PartialEq)]
