@@ -198,6 +198,10 @@ pub struct SceneDesc {
     pub nee: Nee,
     /// Russian roulette
     pub russian_roulette: bool,
+    /// Mitsuba's `hide_emitters`: camera rays see no emitter (area lights, emissive materials and
+    /// the environment are black where a camera ray meets them; their light still reaches other
+    /// surfaces). Hashed only when set.
+    pub hide_emitters: bool,
     /// direction sampling of the path tracer
     pub importance_sampling: ImportanceSampling,
     /// distinct materials, referenced by index
@@ -319,6 +323,9 @@ impl SceneDesc {
             }
         }
         // The Mitsuba-side fields, likewise only when set.
+        if self.hide_emitters {
+            h.word(0x6869_6465);
+        }
         if self.sensor.is_some() || self.filter != PixelFilter::Box {
             let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
         }
@@ -406,6 +413,7 @@ impl Default for SceneDesc {
             light_selection: None,
             nee: Nee::Off,
             russian_roulette: false,
+            hide_emitters: false,
             importance_sampling: ImportanceSampling::Hemisphere,
             materials: Vec::new(),
             triangles: Vec::new(),

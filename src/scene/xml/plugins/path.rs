@@ -30,8 +30,6 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     let rr = p.int("rr_depth", 5)?;
     let max_depth = p.int("max_depth", -1)?;
     b.desc.russian_roulette = rr < 1_000 && !(max_depth >= 1 && max_depth <= rr);
-    if p.bool("hide_emitters", false)? {
-        return Err(p.elem.at.err("hide_emitters is not supported yet"));
-    }
+    b.desc.hide_emitters = p.bool("hide_emitters", false)?;
     Ok(())
 }
