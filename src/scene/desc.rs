@@ -198,6 +198,9 @@ pub struct SceneDesc {
     pub nee: Nee,
     /// Russian roulette
     pub russian_roulette: bool,
+    /// the first path vertex (1: the camera hit) after which Russian roulette is played, when on
+    /// (Mitsuba's `rr_depth`; 1 in `.test` scenes; hashed only when not 1)
+    pub rr_depth: u32,
     /// Mitsuba's `hide_emitters`: camera rays see no emitter (area lights, emissive materials and
     /// the environment are black where a camera ray meets them; their light still reaches other
     /// surfaces). Hashed only when set.
@@ -326,6 +329,10 @@ impl SceneDesc {
         if self.hide_emitters {
             h.word(0x6869_6465);
         }
+        if self.rr_depth != 1 {
+            h.word(0x7272_6400);
+            h.word(self.rr_depth);
+        }
         if self.sensor.is_some() || self.filter != PixelFilter::Box {
             let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
         }
@@ -414,6 +421,7 @@ impl Default for SceneDesc {
             nee: Nee::Off,
             russian_roulette: false,
             hide_emitters: false,
+            rr_depth: 1,
             importance_sampling: ImportanceSampling::Hemisphere,
             materials: Vec::new(),
             triangles: Vec::new(),

@@ -487,7 +487,7 @@ impl Bounce<'_> {
                 shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO) & leaves(wi);
             let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
             let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
-            if it.path.russian_roulette {
+            if it.path.russian_roulette && self.v >= it.path.rr_depth {
                 let q = nb.max_elem().min(F8::ONE);
                 alive &= u_rr.simd_lt(q);
                 nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));
