@@ -7,7 +7,7 @@
 
 pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
 pub use crate::light::desc::{DeltaLightDesc, EnvironmentDesc, RgbImage};
-pub use crate::scene::sensor::{FovAxis, PixelFilter, Projection, SensorDesc};
+pub use crate::scene::sensor::{FilmCrop, FovAxis, PixelFilter, Projection, SensorDesc};
 use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
@@ -245,6 +245,8 @@ pub struct SceneDesc {
     pub environment: Option<EnvironmentDesc>,
     /// a Mitsuba sensor; when given it replaces `camera`
     pub sensor: Option<SensorDesc>,
+    /// the film's crop window, with a `sensor` only (`width` x `height` is the window)
+    pub crop: Option<FilmCrop>,
     /// the pixel filter (box: uniform jitter, every `.test` scene)
     pub filter: PixelFilter,
     /// point, spot, directional and projector lights (Mitsuba's), sampled at every next event
@@ -335,6 +337,9 @@ impl SceneDesc {
         }
         if self.sensor.is_some() || self.filter != PixelFilter::Box {
             let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
+        }
+        if let Some(c) = self.crop {
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{c:?}"));
         }
         for l in &self.delta_lights {
             match l {
@@ -437,6 +442,7 @@ impl Default for SceneDesc {
             directional_lights: Vec::new(),
             environment: None,
             sensor: None,
+            crop: None,
             filter: PixelFilter::Box,
             delta_lights: Vec::new(),
             emissive_materials: Vec::new(),
