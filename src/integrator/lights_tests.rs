@@ -131,3 +131,49 @@ fn constant_envmap_lights_a_diffuse_plane_to_albedo_times_radiance() {
         check(&format!("envmap {kind:?} {nee:?}"), render(d), |_, _, c| ALBEDO * 2.0 * colour[c]);
     }
 }
+
+/// `hide_emitters`: camera rays that escape see black instead of the sky, and an emissive triangle
+/// in view is black, while the sky still lights the plane (`albedo * L`), in `direct` and in the
+/// path tracer; without it the escaped pixels see `L`.
+#[test]
+fn hide_emitters_hides_what_camera_rays_see_only() {
+    const L: f32 = 2.0;
+    for (integrator, nee) in [(IntegratorKind::Direct, Nee::Mis), (IntegratorKind::PathTracer, Nee::Mis)] {
+        for hide in [false, true] {
+            let mut d = plane_scene(integrator, nee);
+            // The plane covers only x < 0 (image columns 0..8); columns 8.. look past it.
+            let c = [
+                Vec3::new(-2.0, -2.0, 0.0),
+                Vec3::new(0.0, -2.0, 0.0),
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::new(-2.0, 2.0, 0.0),
+            ];
+            d.triangles = vec![
+                TriangleDesc { v: [c[0], c[1], c[2]], material: 0 },
+                TriangleDesc { v: [c[0], c[2], c[3]], material: 0 },
+            ];
+            // A small emitter in view over the empty half, facing the sensor (+z), above it.
+            let e = [Vec3::new(0.5, -0.5, -0.5), Vec3::new(0.9, -0.5, -0.5), Vec3::new(0.9, -0.1, -0.5)];
+            d.emissive_triangles.push(EmissiveTriangleDesc { v: e, radiance: Vec3::splat(5.0) });
+            d.environment = Some(EnvironmentDesc::Constant(Vec3::splat(L)));
+            d.hide_emitters = hide;
+            d.spp = 16;
+            let (mean, _) = render(d);
+            let at = |x: u32, y: u32| mean[(y * W + x) as usize];
+            // Pixel (2, 2): on the plane (lit by the sky, the emitter below the plane is hidden
+            // from it by the plane's own facing only in part: compare loosely); (13, 2): sky.
+            let sky_px = at(13, 2);
+            let plane_px = at(2, 2);
+            let emitter_px = at(14, 11);
+            if hide {
+                assert_eq!(sky_px, [0.0; 3], "{integrator:?}: escaped camera ray sees {sky_px:?}");
+                assert_eq!(emitter_px, [0.0; 3], "{integrator:?}: the emitter is seen: {emitter_px:?}");
+                assert!(plane_px[0] > 0.5 * ALBEDO * L, "{integrator:?}: plane {plane_px:?}");
+            } else {
+                assert_eq!(sky_px, [L; 3], "{integrator:?}");
+                assert_eq!(emitter_px, [5.0; 3], "{integrator:?}");
+                assert!(plane_px[0] > 0.5 * ALBEDO * L, "{integrator:?}: plane {plane_px:?}");
+            }
+        }
+    }
+}

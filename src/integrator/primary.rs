@@ -67,14 +67,15 @@ fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>
         *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
     }
     ctx.tracer.intersect_all(&mut wave.rh, RayKind::Camera);
-    // Gather: hit records to SoA shading records; emission.
+    // Gather: hit records to SoA shading records; emission (none seen under `hide_emitters`).
+    let hide = ctx.scene.desc.hide_emitters;
     for ((rh, traced), sh) in wave.rh.iter().zip(wave.hits.iter_mut()) {
         ctx.scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced), sh);
-        out.push(masked(sh.emitted + sh.le, sh.valid));
+        out.push(if hide { Vec3x8::ZERO } else { masked(sh.emitted + sh.le, sh.valid) });
     }
     // Camera rays that leave the scene see the environment (none in `.test` scenes).
     let scene = ctx.scene;
-    if scene.sky.is_some() || scene.envmap.is_some() {
+    if !hide && (scene.sky.is_some() || scene.envmap.is_some()) {
         for ((rh, traced), (sh, o)) in wave.rh.iter().zip(wave.hits.iter().zip(out.iter_mut())) {
             let missed = *traced & !sh.valid;
             if missed.none() {

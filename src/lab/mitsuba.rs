@@ -54,12 +54,7 @@ pub const CORPUS: &[(&str, Expect)] = &[
     ("orthographic_sensor/test_orthographic_path.xml", Expect::Pass),
     ("projector/test_projector_constant_direct.xml", Expect::Pass),
     ("projector/test_projector_textured_direct.xml", Expect::Pass),
-    (
-        "spot_light/test_spot_direct.xml",
-        Expect::Fails(
-            "about 90 % of pixel channels accepted: the spot's textured cone differs at texel scale (not found yet)",
-        ),
-    ),
+    ("spot_light/test_spot_direct.xml", Expect::Pass),
     ("texture_interp/test_texture_interp_direct.xml", Expect::Pass),
     ("various_emitters/test_various_emitters_ptracer.xml", Expect::Refused("particle tracer")),
     (

@@ -17,7 +17,7 @@
 
 use crate::accel::{self, INVALID_ID};
 use crate::light::emitters::{Emitter, Emitters};
-use crate::scene::desc::{CameraDesc, Material, Projection, SceneDesc, SensorDesc};
+use crate::scene::desc::{CameraDesc, FilmCrop, Material, Projection, SceneDesc, SensorDesc};
 use crate::simd::{Vec3x8, F8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
@@ -110,6 +110,26 @@ impl Camera {
         let eye = m.w_axis.truncate();
         let look = cz.normalize_or(Vec3::Z);
         Self { eye, look, right: -cx, up: cy, plane_dist: 1.0, width, height, lens, filter: None }
+    }
+
+    /// This full-frame sensor camera restricted to the `width` x `height` window of `crop`: image
+    /// position (x, y) of the window makes the ray of (x + crop.x, y + crop.y) in the full frame
+    /// (the lens' affine map rescaled, so the ray code is the same). A pinhole is left as is.
+    pub fn cropped(mut self, crop: FilmCrop, width: u32, height: u32) -> Self {
+        // 2 (x + ox) / W - 1 = (w / W) (2 x / w - 1) + (w + 2 ox) / W - 1, likewise for y.
+        let (sx, tx) = (width as f32 / self.width as f32, (width + 2 * crop.x) as f32 / self.width as f32 - 1.0);
+        let (sy, ty) = (height as f32 / self.height as f32, (height + 2 * crop.y) as f32 / self.height as f32 - 1.0);
+        match &mut self.lens {
+            Lens::Pinhole => return self,
+            Lens::Perspective { base: c, ax, ay, .. } | Lens::Orthographic { centre: c, ax, ay, .. } => {
+                *c += *ax * tx + *ay * ty;
+                *ax *= sx;
+                *ay *= sy;
+            }
+        }
+        self.width = width;
+        self.height = height;
+        self
     }
 
     /// The camera's rays (origins, unit directions) through image positions (x, y) in pixels,
@@ -405,7 +425,10 @@ impl Scene {
     /// [`Scene::degenerate_dropped`].
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
         let mut camera = match (&desc.sensor, desc.camera) {
-            (Some(s), _) => Camera::from_sensor(s, desc.width, desc.height),
+            (Some(s), _) => match desc.crop {
+                Some(c) => Camera::from_sensor(s, c.full_width, c.full_height).cropped(c, desc.width, desc.height),
+                None => Camera::from_sensor(s, desc.width, desc.height),
+            },
             (None, Some(c)) => Camera::new(&c, desc.width, desc.height),
             (None, None) => return Err(BuildError::NoCamera(desc.source.clone())),
         };
@@ -679,6 +702,30 @@ mod tests {
         let left = up.normalize().cross(dir).normalize();
         let new_up = dir.cross(left);
         Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0))
+    }
+
+    /// A crop window's camera makes the full frame's rays at the offset pixels, for both lenses.
+    #[test]
+    fn cropped_camera_makes_the_full_frames_rays() {
+        use crate::scene::desc::{FilmCrop, FovAxis, Projection, SensorDesc};
+        let m = lookat(Vec3::new(0.3, 1.0, 5.0), Vec3::new(0.0, 0.5, 0.0), Vec3::Y);
+        for projection in [Projection::Perspective { fov_deg: 40.0, fov_axis: FovAxis::X }, Projection::Orthographic] {
+            let s = SensorDesc { to_world: m, projection, near_clip: 0.5 };
+            let full = Camera::from_sensor(&s, 200, 100);
+            let crop = FilmCrop { full_width: 200, full_height: 100, x: 30, y: 20 };
+            let cam = Camera::from_sensor(&s, 200, 100).cropped(crop, 50, 40);
+            assert_eq!((cam.width, cam.height), (50, 40));
+            for (x, y) in [(0.0, 0.0), (50.0, 40.0), (12.25, 33.5), (49.9, 0.1)] {
+                let (o, d) = cam.ray(x, y);
+                let (fo, fd) = full.ray(x + 30.0, y + 20.0);
+                assert!(
+                    (o - fo).length() < 1e-5 && (d - fd).length() < 1e-6,
+                    "{projection:?} ({x}, {y}): {o} {d} vs {fo} {fd}"
+                );
+                let (o8, d8) = cam.rays8(crate::simd::F8::splat(x), crate::simd::F8::splat(y));
+                assert_eq!((o8.lane(3), d8.lane(3)), (o, d), "x8 and scalar agree");
+            }
+        }
     }
 
     #[test]

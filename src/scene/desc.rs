@@ -7,7 +7,7 @@
 
 pub use crate::bsdf::desc::{BrdfKind, ImportanceSampling, Material};
 pub use crate::light::desc::{DeltaLightDesc, EnvironmentDesc, RgbImage};
-pub use crate::scene::sensor::{FovAxis, PixelFilter, Projection, SensorDesc};
+pub use crate::scene::sensor::{FilmCrop, FovAxis, PixelFilter, Projection, SensorDesc};
 use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
@@ -198,6 +198,13 @@ pub struct SceneDesc {
     pub nee: Nee,
     /// Russian roulette
     pub russian_roulette: bool,
+    /// the first path vertex (1: the camera hit) after which Russian roulette is played, when on
+    /// (Mitsuba's `rr_depth`; 1 in `.test` scenes; hashed only when not 1)
+    pub rr_depth: u32,
+    /// Mitsuba's `hide_emitters`: camera rays see no emitter (area lights, emissive materials and
+    /// the environment are black where a camera ray meets them; their light still reaches other
+    /// surfaces). Hashed only when set.
+    pub hide_emitters: bool,
     /// direction sampling of the path tracer
     pub importance_sampling: ImportanceSampling,
     /// distinct materials, referenced by index
@@ -238,6 +245,8 @@ pub struct SceneDesc {
     pub environment: Option<EnvironmentDesc>,
     /// a Mitsuba sensor; when given it replaces `camera`
     pub sensor: Option<SensorDesc>,
+    /// the film's crop window, with a `sensor` only (`width` x `height` is the window)
+    pub crop: Option<FilmCrop>,
     /// the pixel filter (box: uniform jitter, every `.test` scene)
     pub filter: PixelFilter,
     /// point, spot, directional and projector lights (Mitsuba's), sampled at every next event
@@ -319,8 +328,18 @@ impl SceneDesc {
             }
         }
         // The Mitsuba-side fields, likewise only when set.
+        if self.hide_emitters {
+            h.word(0x6869_6465);
+        }
+        if self.rr_depth != 1 {
+            h.word(0x7272_6400);
+            h.word(self.rr_depth);
+        }
         if self.sensor.is_some() || self.filter != PixelFilter::Box {
             let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
+        }
+        if let Some(c) = self.crop {
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{c:?}"));
         }
         for l in &self.delta_lights {
             match l {
@@ -406,6 +425,8 @@ impl Default for SceneDesc {
             light_selection: None,
             nee: Nee::Off,
             russian_roulette: false,
+            hide_emitters: false,
+            rr_depth: 1,
             importance_sampling: ImportanceSampling::Hemisphere,
             materials: Vec::new(),
             triangles: Vec::new(),
@@ -421,6 +442,7 @@ impl Default for SceneDesc {
             directional_lights: Vec::new(),
             environment: None,
             sensor: None,
+            crop: None,
             filter: PixelFilter::Box,
             delta_lights: Vec::new(),
             emissive_materials: Vec::new(),

@@ -85,6 +85,21 @@ pub struct SensorDesc {
     pub near_clip: f32,
 }
 
+/// A film's crop window (Mitsuba's `crop_offset_x/y`, `crop_width/height`): the image is the
+/// window's `SceneDesc::width` x `height` pixels at `(x, y)` of the full `full_width` x
+/// `full_height` frame, whose size alone sets the projection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FilmCrop {
+    /// the full frame's width in pixels
+    pub full_width: u32,
+    /// the full frame's height in pixels
+    pub full_height: u32,
+    /// the window's left column in the full frame
+    pub x: u32,
+    /// the window's top row in the full frame
+    pub y: u32,
+}
+
 /// Mitsuba's default `near_clip`.
 pub const DEFAULT_NEAR_CLIP: f32 = 0.01;
 

@@ -102,12 +102,15 @@ pub struct BitmapLimits {
     pub max_side: u32,
     /// Maximum width * height.
     pub max_texels: u64,
+    /// Maximum size of the file in bytes (checked before it is read).
+    pub max_file_bytes: u64,
 }
 
 impl Default for BitmapLimits {
-    /// 65536 texels a side, 2^27 texels (1.5 GiB of RGB f32).
+    /// 65536 texels a side, 2^27 texels (1.5 GiB of RGB f32), files up to 4 GiB (the scene
+    /// limit `max_file_bytes`' default).
     fn default() -> Self {
-        Self { max_side: 65536, max_texels: 1 << 27 }
+        Self { max_side: 65536, max_texels: 1 << 27, max_file_bytes: 4 << 30 }
     }
 }
 
@@ -166,10 +169,17 @@ impl Bitmap {
     }
 
     /// Reads `path` (PNG, JPEG, BMP, Radiance HDR or OpenEXR, told by its first bytes, else by
-    /// its extension), checking `limits` from the header before decoding.
+    /// its extension), checking `limits` from the header before decoding. The file is read once,
+    /// through `files::read_bounded` (a FIFO, device or directory is refused before opening; the
+    /// size is checked before reading), and decoded from memory.
     pub fn load(path: &Path, options: &BitmapOptions, limits: &BitmapLimits) -> Result<Self, TextureError> {
-        let (width, height, texels) =
-            if is_exr(path)? { read_exr(path, limits)? } else { read_image(path, options.raw, limits)? };
+        let bytes = crate::files::read_bounded(path, limits.max_file_bytes)
+            .map_err(|source| TextureError::Io { path: path.to_path_buf(), source })?;
+        let (width, height, texels) = if is_exr(path, &bytes) {
+            read_exr(path, &bytes, limits)?
+        } else {
+            read_image(path, &bytes, options.raw, limits)?
+        };
         Self::from_texels(width, height, texels, options.filter, options.wrap)
     }
 
@@ -330,16 +340,11 @@ fn sanitize_x8(x: F8) -> F8 {
 
 /// Whether `path` is an OpenEXR file: by its magic number, or by its extension when shorter
 /// than four bytes (then the EXR reader reports it truncated).
-fn is_exr(path: &Path) -> Result<bool, TextureError> {
-    use std::io::Read;
-    let io = |source| TextureError::Io { path: path.to_path_buf(), source };
-    let mut head = [0u8; 4];
-    let mut f = std::fs::File::open(path).map_err(io)?;
-    let n = f.read(&mut head).map_err(io)?;
-    if n == 4 {
-        return Ok(head == [0x76, 0x2f, 0x31, 0x01]);
+fn is_exr(path: &Path, bytes: &[u8]) -> bool {
+    match bytes.get(..4) {
+        Some(head) => head == [0x76, 0x2f, 0x31, 0x01],
+        None => path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")),
     }
-    Ok(path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")))
 }
 
 /// `width` x `height` against `limits`.
@@ -362,11 +367,18 @@ fn check_size(path: &Path, width: u64, height: u64, limits: &BitmapLimits) -> Re
 }
 
 /// A PNG/JPEG/BMP/HDR file through the `image` crate: header and size check, then decoding.
-fn read_image(path: &Path, raw: bool, limits: &BitmapLimits) -> Result<(u32, u32, Vec<[f32; 3]>), TextureError> {
+fn read_image(
+    path: &Path,
+    bytes: &[u8],
+    raw: bool,
+    limits: &BitmapLimits,
+) -> Result<(u32, u32, Vec<[f32; 3]>), TextureError> {
     let decode = |e: image::ImageError| TextureError::Decode { path: path.to_path_buf(), message: e.to_string() };
     let reader = || -> Result<image::ImageReader<_>, TextureError> {
-        let r =
-            image::ImageReader::open(path).map_err(|source| TextureError::Io { path: path.to_path_buf(), source })?;
+        let mut r = image::ImageReader::new(std::io::Cursor::new(bytes));
+        if let Ok(format) = image::ImageFormat::from_path(path) {
+            r.set_format(format);
+        }
         let r = r.with_guessed_format().map_err(|source| TextureError::Io { path: path.to_path_buf(), source })?;
         if r.format().is_none() {
             return Err(TextureError::Format { path: path.to_path_buf() });
@@ -414,10 +426,10 @@ fn read_image(path: &Path, raw: bool, limits: &BitmapLimits) -> Result<(u32, u32
 
 /// An OpenEXR file's first layer (its R, G, B channels, or Y as grey), size checked from the
 /// header before the pixels are read.
-fn read_exr(path: &Path, limits: &BitmapLimits) -> Result<(u32, u32, Vec<[f32; 3]>), TextureError> {
+fn read_exr(path: &Path, bytes: &[u8], limits: &BitmapLimits) -> Result<(u32, u32, Vec<[f32; 3]>), TextureError> {
     use exr::prelude::*;
     let err = |e: exr::error::Error| TextureError::Decode { path: path.to_path_buf(), message: e.to_string() };
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(err)?;
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).map_err(err)?;
     let header = meta
         .headers
         .first()
@@ -430,7 +442,7 @@ fn read_exr(path: &Path, limits: &BitmapLimits) -> Result<(u32, u32, Vec<[f32; 3
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
+        .from_buffered(std::io::Cursor::new(bytes))
         .map_err(err)?;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());

@@ -174,7 +174,7 @@ fn hostile_files_are_errors() {
     let e = Bitmap::load(f.path(), &opts, &lim).unwrap_err();
     assert!(matches!(e, TextureError::TooLarge { width: 100_000, .. }), "{e}");
     // Within the side limit but over the texel limit.
-    let small = BitmapLimits { max_side: 65536, max_texels: 3 };
+    let small = BitmapLimits { max_side: 65536, max_texels: 3, ..BitmapLimits::default() };
     let mut g = tempfile::Builder::new().suffix(".png").tempfile().unwrap();
     write_png(&mut g, 2, 2, &[0; 12]);
     assert!(matches!(Bitmap::load(g.path(), &opts, &small), Err(TextureError::TooLarge { .. })));
@@ -197,6 +197,16 @@ fn hostile_files_are_errors() {
     assert!(Bitmap::load(empty.path(), &opts, &lim).is_err());
     let e = Bitmap::load(Path::new("/nonexistent/x.png"), &opts, &lim).unwrap_err();
     assert!(matches!(e, TextureError::Io { .. }) && e.to_string().contains("/nonexistent/x.png"));
+    // A FIFO (nobody writes to it) is refused before it is opened, never waited on; a file over
+    // the byte limit is refused before it is read.
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("f.png");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let e = Bitmap::load(&fifo, &opts, &lim).unwrap_err();
+    assert!(matches!(e, TextureError::Io { .. }) && e.to_string().contains("is a FIFO"), "{e}");
+    let tiny = BitmapLimits { max_file_bytes: 10, ..lim };
+    let e = Bitmap::load(g.path(), &opts, &tiny).unwrap_err();
+    assert!(e.to_string().contains("above the limit of 10 bytes"), "{e}");
     // In memory: sizes that disagree.
     assert!(Bitmap::from_texels(2, 2, vec![[0.0; 3]; 3], FilterType::Nearest, WrapMode::Clamp).is_err());
     assert!(Bitmap::from_texels(0, 0, vec![], FilterType::Nearest, WrapMode::Clamp).is_err());

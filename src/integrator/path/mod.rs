@@ -213,7 +213,8 @@ fn path_tile<L: LobeSet>(
                 continue;
             }
             scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
-            let missed = *traced & !sh.valid;
+            // Under `hide_emitters` camera rays (v = 1) see no emitter.
+            let missed = if v == 1 && scene.desc.hide_emitters { Mask8::default() } else { *traced & !sh.valid };
             if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
                 let le = sky::escaped(it, sky, v, paths.get(PDF, ci), missed);
                 add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
@@ -234,8 +235,10 @@ fn path_tile<L: LobeSet>(
                 beta: paths.get3(BETA, ci),
             };
             let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
-            let le = b.emission(&vx, paths.get(PDF, ci), pp, pn);
-            add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
+            if v > 1 || !scene.desc.hide_emitters {
+                let le = b.emission(&vx, paths.get(PDF, ci), pp, pn);
+                add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
+            }
             b.shade::<L>(&vx);
         }
         // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
@@ -482,7 +485,7 @@ impl Bounce<'_> {
                 shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO) & leaves(wi);
             let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
             let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
-            if it.path.russian_roulette {
+            if it.path.russian_roulette && self.v >= it.path.rr_depth {
                 let q = nb.max_elem().min(F8::ONE);
                 alive &= u_rr.simd_lt(q);
                 nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));

@@ -302,15 +302,13 @@ impl Mesh {
     }
 }
 
-/// Reads `path` whole, refusing it when it has more than `max_bytes` bytes.
+/// Reads `path` whole through `files::open_regular` (a FIFO, device or directory is refused
+/// before opening), refusing it when it has more than `max_bytes` bytes (checked before reading).
 pub(crate) fn read_file(path: &Path, max_bytes: u64) -> Result<Vec<u8>, MeshError> {
-    use std::io::Read;
     let io = |source| MeshError::Io { file: path.to_path_buf(), source };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::new();
-    file.take(max_bytes.saturating_add(1)).read_to_end(&mut bytes).map_err(io)?;
-    check_limit(path, "bytes", bytes.len() as u64, max_bytes, "max_file_bytes")?;
-    Ok(bytes)
+    let (file, len) = crate::files::open_regular(path).map_err(io)?;
+    check_limit(path, "bytes", len, max_bytes, "max_file_bytes")?;
+    crate::files::read::read_all_of(file, len, max_bytes).map_err(io)
 }
 
 #[cfg(test)]

@@ -33,8 +33,7 @@ const DOUBLE: u32 = 0x2000;
 /// Loads shape `shape_index` (0-based) of a `.serialized` file within `limits`.
 pub fn load_serialized(path: &Path, shape_index: u32, limits: &Limits) -> Result<Mesh, MeshError> {
     let io = |source| MeshError::Io { file: path.to_path_buf(), source };
-    let mut file = std::fs::File::open(path).map_err(io)?;
-    let len = file.metadata().map_err(io)?.len();
+    let (mut file, len) = crate::files::open_regular(path).map_err(io)?;
     check_limit(path, "bytes", len, limits.max_file_bytes, "max_file_bytes")?;
     let bad = |at: Location, msg: String| MeshError::malformed(path, at, msg);
     if len < 8 {

@@ -136,3 +136,28 @@ fn instance_is_a_transformed_copy() {
     assert_eq!(desc.triangle_normals[1], [Vec3::Z; 3]);
     assert_eq!(desc.triangle_attrs.len(), 4, "each copy carries its attributes");
 }
+
+/// Every loader reads through `files::open_regular`: a FIFO (nobody writes to it) is refused
+/// before it is opened, never waited on, and a directory is refused too.
+#[test]
+fn loaders_refuse_fifos_and_directories() {
+    use crate::scene::limits::Limits;
+    let dir = tempfile::tempdir().unwrap();
+    let lim = Limits::default();
+    for name in ["f.ply", "f.serialized", "f.obj", "f.vol"] {
+        let fifo = dir.path().join(name);
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        for path in [fifo.as_path(), dir.path()] {
+            let e = match name {
+                "f.ply" => ply::load_ply(path, &lim),
+                "f.serialized" => serialized::load_serialized(path, 0, &lim),
+                "f.obj" => obj::load_obj(path, true, &lim),
+                _ => sdfgrid::load_sdfgrid(path, 1, &lim),
+            }
+            .unwrap_err()
+            .to_string();
+            assert!(e.contains("is a FIFO") || e.contains("is a directory"), "{name}: {e}");
+            assert!(e.contains(&path.display().to_string()), "{name}: {e}");
+        }
+    }
+}

@@ -20,9 +20,7 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     if bs < 0 {
         return Err(p.elem.at.err(format!("bsdf_samples {bs} must be >= 0")));
     }
-    if p.bool("hide_emitters", false)? {
-        return Err(p.elem.at.err("hide_emitters is not supported yet"));
-    }
+    b.desc.hide_emitters = p.bool("hide_emitters", false)?;
     b.desc.integrator = IntegratorKind::Direct;
     b.desc.light_samples = e as u32;
     Ok(())

@@ -1,7 +1,10 @@
-//! `<film type="hdrfilm">`: `width`, `height` (default 768 x 576), a full-frame crop, and its
+//! `<film type="hdrfilm">`: `width`, `height` (default 768 x 576), the crop window
+//! (`crop_offset_x/y`, `crop_width/height`: the image is the window, the projection the full
+//! frame's), and its
 //! nested `rfilter` (default: Mitsuba's gaussian). Output format settings are strata's own.
 
 use super::{Build, Plugin, Run};
+use crate::scene::desc::FilmCrop;
 use crate::scene::error::SceneError;
 use crate::scene::xml::props::Props;
 
@@ -22,11 +25,20 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     }
     let (cx, cy) = (p.int("crop_offset_x", 0)?, p.int("crop_offset_y", 0)?);
     let (cw, ch) = (p.int("crop_width", i64::from(w))?, p.int("crop_height", i64::from(h))?);
-    if (cx, cy, cw, ch) != (0, 0, i64::from(w), i64::from(h)) {
-        return Err(p.elem.at.err("a film crop window is not supported yet (render the full frame)"));
+    let inside = |o: i64, n: i64, full: u32| o >= 0 && n >= 1 && o + n <= i64::from(full);
+    if !inside(cx, cw, w) || !inside(cy, ch, h) {
+        return Err(p.elem.at.err(format!(
+            "crop window {cw}x{ch} at ({cx}, {cy}) does not fit in the {w}x{h} film (offsets >= 0, sizes >= 1)"
+        )));
     }
-    b.desc.width = w;
-    b.desc.height = h;
+    if (cx, cy, cw, ch) == (0, 0, i64::from(w), i64::from(h)) {
+        b.desc.width = w;
+        b.desc.height = h;
+    } else {
+        b.desc.width = cw as u32;
+        b.desc.height = ch as u32;
+        b.desc.crop = Some(FilmCrop { full_width: w, full_height: h, x: cx as u32, y: cy as u32 });
+    }
     // Output formatting: strata writes RGB float EXR (and PNG) itself.
     for name in ["pixel_format", "component_format", "file_format", "banner", "sample_border", "compensate"] {
         p.ignore(name);
