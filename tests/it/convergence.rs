@@ -223,9 +223,12 @@ fn every_sampler_converges_in_every_configuration() {
 
 /// `--light-warp solid-angle` in the matrix: on hw2 sphere (`direct`, every light, three
 /// rectangular quad lights) and hw3 cornellNEE (the path tracer, NEE, one rectangular quad light
-/// near the ceiling), for every sampler: no plateau (RMSE falls at least 1.8x from N to 4N spp),
-/// the block z-test against the area-sampled reference passes (the warp converges to the same
-/// image), and the MSE at 4N spp is below area sampling's with the same sampler and seed.
+/// near the ceiling; its direct lighting, max depth 1, and the scene's max depth 5), for every
+/// sampler: no plateau (RMSE falls at least 1.8x from N to 4N spp), the block z-test against the
+/// area-sampled reference passes (the warp converges to the same image), and the MSE at 4N spp
+/// is below area sampling's with the same sampler and seed. At depth 5 the light points are a
+/// small part of the variance (indirect light dominates; measured ratios 0.90..1.03), so there
+/// the bound is "not worse beyond noise": 1.1.
 #[test]
 fn solid_angle_warp_converges_with_lower_error_than_area_sampling() {
     use strata::integrator::LightWarp;
@@ -241,9 +244,10 @@ fn solid_angle_warp_converges_with_lower_error_than_area_sampling() {
         max_depth: None,
         reference: "path cornellNEE",
     };
+    let direct_nee = Case { name: "path-nee-d1 cornellNEE", max_depth: Some(1), ..nee.clone() };
     let (n, seed) = (64, 11);
     let mut failures = Vec::new();
-    for case in [sphere, nee] {
+    for (case, bound) in [(sphere, 1.0), (direct_nee, 1.0), (nee, 1.1)] {
         let with = |o: RenderOptions, warp| RenderOptions { light_warp: Some(warp), ..o };
         let reference = render(&options(&case, SamplerKind::INDEPENDENT, REF_SPP, 1_000_003));
         for kind in samplers() {
@@ -272,7 +276,7 @@ fn solid_angle_warp_converges_with_lower_error_than_area_sampling() {
             if !(z < 5.0) {
                 failures.push(format!("{} {}: block z {z:.2}", case.name, kind.name()));
             }
-            if !(ratio < 1.0) {
+            if !(ratio < bound) {
                 failures.push(format!("{} {}: MSE solid-angle / area {ratio:.3}", case.name, kind.name()));
             }
         }

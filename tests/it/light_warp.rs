@@ -108,8 +108,9 @@ fn solid_angle_agrees_with_area_sampling_on_quad_lights() {
 #[test]
 fn solid_angle_agrees_with_area_sampling_on_emissive_triangles() {
     let scene = triangles_and_quads();
-    for (k, sel) in
-        [LightSelection::All, LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial].into_iter().enumerate()
+    for (k, sel) in [LightSelection::All, LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial]
+        .into_iter()
+        .enumerate()
     {
         let o = RenderOptions { light_selection: Some(sel), ..base(&scene, (32, 32), 256, 10 + k as u64) };
         both(&format!("triangles mis {sel}"), o);
