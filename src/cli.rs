@@ -339,6 +339,12 @@ pub(crate) struct RenderArgs {
     /// (a sampler dimension of its own).
     #[arg(long, help_heading = LIGHTS, value_name = "MODE")]
     pub(crate) light_choice: Option<strata::integrator::LightChoice>,
+    /// How a point is placed on the chosen area light (direct and the path tracer): area (uniform
+    /// in area; default) or solid-angle (uniform in the solid angle the light subtends: spherical
+    /// rectangles for rectangular quads, spherical triangles for emissive triangles; area sampling
+    /// where a light subtends less than 3e-4 sr). See docs/light-selection.md.
+    #[arg(long, help_heading = LIGHTS, value_name = "WARP")]
+    pub(crate) light_warp: Option<strata::integrator::LightWarp>,
     /// Light samples per light, at least 1 (default: the scene's lightsamples).
     #[arg(long, help_heading = LIGHTS, value_parser = parse_positive::<u32>)]
     pub(crate) light_samples: Option<u32>,
@@ -463,6 +469,7 @@ impl RenderArgs {
             sampler: self.sampler,
             light_sampler: self.light_sampler,
             light_choice: self.light_choice,
+            light_warp: self.light_warp,
             light_samples: self.light_samples,
             pixel_sampler: self.pixel_sampler,
             out: self.out,

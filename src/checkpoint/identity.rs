@@ -145,6 +145,7 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("light_samples", json!(it.light_set.n())),
         ("sampler", json!(it.path_set.set().kind().name())),
         ("light_choice", json!(it.light_choice.name())),
+        ("light_warp", json!(it.light_warp.name())),
         ("layout", json!(if time_budget { "time-budget" } else { "spp" })),
         ("gamma", json!(d.gamma)),
         ("clamp", json!(it.path.clamp)),

@@ -26,6 +26,7 @@ use crate::accel::Ray8;
 use crate::bsdf::LobeSet;
 use crate::light::emitters::{Emitter, LightSample8};
 use crate::light::select::LightChoice;
+use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::{PathDim, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
@@ -109,9 +110,18 @@ impl Group<'_> {
         active: Mask8,
     ) -> (LightSample8, Mask8) {
         match self {
-            Group::Quad(e) => (e.sample_x8(u, v), active),
+            Group::Quad(e) => {
+                let mut ls = e.sample_x8(u, v);
+                e.warp_x8(it.light_warp, &mut ls, sh.p, active);
+                (ls, active)
+            }
             // The triangle chosen by power from u, u remapped within its interval (`reuse`).
-            Group::Triangles => it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, (u, v)),
+            Group::Triangles => {
+                let (mut ls, ok) =
+                    it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, (u, v));
+                scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
+                (ls, ok)
+            }
         }
     }
 }
@@ -157,6 +167,9 @@ fn shade_all<L: LobeSet>(
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
     let streams = it.light_streams();
+    // Solid-angle points carry their own 1 / pdf_area per sample (`ls.area`); area ones share
+    // the quad's area, applied once per group.
+    let warped = it.light_warp == LightWarp::SolidAngle;
     shading_lanes(scene, hits, sc);
     for (gi, group) in groups(scene).enumerate() {
         let dim = LIGHT_POINT.at(gi as u32);
@@ -194,6 +207,7 @@ fn shade_all<L: LobeSet>(
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
                 let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
                 sc.contrib.push(match group {
+                    Group::Quad(_) if warped => f.scale(g * ls.area),
                     Group::Quad(_) => f.scale(g),
                     Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
                 });
@@ -210,7 +224,8 @@ fn shade_all<L: LobeSet>(
             trace_shadow_batch(tracer, shadow, contrib, owner, target);
         }
         if let Group::Quad(light) = group {
-            let scale = Vec3x8::splat(light.radiance).scale(inv_n * F8::splat(light.area));
+            let area = if warped { F8::ONE } else { F8::splat(light.area) };
+            let scale = Vec3x8::splat(light.radiance).scale(inv_n * area);
             for (o, acc) in out.iter_mut().zip(&sc.acc) {
                 *o += acc.mul_elem(scale);
             }
@@ -299,7 +314,7 @@ fn shade_one<L: LobeSet>(
             } else {
                 table.point(smp, pks[i].pixel, k)
             };
-            let (ls, ok) = if one_light {
+            let (mut ls, ok) = if one_light {
                 // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
@@ -316,6 +331,7 @@ fn shade_one<L: LobeSet>(
                 it.light_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, v))
             };
             j += 1;
+            scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
             let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
             let g = g * ls.area * ls.inv_pmf * inv_n;
             sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));

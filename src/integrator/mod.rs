@@ -37,6 +37,7 @@ pub mod whitted;
 
 pub use crate::camera::{FirstSample, DIM_CAMERA};
 pub use crate::light::select::{LightChoice, LightSampler, LightSelection};
+pub use crate::light::warp::LightWarp;
 pub use context::{TileCtx, Tracer};
 pub use direct::DIM_LIGHT_BASE;
 pub use estimator::Estimator;

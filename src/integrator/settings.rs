@@ -76,6 +76,8 @@ pub struct Integrator {
     pub light_selection: LightSelection,
     /// where a one-light choice takes its number from (`--light-choice`; default reuse)
     pub light_choice: LightChoice,
+    /// how a point is placed on the chosen area light (`--light-warp`; `new` gives area)
+    pub light_warp: crate::light::warp::LightWarp,
     /// the light sampler of `light_selection` over the scene's emitters (shared by the threads)
     pub light_sampler: std::sync::Arc<LightSampler>,
     /// `direct` under `all`: the power choice among the emissive triangles (one sampling group)
@@ -106,6 +108,7 @@ impl Integrator {
             first_sample: FirstSample::Jittered,
             light_selection: LightSelection::UNIFORM,
             light_choice: LightChoice::Reuse,
+            light_warp: crate::light::warp::LightWarp::Area,
             light_sampler: std::sync::Arc::new(LightSampler::new(&scene.emitters.list, LightSelection::UNIFORM)),
             triangle_sampler: std::sync::Arc::new(LightSampler::over_range(
                 &scene.emitters.list,

@@ -443,7 +443,11 @@ fn convergence(variant: &str, runs: &[RunRow]) -> Convergence {
 /// the light choice.
 fn samplers_ran(it: &crate::integrator::Integrator) -> String {
     let [pixel, light, path] = it.kinds().map(|k| k.name());
-    format!("pixel {pixel}, light {light}, other {path}, choice {}", it.light_choice.name())
+    let warp = match it.light_warp {
+        crate::light::warp::LightWarp::Area => String::new(),
+        w => format!(", warp {}", w.name()),
+    };
+    format!("pixel {pixel}, light {light}, other {path}, choice {}{warp}", it.light_choice.name())
 }
 
 #[cfg(test)]

@@ -82,6 +82,7 @@ impl Emitter {
     /// sample of this light alone (`inv_pmf` 1, index 0); bit-identical to the gathered
     /// [`Emitters::sample_x8`] of the same light.
     pub fn sample_x8(&self, u: F8, v: F8) -> LightSample8 {
+        let (u0, v0) = (u, v);
         let fold = if self.triangle { (u + v).simd_gt(F8::ONE) } else { Mask8::splat(0.0) };
         let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
         let s = Vec3x8::splat;
@@ -92,6 +93,7 @@ impl Emitter {
             area: F8::splat(self.area),
             inv_pmf: F8::ONE,
             light: U8::splat(0),
+            uv: (u0, v0),
         }
     }
 }
@@ -105,12 +107,17 @@ pub struct LightSample8 {
     pub normal: Vec3x8,
     /// its radiance
     pub radiance: Vec3x8,
-    /// its area (the point's pdf is 1 / (area * inv_pmf) per unit area)
+    /// 1 / (the point's pdf per unit area on its light): the light's area when the point is
+    /// uniform in area, `S d^2 / cos_l` where `light::warp` placed it uniformly in the solid
+    /// angle S the light subtends (its pdf per unit area is then 1 / (area * inv_pmf) either way)
     pub area: F8,
     /// 1 / probability of having chosen it
     pub inv_pmf: F8,
     /// index into [`Emitters::list`]
     pub light: U8,
+    /// the unit-square sample the point was placed from (after a `reuse` remap of u, before a
+    /// triangle's fold), for `light::warp` to place it again by solid angle
+    pub uv: (F8, F8),
 }
 
 /// The scene's area lights.
@@ -171,6 +178,7 @@ impl Emitters {
             area: F8::new(es.map(|e| e.area)),
             inv_pmf,
             light: idx,
+            uv: (u, v),
         }
     }
 
@@ -186,6 +194,7 @@ impl Emitters {
             area: F8::splat(e.area),
             inv_pmf,
             light: U8::splat(i),
+            uv: (u, v),
         }
     }
 }

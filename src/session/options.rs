@@ -35,6 +35,8 @@ pub struct RenderOptions {
     pub light_sampler: Option<SamplerKind>,
     /// where a one-light choice takes its number from (`--light-choice`; default reuse)
     pub light_choice: Option<crate::light::select::LightChoice>,
+    /// `--light-warp`: how a point is placed on the chosen area light (default area)
+    pub light_warp: Option<crate::light::warp::LightWarp>,
     /// light samples per light (default: the scene's `lightsamples`)
     pub light_samples: Option<u32>,
     /// pixel sample layout (default stratified)

@@ -185,6 +185,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     };
     let mut integrator = Integrator::new(&scene, spp, opts.seed, samplers, opts.light_samples);
     integrator.light_choice = opts.light_choice.unwrap_or(crate::light::select::LightChoice::Reuse);
+    integrator.light_warp = opts.light_warp.unwrap_or_default();
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }
@@ -219,6 +220,7 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
         let given = [
             ("--light-sampler", opts.light_sampler.is_some()),
             ("--light-choice", opts.light_choice.is_some()),
+            ("--light-warp", opts.light_warp.is_some()),
             ("--light-selection", opts.light_selection.is_some()),
         ];
         if let Some((flag, _)) = given.into_iter().find(|(_, on)| *on) {

@@ -30,6 +30,7 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "light_samples": out.integrator.light_set.n(),
         "sampler": out.integrator.path_set.set().kind().name(),
         "light_choice": out.integrator.light_choice.name(),
+        "light_warp": out.integrator.light_warp.name(),
         "rays": { "camera": c.camera, "shadow": c.shadow, "bounce": c.bounce, "total": c.total_rays() },
         "mrays_per_sec": out.stats.mrays_per_sec(),
         "packets": { "camera": c.camera_packets, "bounce": c.bounce_packets, "shadow": c.shadow_packets },

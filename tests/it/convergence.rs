@@ -222,6 +222,69 @@ fn every_sampler_converges_in_every_configuration() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// `--light-warp solid-angle` in the matrix: on hw2 sphere (`direct`, every light, three
+/// rectangular quad lights) and hw3 cornellNEE (the path tracer, NEE, one rectangular quad light
+/// near the ceiling; its direct lighting, max depth 1, and the scene's max depth 5), for every
+/// sampler: no plateau (RMSE falls at least 1.8x from N to 4N spp), the block z-test against the
+/// area-sampled reference passes (the warp converges to the same image), and the MSE at 4N spp
+/// is below area sampling's with the same sampler and seed. At depth 5 the light points are a
+/// small part of the variance (indirect light dominates; measured ratios 0.90..1.03), so there
+/// the bound is "not worse beyond noise": 1.1.
+#[test]
+fn solid_angle_warp_converges_with_lower_error_than_area_sampling() {
+    use strata::integrator::LightWarp;
+    let c = common::corpus_required();
+    let sphere = cases().into_iter().find(|c| c.name == "direct-all sphere").expect("case");
+    let nee = Case {
+        name: "path-nee cornellNEE",
+        scene: c.join("hw3/cornellNEE.test"),
+        integrator: IntegratorKind::PathTracer,
+        selection: LightSelection::All,
+        nee: None,
+        strategy: None,
+        max_depth: None,
+        reference: "path cornellNEE",
+    };
+    let direct_nee = Case { name: "path-nee-d1 cornellNEE", max_depth: Some(1), ..nee.clone() };
+    let (n, seed) = (64, 11);
+    let mut failures = Vec::new();
+    for (case, bound) in [(sphere, 1.0), (direct_nee, 1.0), (nee, 1.1)] {
+        let with = |o: RenderOptions, warp| RenderOptions { light_warp: Some(warp), ..o };
+        let reference = render(&options(&case, SamplerKind::INDEPENDENT, REF_SPP, 1_000_003));
+        for kind in samplers() {
+            let [area, solid] = [LightWarp::Area, LightWarp::SolidAngle].map(|w| {
+                let lo = render(&with(options(&case, kind, n, seed), w)).0;
+                let hi = render(&with(options(&case, kind, 4 * n, seed), w));
+                (mse(&lo, &reference).max(0.0), mse(&hi.0, &reference).max(0.0), hi)
+            });
+            let fall = (solid.0 / solid.1).sqrt();
+            let z = block_z(&solid.2, &reference, size(&case.scene));
+            let ratio = solid.1 / area.1;
+            eprintln!(
+                "{:<20} {:<12} solid-angle RMSE {n} spp {:.5}, {} spp {:.5} (falls {fall:.2}x), block z {z:.2}; \
+                 MSE solid-angle / area at {n} spp {:.3}, at {} spp {ratio:.3}",
+                case.name,
+                kind.name(),
+                solid.0.sqrt(),
+                4 * n,
+                solid.1.sqrt(),
+                solid.0 / area.0,
+                4 * n
+            );
+            if !(fall >= 1.8) {
+                failures.push(format!("{} {}: RMSE fell only {fall:.2}x", case.name, kind.name()));
+            }
+            if !(z < 5.0) {
+                failures.push(format!("{} {}: block z {z:.2}", case.name, kind.name()));
+            }
+            if !(ratio < bound) {
+                failures.push(format!("{} {}: MSE solid-angle / area {ratio:.3}", case.name, kind.name()));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 /// Low-discrepancy samplers converge faster than Monte Carlo on a smooth direct-lighting scene
 /// (`scenes/three_lights.test`: three coloured area lights over an unoccluded diffuse floor, one
 /// light sample per pixel sample, the light chosen uniformly): a

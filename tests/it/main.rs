@@ -18,6 +18,7 @@ mod golden;
 mod kernels;
 mod layering;
 mod light_selection;
+mod light_warp;
 mod mitsuba_corpus;
 mod normals;
 mod obj;

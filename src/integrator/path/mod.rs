@@ -28,6 +28,7 @@ use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
 use crate::light::emitters::LightSample8;
 use crate::light::select::LightChoice;
+use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
@@ -325,7 +326,7 @@ impl Bounce<'_> {
                     // N points on every light: multi-sample MIS against N p_light.
                     F8::splat(it.light_set.n().max(1) as f32)
                 };
-                let p_light = light_pdf_at_hit_pmf(self.scene, sh, vx.rh, is_light, pmf);
+                let p_light = light_pdf_at_hit_pmf(it, self.scene, sh, vx.rh, is_light, pmf);
                 power_heuristic_x8(pdf, p_light, is_light)
             }
         };
@@ -423,7 +424,9 @@ impl Bounce<'_> {
                 {
                     let ls = {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                        scene.emitters.list[0].sample_x8(u, w)
+                        let mut ls = scene.emitters.list[0].sample_x8(u, w);
+                        scene.emitters.list[0].warp_x8(it.light_warp, &mut ls, sh.p, shade);
+                        ls
                     };
                     push(&ls, None, None, shade)
                 }
@@ -442,7 +445,9 @@ impl Bounce<'_> {
                             let (uj, wj) = lattice_point(u, w, j, n_all);
                             let ls = {
                                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                                e.sample_x8(uj, wj)
+                                let mut ls = e.sample_x8(uj, wj);
+                                e.warp_x8(it.light_warp, &mut ls, sh.p, shade);
+                                ls
                             };
                             push(&ls, scale, mis_n, shade);
                         }
@@ -455,11 +460,13 @@ impl Bounce<'_> {
                     let (ls, ok) = {
                         let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                         let ls = &it.light_sampler;
-                        if own_choice {
+                        let (mut ls, ok) = if own_choice {
                             ls.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
                         } else {
                             ls.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, w))
-                        }
+                        };
+                        scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
+                        (ls, ok)
                     };
                     push(&ls, None, None, ok);
                 }
@@ -563,9 +570,12 @@ impl Bounce<'_> {
 }
 
 /// Solid-angle pdf of NEE at a light hit for a light chosen with probability `pmf` (per lane):
-/// pmf d^2 / (A cos_l); zero where `is_light` is off or `pmf` is 0.
+/// pmf d^2 / (A cos_l), or pmf / S where `--light-warp solid-angle` samples the light by its solid
+/// angle S seen from the ray's origin (`Emitters::solid_angle_x8`); zero where `is_light` is off
+/// or `pmf` is 0.
 #[inline]
 fn light_pdf_at_hit_pmf(
+    it: &Integrator,
     scene: &Scene,
     sh: &crate::scene::build::SurfaceHit8,
     rh: &RayHit8,
@@ -578,7 +588,13 @@ fn light_pdf_at_hit_pmf(
     let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
     let t = F8::new(rh.ray.tfar);
     let cos_l = ln.dot(sh.wo);
-    let p = pmf * t * t / (area * cos_l);
+    let mut p = pmf * t * t / (area * cos_l);
+    if it.light_warp == LightWarp::SolidAngle {
+        let r = &rh.ray;
+        let origin = Vec3x8::new(F8::new(r.org_x), F8::new(r.org_y), F8::new(r.org_z));
+        let (omega, warped) = scene.emitters.solid_angle_x8(sh.light, origin, is_light);
+        p = warped.select(pmf / omega, p);
+    }
     is_light.select(p, F8::ZERO)
 }
 

@@ -1,0 +1,216 @@
+//! `--light-warp area|solid-angle`: how a point is placed on the chosen area light.
+//!
+//! `area` (the default) places it uniformly in area (`emitters.rs`). `solid-angle` places it
+//! uniformly in the solid angle S the light subtends at the shading point: spherical rectangles
+//! for rectangular quad lights (`sampling::spherical_rect`), spherical triangles for emissive
+//! triangles (`sampling::spherical_tri`). The 2D point is the same sampler point the area warp
+//! would have used ([`LightSample8::uv`]), so stratification and low discrepancy carry through.
+//!
+//! A lane is warped where the light is a rectangle or a triangle (a skewed parallelogram quad is
+//! not: area sampling), the point lies on the light's emitting side, and S >= [`OMEGA_MIN`];
+//! elsewhere the area sample stays (below `OMEGA_MIN` the f32 warp no longer resolves the light,
+//! see the constant). The decision is a function of (light, point) only, so the pdf of a
+//! BSDF-sampled light hit ([`Emitters::solid_angle_x8`]) is the one next event estimation used.
+//!
+//! A warped sample keeps the integrators' area form: its `area` becomes `S d^2 / cos_l`, so
+//! `cos_l / (d^2 area) = 1 / S` is its pdf per unit area converted to solid angle and
+//! `L f cos_i cos_l area / d^2 = L f cos_i S` its estimate.
+
+use super::emitters::{Emitter, Emitters, LightSample8};
+use crate::sampling::spherical_rect::SphericalRect8;
+use crate::sampling::spherical_tri::SphericalTri8;
+use crate::simd::{mask_from_bools, Mask8, Vec3x8, F8, U8};
+
+/// Smallest solid angle (sr) sampled by the warps; a light subtending less is sampled by area.
+///
+/// Measured (`light::warp::tests::f32_warp_error_by_solid_angle`, `--nocapture`): the largest
+/// distance between the f32 warps' points and the same warps in f64, over a 65 x 65 grid of
+/// (u, v), relative to the size of a unit light seen head-on. The rectangle's error grows as 1/S
+/// (its `au = u S + k` keeps `ulp(k) / S` of u's resolution): 2.2e-5 at S = 1e-2, 1.7e-4 at
+/// 1.1e-3, 2.1e-3 at 1e-4, 1.7e-2 at 1.1e-5. The triangle's (half-angle form, see
+/// `sampling::spherical_tri`) stays below 2e-5 down to 1e-6 sr. At 3e-4 sr the rectangle is
+/// within 1e-3 of its light; a unit light is then 58 units away, where area sampling's density
+/// is within 3e-4 of uniform in solid angle anyway, so nothing is lost by falling back there.
+pub const OMEGA_MIN: f32 = 3e-4;
+
+/// Relative tolerance of `|ab . ac| / (|ab| |ac|)` for a quad light to count as a rectangle.
+const RECT_TOL: f32 = 1e-4;
+
+/// How next event estimation places a point on an area light (`--light-warp`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum LightWarp {
+    /// uniform in area (the course's convention; the default)
+    #[default]
+    Area,
+    /// uniform in the solid angle the light subtends (spherical rectangles and triangles)
+    SolidAngle,
+}
+
+impl LightWarp {
+    /// Every warp with its name, in a fixed order.
+    pub const ALL: [(LightWarp, &'static str); 2] = [(Self::Area, "area"), (Self::SolidAngle, "solid-angle")];
+
+    /// Name (`area`, `solid-angle`).
+    pub fn name(self) -> &'static str {
+        Self::ALL.iter().find(|(c, _)| *c == self).map(|(_, n)| *n).unwrap_or("area")
+    }
+}
+
+impl std::str::FromStr for LightWarp {
+    type Err = super::select::UnknownName;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL.iter().find(|(_, n)| n.eq_ignore_ascii_case(s.trim())).map(|(c, _)| *c).ok_or_else(|| {
+            super::select::UnknownName {
+                what: "light warp",
+                name: s.into(),
+                known: Self::ALL.map(|(_, n)| n).join(", "),
+            }
+        })
+    }
+}
+
+impl Emitter {
+    /// A quad light whose edges are orthogonal (within [`RECT_TOL`]): sampled by spherical
+    /// rectangles.
+    pub fn is_rectangle(&self) -> bool {
+        !self.triangle && self.ab.dot(self.ac).abs() <= RECT_TOL * self.ab.length() * self.ac.length()
+    }
+}
+
+/// Eight lanes' lights, gathered or splatted.
+struct Lights8 {
+    a: Vec3x8,
+    ab: Vec3x8,
+    ac: Vec3x8,
+    normal: Vec3x8,
+    tri: Mask8,
+    rect: Mask8,
+    any_tri: bool,
+    any_rect: bool,
+}
+
+impl Lights8 {
+    fn one(e: &Emitter) -> Self {
+        let s = Vec3x8::splat;
+        let (tri, rect) = (e.triangle, e.is_rectangle());
+        Self {
+            a: s(e.a),
+            ab: s(e.ab),
+            ac: s(e.ac),
+            normal: s(e.normal),
+            tri: mask_from_bools([tri; 8]),
+            rect: mask_from_bools([rect; 8]),
+            any_tri: tri,
+            any_rect: rect,
+        }
+    }
+
+    fn lanes(list: &[Emitter], ids: U8, active: Mask8) -> Self {
+        let ids = ids.to_array();
+        if ids.iter().all(|&i| i == ids[0]) {
+            if let Some(e) = list.get(ids[0] as usize) {
+                return Self::one(e);
+            }
+        }
+        let on = crate::simd::mask_to_bools(active);
+        let es: [Option<&Emitter>; 8] = std::array::from_fn(|i| list.get(ids[i] as usize).filter(|_| on[i]));
+        let tri = es.map(|e| e.is_some_and(|e| e.triangle));
+        let rect = es.map(|e| e.is_some_and(Emitter::is_rectangle));
+        let get = |f: fn(&Emitter) -> glam::Vec3| Vec3x8::from_lanes(es.map(|e| e.map_or(glam::Vec3::ZERO, f)));
+        Self {
+            a: get(|e| e.a),
+            ab: get(|e| e.ab),
+            ac: get(|e| e.ac),
+            normal: get(|e| e.normal),
+            tri: mask_from_bools(tri),
+            rect: mask_from_bools(rect),
+            any_tri: tri.contains(&true),
+            any_rect: rect.contains(&true),
+        }
+    }
+
+    /// The lights seen from `p` on lanes `active`: the warps, S per lane and the lanes warped.
+    fn subtend(&self, p: Vec3x8, active: Mask8) -> Subtended {
+        // Only the emitting side is lit; there every point of the (planar) light has cos_l > 0.
+        let front = self.normal.dot(p - self.a).simd_gt(F8::ZERO);
+        let rect = self.any_rect.then(|| {
+            let (lx, ly) = (self.ab.length(), self.ac.length());
+            let (ex, ey) = (self.ab.scale(F8::ONE / lx), self.ac.scale(F8::ONE / ly));
+            SphericalRect8::new(p, self.a, ex, ey, lx, ly)
+        });
+        let tri = self.any_tri.then(|| SphericalTri8::new(p, self.a, self.a + self.ab, self.a + self.ac));
+        let s_rect = rect.map_or(F8::ZERO, |r| self.rect.select(r.solid_angle(), F8::ZERO));
+        let s_tri = tri.map_or(F8::ZERO, |t| self.tri.select(t.solid_angle(), F8::ZERO));
+        let omega = self.tri.select(s_tri, s_rect);
+        let warped = active & front & (self.tri | self.rect) & omega.simd_ge(F8::splat(OMEGA_MIN));
+        Subtended { rect, tri, omega, warped }
+    }
+}
+
+/// Lights seen from a point ([`Lights8::subtend`]).
+struct Subtended {
+    rect: Option<SphericalRect8>,
+    tri: Option<SphericalTri8>,
+    omega: F8,
+    warped: Mask8,
+}
+
+/// Places the points of `ls` again, uniformly in solid angle about `p`, on the lanes of `active`
+/// that the warp covers (see the module docs); the other lanes keep their area sample.
+fn rewarp(l: &Lights8, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
+    let sub = l.subtend(p, active);
+    if sub.warped.none() {
+        return;
+    }
+    let (u, v) = ls.uv;
+    let mut y = ls.y;
+    if let Some(r) = sub.rect {
+        y = Vec3x8::select(sub.warped & l.rect, r.sample(u, v), y);
+    }
+    if let Some(t) = sub.tri {
+        y = Vec3x8::select(sub.warped & l.tri, t.sample(u, v), y);
+    }
+    let to = y - p;
+    let d2 = to.length_squared();
+    let cos_l_d = -l.normal.dot(to);
+    // S d^2 / cos_l with cos_l = cos_l_d / d.
+    let area = sub.omega * d2 * d2.sqrt() / cos_l_d;
+    let ok = sub.warped & area.simd_gt(F8::ZERO) & area.is_finite();
+    ls.y = Vec3x8::select(ok, y, ls.y);
+    ls.area = ok.select(area, ls.area);
+}
+
+impl Emitter {
+    /// [`Emitter::sample_x8`]'s points `ls` (of this light) placed again by solid angle about `p`
+    /// where the warp applies (module docs), on the lanes `active`.
+    #[inline]
+    pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
+        if warp == LightWarp::SolidAngle && (self.triangle || self.is_rectangle()) {
+            rewarp(&Lights8::one(self), ls, p, active);
+        }
+    }
+}
+
+impl Emitters {
+    /// Points `ls` of the lights `ls.light` (per lane) placed again by solid angle about `p`
+    /// where the warp applies (module docs), on the lanes `active`.
+    #[inline]
+    pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
+        if warp == LightWarp::SolidAngle && active.any() {
+            rewarp(&Lights8::lanes(&self.list, ls.light, active), ls, p, active);
+        }
+    }
+
+    /// The solid angle S of lights `ids` seen from `p` and the lanes of `active` where
+    /// `solid-angle` sampling places points by it (pdf 1 / S per unit solid angle there): what
+    /// a BSDF-sampled hit of a light weighs its MIS with.
+    #[inline]
+    pub fn solid_angle_x8(&self, ids: U8, p: Vec3x8, active: Mask8) -> (F8, Mask8) {
+        let sub = Lights8::lanes(&self.list, ids, active).subtend(p, active);
+        (sub.omega, sub.warped)
+    }
+}
+
+#[cfg(test)]
+#[path = "warp_tests.rs"]
+mod tests;

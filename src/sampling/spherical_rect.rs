@@ -1,0 +1,125 @@
+//! Uniform sampling of the solid angle a rectangle subtends (Ureña, Fajardo and King 2013, "An
+//! Area-Preserving Parametrization for Spherical Rectangles").
+//!
+//! The rectangle is `corner + s ex + t ey`, s in [0, lx], t in [0, ly], with `ex`, `ey` orthonormal.
+//! In the frame (ex, ey, ez) at the reference point o, with ez turned away from the rectangle, its
+//! corners are (x0 | x1, y0 | y1, z0) with z0 < 0. The four great circles through o and its edges
+//! have unit normals n0..n3; the spherical rectangle's inner angles are g_i = pi/2 + asin(n_i .
+//! n_i+1), so its area is S = sum_i asin(n_i . n_i+1), written without the 2 pi that cancels in
+//! the paper's `g0 + g1 + g2 + g3 - 2 pi` (in f32 that cancellation loses every digit of a small
+//! S). u picks the x of the point by inverting the area to the left of x (the paper's
+//! `au = u S + k`), v its y uniformly in the height `h = y / sqrt(x^2 + y^2 + z0^2)` along the
+//! column, which is uniform in solid angle. The density is 1 / S per unit solid angle.
+//!
+//! Only the x8 form does arithmetic; the scalar form is lane 0 of it on splatted input, so the two
+//! are bit-identical. Precision: for a small S the argument `au`, near pi/2 .. pi, keeps
+//! `ulp(au) / S` of u's resolution; see `light::warp` for the solid angle under which the caller
+//! falls back to area sampling.
+
+use crate::simd::{Vec3x8, F8};
+use glam::Vec3;
+
+/// The spherical rectangle of a rectangle seen from a point, for 8 lanes: everything its
+/// sampling needs, computed once per shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct SphericalRect8 {
+    o: Vec3x8,
+    ex: Vec3x8,
+    ey: Vec3x8,
+    ez: Vec3x8,
+    x0: F8,
+    y0: F8,
+    z0: F8,
+    x1: F8,
+    y1: F8,
+    b0: F8,
+    b1: F8,
+    k: F8,
+    s: F8,
+}
+
+impl SphericalRect8 {
+    /// The rectangle `corner + s ex + t ey` (`ex`, `ey` orthonormal, s in [0, lx], t in [0, ly])
+    /// seen from `o`, per lane.
+    #[inline]
+    pub fn new(o: Vec3x8, corner: Vec3x8, ex: Vec3x8, ey: Vec3x8, lx: F8, ly: F8) -> Self {
+        let d = corner - o;
+        let ez0 = ex.cross(ey);
+        let z0 = d.dot(ez0);
+        // Turn ez away from the rectangle, so z0 <= 0.
+        let flip = z0.simd_gt(F8::ZERO);
+        let sgn = flip.select(-F8::ONE, F8::ONE);
+        let ez = ez0.scale(sgn);
+        let z0 = z0 * sgn;
+        let (x0, y0) = (d.dot(ex), d.dot(ey));
+        let (x1, y1) = (x0 + lx, y0 + ly);
+        let z2 = z0 * z0;
+        // Lengths of the unnormalized edge-plane normals (0, z0, -y0), (-z0, 0, x1), (0, -z0, y1),
+        // (z0, 0, -x0).
+        let l0 = y0.mul_add(y0, z2).sqrt();
+        let l1 = x1.mul_add(x1, z2).sqrt();
+        let l2 = y1.mul_add(y1, z2).sqrt();
+        let l3 = x0.mul_add(x0, z2).sqrt();
+        let clamp = |c: F8| c.max(-F8::ONE).min(F8::ONE);
+        let c0 = clamp(-(y0 * x1) / (l0 * l1));
+        let c1 = clamp((x1 * y1) / (l1 * l2));
+        let c2 = clamp(-(y1 * x0) / (l2 * l3));
+        let c3 = clamp((x0 * y0) / (l3 * l0));
+        let (a0, a1, a2, a3) = (c0.asin(), c1.asin(), c2.asin(), c3.asin());
+        let s = (a0 + a1) + (a2 + a3);
+        // k = 2 pi - g2 - g3.
+        let k = F8::PI - a2 - a3;
+        let (b0, b1) = (-y0 / l0, y1 / l2);
+        Self { o, ex, ey, ez, x0, y0, z0, x1, y1, b0, b1, k, s }
+    }
+
+    /// The solid angle S (0 or NaN-free; 0 where `o` lies in the rectangle's plane).
+    #[inline]
+    pub fn solid_angle(&self) -> F8 {
+        let ok = self.s.simd_gt(F8::ZERO) & self.s.is_finite();
+        ok.select(self.s, F8::ZERO)
+    }
+
+    /// The point of the rectangle for the unit-square sample `(u, v)`: uniform in solid angle
+    /// about `o` (density 1 / S). Lanes whose S is 0 give a point of no use (the caller falls
+    /// back to area sampling there).
+    #[inline]
+    pub fn sample(&self, u: F8, v: F8) -> Vec3x8 {
+        let Self { x0, y0, z0, x1, y1, b0, b1, k, s, .. } = *self;
+        let au = u.mul_add(s, k);
+        let (sin_au, cos_au) = au.sin_cos();
+        let fu = cos_au.mul_add(b0, -b1) / sin_au;
+        let r = F8::ONE / fu.mul_add(fu, b0 * b0).sqrt();
+        let cu = fu.simd_lt(F8::ZERO).select(-r, r).max(-F8::ONE).min(F8::ONE);
+        let tiny = F8::splat(f32::MIN_POSITIVE);
+        let xu = -(cu * z0) / (F8::ONE - cu * cu).max(tiny).sqrt();
+        let xu = xu.max(x0).min(x1);
+        let dd = xu.mul_add(xu, z0 * z0);
+        let h0 = y0 / y0.mul_add(y0, dd).sqrt();
+        let h1 = y1 / y1.mul_add(y1, dd).sqrt();
+        let hv = v.mul_add(h1 - h0, h0);
+        let hv2 = hv * hv;
+        let inside = hv2.simd_lt(F8::splat(1.0 - 1e-6));
+        let yv = inside.select(hv * dd.sqrt() / (F8::ONE - hv2).max(tiny).sqrt(), y1);
+        let yv = yv.max(y0).min(y1);
+        self.ez.mul_add(z0, self.ey.mul_add(yv, self.ex.mul_add(xu, self.o)))
+    }
+}
+
+/// Scalar [`SphericalRect8`]: the point for `(u, v)` and the solid angle S of the rectangle
+/// `corner + s ex + t ey` (s in [0, lx], t in [0, ly]) seen from `o`; lane 0 of the x8 form.
+#[allow(clippy::too_many_arguments)]
+pub fn sample_spherical_rect(
+    o: Vec3,
+    corner: Vec3,
+    ex: Vec3,
+    ey: Vec3,
+    lx: f32,
+    ly: f32,
+    u: f32,
+    v: f32,
+) -> (Vec3, f32) {
+    let s = Vec3x8::splat;
+    let r = SphericalRect8::new(s(o), s(corner), s(ex), s(ey), F8::splat(lx), F8::splat(ly));
+    (r.sample(F8::splat(u), F8::splat(v)).lane(0), r.solid_angle().as_array()[0])
+}
