@@ -80,10 +80,15 @@ pub struct BsdfParams {
     pub scalar: [f32; SCALARS],
 }
 
-impl Default for BsdfParams {
+impl BsdfParams {
     /// The course's material (two-sided, slots unused).
+    pub const COURSE: Self = Self { kind: COURSE, twosided: true, color: [Vec3::ZERO; COLORS], scalar: [0.0; SCALARS] };
+}
+
+impl Default for BsdfParams {
+    /// [`BsdfParams::COURSE`].
     fn default() -> Self {
-        Self { kind: COURSE, twosided: true, color: [Vec3::ZERO; COLORS], scalar: [0.0; SCALARS] }
+        Self::COURSE
     }
 }
 

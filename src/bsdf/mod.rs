@@ -36,7 +36,7 @@ pub mod desc;
 pub use desc::{BrdfKind, ImportanceSampling};
 pub use ggx::Ggx;
 pub use lobe::{AllLobes, Diffuse, DiffuseGgx, DiffusePhong, Lobe, LobeSet, Lobes};
-pub use material::{Material, Material8};
+pub use material::{Material, Material8, Sampled8};
 pub use phong::Phong;
 
 /// The BSDF registry: one line per BSDF file (`file: Type,`): declares the module, re-exports the
@@ -55,6 +55,9 @@ macro_rules! registry {
 registry! {
     conductor: Conductor,
     dielectric: Dielectric,
+    plastic: Plastic,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};
+#[cfg(test)]
+mod registry_tests;
