@@ -1,6 +1,12 @@
-//! The format's BRDFs (FORMAT.md, "Materials"): modified Phong and GGX with Smith G and Schlick F, each
-//! plus a Lambertian kd/pi, evaluated and importance-sampled in the local shading frame. Scalar
-//! [`Material`] and eight-lane [`Material8`] mirror each other line by line.
+//! Materials: the BSDF interface ([`interface`]: [`Bsdf`], its registry of one file per BSDF
+//! listed by `registry!` below, Fresnel terms in [`fresnel`]) and the course's materials, registry
+//! id 0: the format's BRDFs (FORMAT.md, "Materials"), modified Phong and GGX with Smith G and
+//! Schlick F, each plus a Lambertian kd/pi, evaluated and importance-sampled in the local shading
+//! frame. Scalar [`Material`] and eight-lane [`Material8`] mirror each other line by line;
+//! [`Material8`] shades course lanes and registry lanes of one packet together
+//! (`eval_pdf_k`, `sample_bsdf_k`).
+//!
+//! The rest of these docs describe the course's materials.
 //!
 //! Files: [`lobe`] (the [`Lobe`] trait, lobe sets, [`Lobes`]), [`diffuse`] (kd/pi and the cosine
 //! sampler), `phong.rs` and `ggx.rs` (one lobe each), [`material`] (the mixture and strategies).
@@ -56,6 +62,7 @@ registry! {
     conductor: Conductor,
     dielectric: Dielectric,
     plastic: Plastic,
+    thindielectric: ThinDielectric,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

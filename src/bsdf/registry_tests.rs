@@ -165,7 +165,11 @@ fn sample_weight_matches_eval_over_pdf() {
                     assert!((pdf - pdf_e).abs() <= 1e-5 * pdf.max(1.0), "{} row {r}: pdf {pdf} vs {pdf_e}", m.name);
                     let want = f * (wi.z.abs() / pdf_e);
                     let tol = 1e-4 * want.max_element().max(1e-6);
-                    assert!((w - want).abs().max_element() <= tol, "{} row {r}: weight {w} vs f cos/pdf {want}", m.name);
+                    assert!(
+                        (w - want).abs().max_element() <= tol,
+                        "{} row {r}: weight {w} vs f cos/pdf {want}",
+                        m.name
+                    );
                 }
             }
         }

@@ -198,6 +198,9 @@ pub struct SceneDesc {
     pub nee: Nee,
     /// Russian roulette
     pub russian_roulette: bool,
+    /// first path vertex (1: the camera hit) where Russian roulette is played (Mitsuba's
+    /// `rr_depth`; 1 for `.test` and OBJ scenes)
+    pub rr_depth: u32,
     /// direction sampling of the path tracer
     pub importance_sampling: ImportanceSampling,
     /// distinct materials, referenced by index
@@ -287,6 +290,7 @@ impl SceneDesc {
                         self.light_stratify,
                         self.nee,
                         self.russian_roulette,
+                        self.rr_depth,
                         self.importance_sampling
                     ),
                     (&self.materials, &self.spheres, &self.quad_lights, &self.point_lights, &self.directional_lights),
@@ -406,6 +410,7 @@ impl Default for SceneDesc {
             light_selection: None,
             nee: Nee::Off,
             russian_roulette: false,
+            rr_depth: 1,
             importance_sampling: ImportanceSampling::Hemisphere,
             materials: Vec::new(),
             triangles: Vec::new(),

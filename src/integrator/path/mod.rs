@@ -407,7 +407,8 @@ impl Bounce<'_> {
                 let wi = to.scale(inv_d);
                 let mut cos_i = sh.n.dot(wi);
                 let cos_l = -ln.dot(wi);
-                let mut lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
+                let mut lit =
+                    ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
                 // Transmitting lanes: lights below the surface too.
                 let below = if transmits && general.any() {
                     let below = ok & general & cos_i.simd_lt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
@@ -506,7 +507,9 @@ impl Bounce<'_> {
         // Continue the path: sample the BSDF, then Russian roulette.
         if bounce_here {
             // (Russian roulette, lobe choice): drawn only where one of them is used.
-            let (u_rr, u_lobe) = if it.path.russian_roulette || it.path.strategy == ImportanceSampling::Brdf {
+            // Registry BSDFs pick their lobe whatever the strategy.
+            let lobe_pick = it.path.strategy == ImportanceSampling::Brdf || <L::Bsdfs as BsdfSet>::BITS != 0;
+            let (u_rr, u_lobe) = if it.path.russian_roulette || lobe_pick {
                 self.smp.table_point(&self.dk[3], false, Phase::SamplerPath, pixel, s)
             } else {
                 (F8::ZERO, F8::ZERO)
@@ -537,7 +540,7 @@ impl Bounce<'_> {
                 pdf = (g & b.has(lobe_flags::DELTA)).select(F8::splat(-1.0), pdf);
             }
             let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
-            if it.path.russian_roulette {
+            if it.path.russian_roulette && v >= it.path.rr_depth {
                 let q = nb.max_elem().min(F8::ONE);
                 alive &= u_rr.simd_lt(q);
                 nb = nb.scale(alive.select(F8::ONE / q, F8::ZERO));

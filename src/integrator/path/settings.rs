@@ -12,6 +12,8 @@ pub struct PathSettings {
     pub nee: Nee,
     /// Russian roulette
     pub russian_roulette: bool,
+    /// first vertex where Russian roulette is played (1: the camera hit)
+    pub rr_depth: u32,
     /// direction sampling strategy
     pub strategy: ImportanceSampling,
     /// opt-in and biased: each pixel sample is scaled so its largest channel is at most this
@@ -22,6 +24,12 @@ pub struct PathSettings {
 impl PathSettings {
     /// The scene's settings, without clamping.
     pub fn of(d: &SceneDesc) -> Self {
-        Self { nee: d.nee, russian_roulette: d.russian_roulette, strategy: d.importance_sampling, clamp: None }
+        Self {
+            nee: d.nee,
+            russian_roulette: d.russian_roulette,
+            rr_depth: d.rr_depth.max(1),
+            strategy: d.importance_sampling,
+            clamp: None,
+        }
     }
 }

@@ -89,6 +89,7 @@ pub fn load(path: &Path, limits: &Limits, defines: &[(String, String)]) -> Resul
         b.desc.nee = crate::scene::desc::Nee::Mis;
         b.desc.importance_sampling = crate::scene::desc::ImportanceSampling::Brdf;
         b.desc.russian_roulette = true;
+        b.desc.rr_depth = 5;
     }
     Ok(Loaded { desc: b.desc, warnings: b.warnings })
 }

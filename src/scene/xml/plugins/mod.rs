@@ -37,6 +37,7 @@ mod tex_bitmap;
 mod tex_checkerboard;
 mod tex_mesh_attribute;
 mod tex_rawconstant;
+mod thindielectric;
 mod twosided;
 
 use super::doc::{Elem, Loc};
@@ -122,7 +123,7 @@ pub const PLUGINS: &[Plugin] = &[
     refused("bsdf", "roughconductor", BSDFS),
     dielectric::PLUGIN,
     refused("bsdf", "roughdielectric", BSDFS),
-    refused("bsdf", "thindielectric", BSDFS),
+    thindielectric::PLUGIN,
     plastic::PLUGIN,
     refused("bsdf", "roughplastic", BSDFS),
     refused("bsdf", "principled", BSDFS),

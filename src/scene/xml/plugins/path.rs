@@ -24,12 +24,13 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     b.desc.max_depth = depth(p)?;
     b.desc.nee = Nee::Mis;
     b.desc.importance_sampling = ImportanceSampling::Brdf;
-    // Russian roulette changes the variance, not the expected image. strata's starts at the
-    // first bounce; Mitsuba's at depth `rr_depth`, so a path that can never reach it (max_depth
-    // <= rr_depth) never plays it: then strata does not either.
+    // Russian roulette changes the variance, not the expected image; Mitsuba plays it from depth
+    // `rr_depth` (strata's vertex rr_depth), so a path that can never reach it (max_depth <=
+    // rr_depth) never plays it: then strata does not either.
     let rr = p.int("rr_depth", 5)?;
     let max_depth = p.int("max_depth", -1)?;
     b.desc.russian_roulette = rr < 1_000 && !(max_depth >= 1 && max_depth <= rr);
+    b.desc.rr_depth = rr.clamp(1, 1_000) as u32;
     if p.bool("hide_emitters", false)? {
         return Err(p.elem.at.err("hide_emitters is not supported yet"));
     }
