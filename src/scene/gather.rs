@@ -46,9 +46,10 @@ pub struct SurfaceHit8 {
     /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
     pub light: U8,
     /// material index per lane (into `Scene::materials`; 0 on misses): the registry BSDF's row
-    /// ([`Scene::bsdf_params`])
+    /// ([`Scene::bsdf_params`]); filled only in scenes with registry BSDFs
     pub material: U8,
-    /// hit lanes that hit the back of the surface (the normals were flipped to face the ray)
+    /// hit lanes that hit the back of the surface (the normals were flipped to face the ray);
+    /// filled only in scenes with registry BSDFs
     pub back: Mask8,
 }
 
@@ -118,6 +119,10 @@ impl Scene {
         let facing = (n.x * dir.x + n.y * dir.y) + n.z * dir.z;
         let back = valid & facing.simd_gt(F8::ZERO);
         let ng = Vec3x8::select(back, -n, n);
+        if self.registry_bsdfs {
+            out.material = U8::new(mat);
+            out.back = back;
+        }
         let (ns, smooth) = if any_tri && !self.desc.triangle_normals.is_empty() {
             self.smooth_normals(bits, geom, prim, hits, dir, ng)
         } else {
@@ -138,8 +143,6 @@ impl Scene {
         out.ambient = m.ambient;
         out.le = le;
         out.light = light;
-        out.material = mat;
-        out.back = back;
         if !self.material_texture.is_empty() {
             self.texture_hits(bits, hits, out);
         }
@@ -155,7 +158,7 @@ impl Scene {
             light: U8::MAX,
             le: Vec3x8::ZERO,
             any_tri: true,
-            mat: valid.to_bits() & U8::splat(self.tri_material[t]),
+            mat: [self.tri_material[t]; 8],
         }
     }
 
@@ -203,7 +206,7 @@ impl Scene {
             }
         }
         let m = self.gather_materials(bits, valid, &mat);
-        Lanes8 { n: n.get(), m, light: U8::new(light), le: le.get(), any_tri, mat: U8::new(mat) }
+        Lanes8 { n: n.get(), m, light: U8::new(light), le: le.get(), any_tri, mat }
     }
 
     /// Shading normals from the triangles' vertex normals (see the module docs) on the triangle
@@ -339,7 +342,7 @@ struct Lanes8 {
     /// some lane hit a triangle
     any_tri: bool,
     /// material index per lane (0 on misses)
-    mat: U8,
+    mat: [u32; 8],
 }
 
 /// Material fields of 8 lanes (a part of [`SurfaceHit8`]).
