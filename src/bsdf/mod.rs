@@ -1,6 +1,12 @@
-//! The format's BRDFs (FORMAT.md, "Materials"): modified Phong and GGX with Smith G and Schlick F, each
-//! plus a Lambertian kd/pi, evaluated and importance-sampled in the local shading frame. Scalar
-//! [`Material`] and eight-lane [`Material8`] mirror each other line by line.
+//! Materials: the BSDF interface ([`interface`]: [`Bsdf`], its registry of one file per BSDF
+//! listed by `registry!` below, Fresnel terms in [`fresnel`]) and the course's materials, registry
+//! id 0: the format's BRDFs (FORMAT.md, "Materials"), modified Phong and GGX with Smith G and
+//! Schlick F, each plus a Lambertian kd/pi, evaluated and importance-sampled in the local shading
+//! frame. Scalar [`Material`] and eight-lane [`Material8`] mirror each other line by line;
+//! [`Material8`] shades course lanes and registry lanes of one packet together
+//! (`eval_pdf_k`, `sample_bsdf_k`).
+//!
+//! The rest of these docs describe the course's materials.
 //!
 //! Files: [`lobe`] (the [`Lobe`] trait, lobe sets, [`Lobes`]), [`diffuse`] (kd/pi and the cosine
 //! sampler), `phong.rs` and `ggx.rs` (one lobe each), [`material`] (the mixture and strategies).
@@ -23,7 +29,9 @@
 //!   `active: Mask8` last; inactive lanes get zero f, pdf and direction.
 
 pub mod diffuse;
+pub mod fresnel;
 mod ggx;
+pub mod interface;
 pub mod lobe;
 pub mod material;
 mod phong;
@@ -34,5 +42,29 @@ pub mod desc;
 pub use desc::{BrdfKind, ImportanceSampling};
 pub use ggx::Ggx;
 pub use lobe::{AllLobes, Diffuse, DiffuseGgx, DiffusePhong, Lobe, LobeSet, Lobes};
-pub use material::{Material, Material8};
+pub use material::{Material, Material8, Sampled8};
 pub use phong::Phong;
+
+/// The BSDF registry: one line per BSDF file (`file: Type,`): declares the module, re-exports the
+/// type and appends it to [`AllBsdfs`], the list the general kernel compiles in (and the generic
+/// tests of `bsdf/tests.rs` iterate).
+macro_rules! registry {
+    ($($file:ident: $ty:ident,)*) => {
+        $(pub mod $file; pub use $file::$ty;)*
+        /// Every registered BSDF (besides the course's materials): the general kernel's set.
+        pub type AllBsdfs = registry!(@list $($ty)*);
+    };
+    (@list) => { () };
+    (@list $h:ident $($t:ident)*) => { ($h, registry!(@list $($t)*)) };
+}
+
+registry! {
+    conductor: Conductor,
+    dielectric: Dielectric,
+    plastic: Plastic,
+    thindielectric: ThinDielectric,
+}
+
+pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};
+#[cfg(test)]
+mod registry_tests;

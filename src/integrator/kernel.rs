@@ -64,7 +64,10 @@ impl Kernel {
     /// Name reported in the summary and `--stats` (`kernel`): `general`, or the integrator's kernel
     /// with the lobes compiled in, e.g. `pathtracer<lobes=none>`.
     pub fn name(&self, integrator: IntegratorKind) -> String {
-        if *self == Self::GENERAL {
+        use crate::bsdf::{Diffuse, DiffuseGgx, DiffusePhong, LobeSet};
+        // The sets `with_lobe_set!` compiles; any other runs the general kernel.
+        let specialized = [<Diffuse as LobeSet>::BITS, DiffusePhong::BITS, DiffuseGgx::BITS];
+        if *self == Self::GENERAL || !specialized.contains(&self.lobes.0) {
             return "general".into();
         }
         let names = self.lobes.names();

@@ -247,6 +247,9 @@ pub struct Scene {
     /// [`super::texturing::NO_TEXTURE`]; empty when no material is textured (then gather reads
     /// no texture and builds no uv)
     pub material_texture: Vec<u32>,
+    /// some material is a registry BSDF (not the course's): hits then carry material ids and
+    /// sides ([`SurfaceHit8::material`], [`SurfaceHit8::back`]), which only such BSDFs read
+    pub registry_bsdfs: bool,
     /// per scene triangle: its corner uvs, `[ZERO; 3]` for none; empty when the scene has no
     /// uvs or no textured material
     pub tri_uv: Vec<[glam::Vec2; 3]>,
@@ -594,6 +597,7 @@ impl Scene {
             tri_source.resize(indices.len(), crate::texture::NO_TRIANGLE);
         }
         let (textures, material_texture) = texturing.unwrap_or_default();
+        let registry_bsdfs = materials.iter().any(|m| m.bsdf.kind != crate::bsdf::interface::COURSE);
         Ok(Self {
             desc,
             camera,
@@ -608,6 +612,7 @@ impl Scene {
             tri_corner_normals,
             textures,
             material_texture,
+            registry_bsdfs,
             tri_uv,
             tri_source,
             degenerate_dropped,

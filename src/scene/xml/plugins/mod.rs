@@ -3,9 +3,11 @@
 //! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
 
 mod area;
+mod conductor;
 mod constant;
 mod cube;
 mod cylinder;
+mod dielectric;
 mod diffuse;
 mod direct;
 mod directional;
@@ -18,6 +20,7 @@ mod obj;
 mod orthographic;
 mod path;
 mod perspective;
+mod plastic;
 mod ply;
 mod point;
 mod projector;
@@ -34,6 +37,7 @@ mod tex_bitmap;
 mod tex_checkerboard;
 mod tex_mesh_attribute;
 mod tex_rawconstant;
+mod thindielectric;
 mod twosided;
 
 use super::doc::{Elem, Loc};
@@ -115,12 +119,12 @@ pub const PLUGINS: &[Plugin] = &[
     envmap::PLUGIN,
     diffuse::PLUGIN,
     twosided::PLUGIN,
-    refused("bsdf", "conductor", BSDFS),
+    conductor::PLUGIN,
     refused("bsdf", "roughconductor", BSDFS),
-    refused("bsdf", "dielectric", BSDFS),
+    dielectric::PLUGIN,
     refused("bsdf", "roughdielectric", BSDFS),
-    refused("bsdf", "thindielectric", BSDFS),
-    refused("bsdf", "plastic", BSDFS),
+    thindielectric::PLUGIN,
+    plastic::PLUGIN,
     refused("bsdf", "roughplastic", BSDFS),
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
