@@ -296,7 +296,6 @@ impl SceneDesc {
                         self.light_stratify,
                         self.nee,
                         self.russian_roulette,
-                        self.rr_depth,
                         self.importance_sampling
                     ),
                     (&self.materials, &self.spheres, &self.quad_lights, &self.point_lights, &self.directional_lights),
