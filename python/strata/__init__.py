@@ -10,7 +10,7 @@ the GIL; Ctrl-C stops a render after its pass (writing the checkpoint the CLI wo
 Point sets (``pixel_points``, ``light_points``, ``points``) are float arrays shaped
 ``[sets, points, dims]`` or ``[points, dims]`` with values in [0, 1), checked and mapped to
 (pixel, dimension) exactly as ``--pixel-sampler file:PATH`` files are (``scramble=``, ``sets=``,
-``pad=`` are the file options; see docs/POINTSETS.md).
+``pad=``, ``shuffle=`` are the file options; see docs/POINTSETS.md).
 """
 
 import json
@@ -75,7 +75,7 @@ def _flag_args(flags):
     return args
 
 
-def points_sampler(name, array, scramble=None, sets=None, pad=None):
+def points_sampler(name, array, scramble=None, sets=None, pad=None, shuffle=None):
     """Checks a point array as a point-set file is checked (the messages name ``<array NAME>``)
     and registers it; returns the sampler name that render flags accept."""
     a = np.asarray(array)
@@ -85,7 +85,8 @@ def points_sampler(name, array, scramble=None, sets=None, pad=None):
         a = a[None]
     if a.ndim != 3:
         raise StrataError(f"<array {name}>: shape {list(np.shape(array))}: expected [sets, points, dims] or [points, dims]")
-    options = "&".join(f"{k}={v}" for k, v in (("scramble", scramble), ("sets", sets), ("pad", pad)) if v)
+    pairs = (("scramble", scramble), ("sets", sets), ("pad", pad), ("shuffle", shuffle))
+    options = "&".join(f"{k}={v}" for k, v in pairs if v)
     data = np.ascontiguousarray(a, dtype="<f8").tobytes()
     return _strata.check_points(name, data, list(a.shape), options)
 
@@ -96,7 +97,7 @@ def _render_args(scene, flags):
         flags = {**scene.flags, **flags}
         scene = scene.path
     arrays = {k: flags.pop(k) for k in ("pixel_points", "light_points", "points") if flags.get(k) is not None}
-    opts = {k: flags.pop(k, None) for k in ("scramble", "sets", "pad")}
+    opts = {k: flags.pop(k, None) for k in ("scramble", "sets", "pad", "shuffle")}
     flag = {"pixel_points": "pixel_sampler", "light_points": "light_sampler", "points": "sampler"}
     for name, array in arrays.items():
         flags[flag[name]] = points_sampler(name, array, **opts)

@@ -353,13 +353,33 @@ fn budget_run(
     notes: &mut Vec<String>,
     variant: &str,
 ) -> (f64, u32) {
+    // A point set that is not progressive runs in whole sets: passes of whole blocks of `g` spp.
+    let g = session::pass::whole_set_spp(it);
+    let cap = (max_spp / g * g).max(g);
     let (mut t, mut s) = (0.0, 0u32);
-    while t < budget && s < max_spp {
-        let n = budget_pass(t, s, budget).min(max_spp - s);
+    while t < budget && s < cap {
+        let n = budget_pass(t, s / g, budget).saturating_mul(g).min(cap - s);
         let st = render::render(scene, it, film, s..s + n, pool);
         stats.merge(&st);
         t += st.cpu_seconds;
         s += n;
+    }
+    if g > 1 {
+        let mut sets: Vec<String> = it
+            .kinds()
+            .iter()
+            .filter_map(|&k| crate::sampler::file::whole_set_points(k).map(|n| format!("{} ({n} points)", k.name())))
+            .collect();
+        sets.dedup();
+        let note = format!(
+            "variant {variant}: {} not progressive (its prefixes are no sets of their own), so its equal-time \
+             runs render whole sets, in blocks of {g} spp, never stopping partway through one (a run may overshoot \
+             the budget; its seconds are what it spent)",
+            sets.join(", ") + if sets.len() > 1 { " are" } else { " is" }
+        );
+        if !notes.contains(&note) {
+            notes.push(note);
+        }
     }
     if t < budget {
         let note = format!(

@@ -118,7 +118,9 @@ fn specs_parse_options_and_refuse_unknown_ones() {
     assert_eq!(Options::default().suffix(), "");
     assert!(SamplerSpec::parse("sobol").is_none());
     assert!(err(SamplerSpec::parse("file:a?scramble=rot").unwrap()).contains("expected shift, owen, xor or none"));
-    assert!(err(SamplerSpec::parse("file:a?colour=red").unwrap()).contains("known options: scramble, sets, pad"));
+    assert!(
+        err(SamplerSpec::parse("file:a?colour=red").unwrap()).contains("known options: scramble, sets, pad, shuffle")
+    );
     assert!(err(resolve_sampler("file:/nonexistent/pts.npy")).starts_with("/nonexistent/pts.npy: "));
     assert!(err(resolve_sampler("sobel")).contains("or file:PATH"));
     assert_eq!(resolve_sampler("pmj").unwrap(), SamplerKind::PMJ02);
@@ -129,7 +131,8 @@ fn one_coordinate_sets_need_pad() {
     let ps = PointSets::new("<array x>", 1, 4, 1, vec![0.0, 0.25, 0.5, 0.75]).unwrap();
     let e = err(sampler_from_sets(&ps, "array", Options::default()));
     assert!(e.contains("1 coordinate per point; a sampler dimension takes 2 (add ?pad=sobol"), "{e}");
-    let opts = Options { pad: Some(SamplerKind::SOBOL), scramble: Scramble::None, ..Options::default() };
+    let opts =
+        Options { pad: Some(SamplerKind::SOBOL), scramble: Scramble::None, shuffle: false, ..Options::default() };
     let k = sampler_from_sets(&ps, "array", opts).unwrap();
     let set = PointSet::new(k, 4);
     for i in 0..4 {
@@ -143,8 +146,8 @@ fn one_coordinate_sets_need_pad() {
 fn a_loaded_file_is_a_sampler() {
     let p = tmp("s.txt");
     formats::write(&p, &sample_sets()).unwrap();
-    let k = resolve_sampler(&format!("file:{}?scramble=none&sets=pixel", p.display())).unwrap();
-    assert!(k.name().starts_with("file:") && k.name().ends_with("s.txt?scramble=none&sets=pixel"));
+    let k = resolve_sampler(&format!("file:{}?scramble=none&sets=pixel&shuffle=none", p.display())).unwrap();
+    assert!(k.name().starts_with("file:") && k.name().ends_with("s.txt?scramble=none&sets=pixel&shuffle=none"));
     assert_eq!(PointSet::new(k, 3).point(1, 0, 0, 1, 0), [0.25, 0.75]);
     assert_eq!(crate::sampler::file::file_info(k).map(|(_, s, p)| (s, p)), Some((2, 3)));
 }
