@@ -15,6 +15,7 @@ Point sets (``pixel_points``, ``light_points``, ``points``) are float arrays sha
 
 import json
 import os
+import shlex
 
 import numpy as np
 
@@ -157,7 +158,15 @@ def compare(scene=None, *, reference, variants, **flags):
     else a list of dicts)."""
     args = [] if scene is None else [os.fspath(scene.path if isinstance(scene, Scene) else scene)]
     args += ["--reference", os.fspath(reference)]
+    # A Scene's flags hold as for render: its size is compare's --size (unless given), the rest
+    # go before each variant's own flags.
+    scene_flags = dict(scene.flags) if isinstance(scene, Scene) else {}
+    if "size" in scene_flags:
+        size = scene_flags.pop("size")
+        flags.setdefault("size", size)
     for name, v in variants.items():
+        if scene_flags:
+            v = {**scene_flags, **v} if isinstance(v, dict) else shlex.join(_flag_args(scene_flags)) + " " + v
         args += ["--variant", f"{name}={_variant_flags(name, v)}"]
     ladder = flags.pop("spp_ladder", None)
     if ladder is not None:

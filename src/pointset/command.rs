@@ -196,25 +196,42 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> PointSetError + '_ {
     move |source| PointSetError::Io { path: path.to_path_buf(), source }
 }
 
+/// The spectrum plot's lowest power (white noise is 1): below it the estimate is rounding, not
+/// signal (a lattice's zeros come out near 1e-31), and the axis would spend 30 decades on it.
+pub const SPECTRUM_FLOOR: f64 = 1e-4;
+
 /// spectrum.csv/svg, integration.csv/svg and pointset.json in `dir`.
 pub fn write_outputs(dir: &Path, r: &Report) -> Result<(), PointSetError> {
     use crate::report::{loglog_svg, Series};
     std::fs::create_dir_all(dir).map_err(io(dir))?;
+    use crate::report::table::exact;
+    // Numbers in the shortest form that reads back to the same f64 (`4.5e-31`, not 0.000...045).
     let mut spectrum = String::from("frequency,power\n");
     for (f, p) in r.spectrum.iter().enumerate().skip(1) {
-        spectrum += &format!("{f},{p}\n");
+        spectrum += &format!("{f},{}\n", exact(*p));
     }
     let mut integration = String::from("integrand,n,rmse\n");
     for c in &r.convergence {
         for (n, e) in &c.points {
-            integration += &format!("{},{n},{e}\n", c.integrand);
+            integration += &format!("{},{n},{}\n", c.integrand, exact(*e));
         }
     }
+    // The plot's power axis stops at a noise floor (a lattice's exact zeros come out as 1e-31 of
+    // rounding); the slope-0 guide is white noise, power 1.
+    let floored = r.spectrum.iter().skip(1).any(|&p| p < SPECTRUM_FLOOR);
     let spec_series = [Series {
-        name: r.name.clone(),
-        points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p)).collect(),
+        name: if floored { format!("{} (power < {SPECTRUM_FLOOR:e} drawn at it)", r.name) } else { r.name.clone() },
+        points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p.max(SPECTRUM_FLOOR))).collect(),
     }];
-    let spec_svg = loglog_svg(&spec_series, &format!("radial power spectrum: {}", r.name), "frequency", "power", 0.0);
+    let spec_svg = crate::report::loglog_svg_guided(
+        &spec_series,
+        &[],
+        &format!("radial power spectrum: {}", r.name),
+        "frequency",
+        "power (white noise = 1: the guide)",
+        0.0,
+        Some((1.0, 1.0)),
+    );
     let int_series: Vec<Series> = r
         .convergence
         .iter()

@@ -151,3 +151,43 @@ fn a_loaded_file_is_a_sampler() {
     assert_eq!(PointSet::new(k, 3).point(1, 0, 0, 1, 0), [0.25, 0.75]);
     assert_eq!(crate::sampler::file::file_info(k).map(|(_, s, p)| (s, p)), Some((2, 3)));
 }
+
+#[test]
+fn pointset_plots_floor_the_spectrum_guide_white_noise_and_write_round_trip_csv() {
+    // A lattice's spectrum has exact zeros that come out as 1e-31 of rounding: the plot's power
+    // axis stops at the floor, the slope-0 guide sits at power 1 (white noise), not at the first
+    // point, and the CSV writes 4.5e-31 in a form that reads back, not 0.000...045.
+    use super::command::{write_outputs, Report, SPECTRUM_FLOOR};
+    let conv = super::analysis::Convergence { integrand: "disk", points: vec![(144.0, 1.25e-3)], slope: None };
+    let r = Report {
+        name: "fib".into(),
+        sampler: "file:fib".into(),
+        sets: Vec::new(),
+        spectrum: vec![f64::NAN, 0.004, 4.5e-31, 0.1 + 0.2, 2.5],
+        convergence: vec![conv],
+        progressive: None,
+    };
+    let dir = tmp("plots");
+    write_outputs(&dir, &r).unwrap();
+    let csv = std::fs::read_to_string(dir.join("spectrum.csv")).unwrap();
+    assert!(csv.contains("2,4.5e-31\n") && !csv.contains("0.0000"), "{csv}");
+    for line in csv.lines().skip(1) {
+        let (f, p) = line.split_once(',').unwrap();
+        let f: usize = f.parse().unwrap();
+        assert_eq!(p.parse::<f64>().unwrap().to_bits(), r.spectrum[f].to_bits(), "{line}");
+    }
+    let svg = std::fs::read_to_string(dir.join("spectrum.svg")).unwrap();
+    let exps: Vec<i32> = svg
+        .split("<tspan dy=\"-6\" font-size=\"9\">")
+        .skip(1)
+        .map(|t| t.split('<').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(exps.iter().all(|&e| f64::from(e) >= SPECTRUM_FLOOR.log10()), "axis decades {exps:?}");
+    // The guide (slope 0) is horizontal at power 1: the y of 10^0 on the axis.
+    let guide = svg.split("class=\"guide\" points=\"").nth(1).unwrap().split('"').next().unwrap();
+    let ys: Vec<f64> = guide.split(' ').map(|p| p.split(',').nth(1).unwrap().parse().unwrap()).collect();
+    let scale = crate::report::LogScale::covering([SPECTRUM_FLOOR, 2.5, 1.0], 410.0, 50.0);
+    assert!(ys.iter().all(|y| (y - scale.map(1.0)).abs() < 0.01), "guide at {ys:?}, power 1 at {}", scale.map(1.0));
+    let int = std::fs::read_to_string(dir.join("integration.csv")).unwrap();
+    assert!(int.contains("disk,144,1.25e-3"), "{int}");
+}
