@@ -494,8 +494,8 @@ mod tests {
                 let i8 = U8::new(std::array::from_fn(|l| (l as u32 * 5 + 1) % n));
                 let k8 = U8::new(std::array::from_fn(|l| key.wrapping_add(l as u32 * 0x9e37)));
                 let got = permute_lanes(i8, n, k8).to_array();
-                for l in 0..8 {
-                    assert_eq!(got[l], permute_lanes(i8.to_array()[l], n, k8.to_array()[l]));
+                for (l, &g) in got.iter().enumerate() {
+                    assert_eq!(g, permute_lanes(i8.to_array()[l], n, k8.to_array()[l]));
                 }
             }
         }
