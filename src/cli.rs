@@ -82,9 +82,10 @@ pub(crate) enum Cmd {
         /// Independent runs per variant (seeds differ), at least 2.
         #[arg(long, default_value_t = 4, value_parser = parse_count::<usize>)]
         runs: usize,
-        /// Equal time: CPU seconds of the worker threads per run (passes of one sample until spent).
-        #[arg(long, visible_alias = "cpu-budget", value_name = "CPU_SECONDS", conflicts_with = "spp_ladder", value_parser = parse_seconds)]
-        budget: Option<f64>,
+        /// Equal time: CPU seconds of the worker threads per run (passes growing geometrically until
+        /// spent); a comma-separated ladder (0.25,0.5,1,2) gives slopes against time.
+        #[arg(long, visible_alias = "cpu-budget", value_name = "CPU_SECONDS", value_delimiter = ',', conflicts_with = "spp_ladder", value_parser = parse_seconds)]
+        budget: Option<Vec<f64>>,
         /// Equal spp: comma-separated spp values, e.g. 1,2,4,8.
         #[arg(long, value_delimiter = ',')]
         spp_ladder: Option<Vec<u32>>,

@@ -91,8 +91,8 @@ pub struct CompareArgs {
     pub quiet: bool,
     /// runs per variant
     pub runs: usize,
-    /// equal time: CPU seconds per run
-    pub budget: Option<f64>,
+    /// equal time: CPU seconds per run (one, or a ladder)
+    pub budget: Option<Vec<f64>>,
     /// equal spp: the ladder
     pub spp_ladder: Option<Vec<u32>>,
     /// image size for every variant
@@ -103,6 +103,9 @@ pub struct CompareArgs {
     pub out: PathBuf,
     /// profile outputs
     pub profile: ProfileOut,
+    /// the command the report says reproduces it (None: this process's command line; the Python
+    /// module sets the equivalent `strata compare ...`, not `python script.py`)
+    pub command: Option<String>,
 }
 
 /// What a compare run produced.
@@ -149,6 +152,7 @@ pub fn compare_args(args: &[String]) -> Result<CompareArgs, FrontendError> {
             threads,
             out,
             profile: ProfileOut { json: profile, svg: profile_svg },
+            command: None,
         }),
         _ => unreachable!("parsed as compare"),
     }
@@ -180,9 +184,10 @@ pub fn compare_variants(scene: Option<&Path>, specs: &[String]) -> Result<Vec<Va
 }
 
 /// Equal time (`--budget`) or equal spp (`--spp-ladder`); the values are checked by [`lab::run`].
-pub fn compare_mode(budget: Option<f64>, ladder: Option<Vec<u32>>) -> Result<Mode, FrontendError> {
+pub fn compare_mode(budget: Option<Vec<f64>>, ladder: Option<Vec<u32>>) -> Result<Mode, FrontendError> {
     match (budget, ladder) {
-        (Some(b), _) => Ok(Mode::Budget(b)),
+        (Some(b), _) if b.len() == 1 => Ok(Mode::Budget(b[0])),
+        (Some(b), _) => Ok(Mode::Budgets(b)),
         (None, Some(l)) => Ok(Mode::Ladder(l)),
         (None, None) => Err(FrontendError::NoMode),
     }
@@ -198,7 +203,7 @@ pub fn command_line() -> String {
 /// table.md, error.svg in `out`, and the profiles asked for).
 pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, FrontendError> {
     let variants = compare_variants(a.scene.as_deref(), &a.variants)?;
-    let mode = compare_mode(a.budget, a.spp_ladder.clone())?;
+    let mode = compare_mode(a.budget.clone(), a.spp_ladder.clone())?;
     for f in [&a.profile.json, &a.profile.svg].into_iter().flatten() {
         session::checks::check_output_file(f)?;
     }
@@ -217,7 +222,8 @@ pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, FrontendError> {
         a.scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
         a.reference.display()
     );
-    let markdown = lab::write_outputs(&c, &a.out, &title, &[command_line()])?;
+    let command = a.command.clone().unwrap_or_else(command_line);
+    let markdown = lab::write_outputs(&c, &a.out, &title, &[command])?;
     if let Some(f) = &a.profile.json {
         let text = serde_json::to_string_pretty(&c.profiles)?;
         session::profile::write_text(f, &text)?;

@@ -5,7 +5,11 @@ against strata's Owen-scrambled Sobol' on the CSE168 hw2 sphere, RMSE against ti
 
 Each set serves every sampler dimension (``points=``: pixel jitter and light samples, one light
 sample per light and pixel sample, so a set of N points serves N spp), randomized per pixel and
-dimension by a Cranley-Patterson shift (strata's default for point arrays). Writes
+dimension by a Cranley-Patterson shift, with the point index shuffled per dimension (both
+strata's defaults for point arrays: without the shuffle, ``shuffle="none"``, the pixel and the
+light dimension of a sample take the same point, and the lattice becomes a correlated 4D
+pattern). Neither set is progressive (a lattice's or a row-ordered jittered set's prefixes are
+no sets of their own), so each is made at the spp it serves and used whole. Writes
 DIR/rmse_vs_time.png and DIR/results.json.
 """
 

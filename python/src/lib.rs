@@ -131,7 +131,18 @@ fn render(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedS
 /// Runs `strata compare ARGS` (writing its outputs as the CLI does); returns the rows as JSON.
 #[pyfunction]
 fn compare(py: Python<'_>, args: Vec<String>) -> PyResult<String> {
-    let a = strata::frontend::compare_args(&args).map_err(err)?;
+    let mut a = strata::frontend::compare_args(&args).map_err(err)?;
+    // The report's command: the CLI's equivalent of this call (arrays appear by their registered
+    // names), never `python script.py`.
+    let quote = |s: &String| {
+        if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=:,@%+".contains(c)) {
+            s.clone()
+        } else {
+            format!("'{}'", s.replace('\'', "'\\''"))
+        }
+    };
+    let cli = format!("strata compare {}", args.iter().map(quote).collect::<Vec<_>>().join(" "));
+    a.command = Some(format!("{cli}  (from Python: strata.compare)"));
     // The message crosses the thread boundary (FrontendError is large; Python gets text anyway).
     let out = py.detach(|| strata::frontend::run_compare(&a).map_err(|e| e.to_string())).map_err(err)?;
     Ok(strata::report::to_json(&out.rows).to_string())

@@ -10,11 +10,12 @@ the GIL; Ctrl-C stops a render after its pass (writing the checkpoint the CLI wo
 Point sets (``pixel_points``, ``light_points``, ``points``) are float arrays shaped
 ``[sets, points, dims]`` or ``[points, dims]`` with values in [0, 1), checked and mapped to
 (pixel, dimension) exactly as ``--pixel-sampler file:PATH`` files are (``scramble=``, ``sets=``,
-``pad=`` are the file options; see docs/POINTSETS.md).
+``pad=``, ``shuffle=`` are the file options; see docs/POINTSETS.md).
 """
 
 import json
 import os
+import shlex
 
 import numpy as np
 
@@ -75,7 +76,7 @@ def _flag_args(flags):
     return args
 
 
-def points_sampler(name, array, scramble=None, sets=None, pad=None):
+def points_sampler(name, array, scramble=None, sets=None, pad=None, shuffle=None):
     """Checks a point array as a point-set file is checked (the messages name ``<array NAME>``)
     and registers it; returns the sampler name that render flags accept."""
     a = np.asarray(array)
@@ -85,7 +86,8 @@ def points_sampler(name, array, scramble=None, sets=None, pad=None):
         a = a[None]
     if a.ndim != 3:
         raise StrataError(f"<array {name}>: shape {list(np.shape(array))}: expected [sets, points, dims] or [points, dims]")
-    options = "&".join(f"{k}={v}" for k, v in (("scramble", scramble), ("sets", sets), ("pad", pad)) if v)
+    pairs = (("scramble", scramble), ("sets", sets), ("pad", pad), ("shuffle", shuffle))
+    options = "&".join(f"{k}={v}" for k, v in pairs if v)
     data = np.ascontiguousarray(a, dtype="<f8").tobytes()
     return _strata.check_points(name, data, list(a.shape), options)
 
@@ -96,7 +98,7 @@ def _render_args(scene, flags):
         flags = {**scene.flags, **flags}
         scene = scene.path
     arrays = {k: flags.pop(k) for k in ("pixel_points", "light_points", "points") if flags.get(k) is not None}
-    opts = {k: flags.pop(k, None) for k in ("scramble", "sets", "pad")}
+    opts = {k: flags.pop(k, None) for k in ("scramble", "sets", "pad", "shuffle")}
     flag = {"pixel_points": "pixel_sampler", "light_points": "light_sampler", "points": "sampler"}
     for name, array in arrays.items():
         flags[flag[name]] = points_sampler(name, array, **opts)
@@ -156,7 +158,15 @@ def compare(scene=None, *, reference, variants, **flags):
     else a list of dicts)."""
     args = [] if scene is None else [os.fspath(scene.path if isinstance(scene, Scene) else scene)]
     args += ["--reference", os.fspath(reference)]
+    # A Scene's flags hold as for render: its size is compare's --size (unless given), the rest
+    # go before each variant's own flags.
+    scene_flags = dict(scene.flags) if isinstance(scene, Scene) else {}
+    if "size" in scene_flags:
+        size = scene_flags.pop("size")
+        flags.setdefault("size", size)
     for name, v in variants.items():
+        if scene_flags:
+            v = {**scene_flags, **v} if isinstance(v, dict) else shlex.join(_flag_args(scene_flags)) + " " + v
         args += ["--variant", f"{name}={_variant_flags(name, v)}"]
     ladder = flags.pop("spp_ladder", None)
     if ladder is not None:

@@ -42,6 +42,9 @@ pub enum Mode {
     Ladder(Vec<u32>),
     /// render each run in passes until this many CPU seconds of the worker threads are spent
     Budget(f64),
+    /// a budget ladder: [`Mode::Budget`] at each of these (increasing) CPU seconds, for slopes
+    /// against time
+    Budgets(Vec<f64>),
 }
 
 /// How a comparison runs.
@@ -106,6 +109,10 @@ pub struct RunRow {
     pub mean_error: f64,
     /// mean FLIP against the reference
     pub flip: f64,
+    /// the equal-time budget of this run's step, CPU seconds (0 for a ladder step)
+    pub budget: f64,
+    /// MSE over the smallest 99.9% of squared errors ([`report::robust::trimmed_mse`])
+    pub mse_trimmed: f64,
 }
 
 /// A variant's fitted convergence: log RMSE (noise-corrected) against log spp over the ladder and
@@ -139,6 +146,8 @@ pub struct Comparison {
     pub images: Vec<(String, Vec<[f32; 3]>)>,
     /// the baseline variant
     pub baseline: String,
+    /// worker threads of the renders
+    pub threads: usize,
 }
 
 /// [`run`] with default options (first variant as baseline, no progress): the rows.
@@ -189,7 +198,23 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         Mode::Ladder(l) => l.clone(),
         Mode::Budget(b) if !(b.is_finite() && *b > 0.0) => return Err(LabError::BadBudget(*b)),
         Mode::Budget(_) => vec![0],
+        Mode::Budgets(l) => {
+            if let Some(&b) = l.iter().find(|b| !(b.is_finite() && **b > 0.0)) {
+                return Err(LabError::BadBudget(b));
+            }
+            if l.is_empty() || l.windows(2).any(|w| w[0] >= w[1]) {
+                return Err(LabError::BadBudgetLadder);
+            }
+            vec![0; l.len()]
+        }
     };
+    // Each step's budget (CPU seconds; 0 for a ladder step).
+    let budgets: Vec<f64> = match &opts.mode {
+        Mode::Budget(b) => vec![*b],
+        Mode::Budgets(l) => l.clone(),
+        Mode::Ladder(l) => vec![0.0; l.len()],
+    };
+    let equal_time = !matches!(opts.mode, Mode::Ladder(_));
     // Prepare every variant first: a refused variant or reference fails before anything renders.
     let mut prepared = Vec::new();
     let mut notes = Vec::new();
@@ -224,7 +249,7 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                 notes.push(note);
             }
         }
-        if matches!(opts.mode, Mode::Budget(_)) {
+        if equal_time {
             // A layout that needs its count in advance cannot run at equal time: refuse it now.
             integ.equal_time().map_err(session::SessionError::from)?;
         }
@@ -243,7 +268,7 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         let pool = render::thread_pool(o.threads)?;
         let mut all = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
         let (mut per_step, mut last) = (Vec::new(), Vec::new());
-        for &step in &steps {
+        for (&step, &budget) in steps.iter().zip(&budgets) {
             let (mut runs_img, mut secs, mut spps, mut hashes) = (Vec::new(), 0.0, 0.0, Vec::new());
             // The samplers the runs of this step used (equal time may replace a default).
             let mut ran = String::new();
@@ -263,8 +288,17 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                     step_stats.merge(&st);
                     (st.cpu_seconds, step)
                 } else {
-                    let Mode::Budget(b) = opts.mode else { unreachable!("step 0 is the budget") };
-                    budget_run(scene, &it, &mut film, &pool, b, o.limits.max_spp, &mut step_stats, &mut notes, &v.name)
+                    budget_run(
+                        scene,
+                        &it,
+                        &mut film,
+                        &pool,
+                        budget,
+                        o.limits.max_spp,
+                        &mut step_stats,
+                        &mut notes,
+                        &v.name,
+                    )
                 };
                 ran = samplers_ran(&it);
                 secs += seconds;
@@ -286,13 +320,15 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                     mse_corrected: one.mse - ref_var,
                     mean_error: one.mean,
                     flip: flip::mean(&flip_map),
+                    budget,
+                    mse_trimmed: report::robust::trimmed_mse(&mean, &img.rgb, report::robust::TRIM_KEEP),
                 });
                 hashes.push(image_hash(&mean));
                 runs_img.push(mean);
                 progress.run_done(&format!(
                     "{} at {}",
                     v.name,
-                    if step > 0 { format!("{step} spp") } else { "budget".into() }
+                    if step > 0 { format!("{step} spp") } else { format!("budget {budget} s") }
                 ));
             }
             let stats = RunStats::against(&runs_img, &img.rgb, ref_info)
@@ -305,6 +341,11 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
                 .with_sampler(step_profile.sampler_ns_per_sample(), step_profile.sampler_share());
             row.first_sample = integ.first_sample.name().into();
             row.flip = flips;
+            let mine = &run_rows[run_rows.len() - opts.runs..];
+            row.mse_trimmed = mine.iter().map(|r| r.mse_trimmed).sum::<f64>() / k;
+            let seed = rows.len() as u64;
+            row.mse_boot_ci = report::robust::mean_ci(&mine.iter().map(|r| r.mse).collect::<Vec<_>>(), seed);
+            row.rel_mse_boot_ci = report::robust::mean_ci(&mine.iter().map(|r| r.rel_mse).collect::<Vec<_>>(), seed);
             row.setting = ran;
             rows.push(row);
             per_step.push(hashes);
@@ -316,9 +357,10 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         profiles.push(VariantProfile { variant: v.name.clone(), profile });
     }
     mark_identical(variants, &renders, steps.len(), &mut rows, &mut notes);
-    rank_against_baseline(&mut rows, &baseline, steps.len());
+    rank_against_baseline(&mut rows, &baseline, steps.len(), &run_rows, opts.runs);
     let convergence = variants.iter().map(|v| convergence(&v.name, &run_rows)).collect();
-    Ok(Comparison { rows, runs: run_rows, profiles, convergence, notes, reference: img, images, baseline })
+    let threads = profiles.first().map_or(opts.threads, |p: &VariantProfile| p.profile.threads);
+    Ok(Comparison { rows, runs: run_rows, profiles, convergence, notes, reference: img, images, baseline, threads })
 }
 
 /// The mean over values of the reference's own variance (0 without a variance layer).
@@ -353,13 +395,33 @@ fn budget_run(
     notes: &mut Vec<String>,
     variant: &str,
 ) -> (f64, u32) {
+    // A point set that is not progressive runs in whole sets: passes of whole blocks of `g` spp.
+    let g = session::pass::whole_set_spp(it);
+    let cap = (max_spp / g * g).max(g);
     let (mut t, mut s) = (0.0, 0u32);
-    while t < budget && s < max_spp {
-        let n = budget_pass(t, s, budget).min(max_spp - s);
+    while t < budget && s < cap {
+        let n = budget_pass(t, s / g, budget).saturating_mul(g).min(cap - s);
         let st = render::render(scene, it, film, s..s + n, pool);
         stats.merge(&st);
         t += st.cpu_seconds;
         s += n;
+    }
+    if g > 1 {
+        let mut sets: Vec<String> = it
+            .kinds()
+            .iter()
+            .filter_map(|&k| crate::sampler::file::whole_set_points(k).map(|n| format!("{} ({n} points)", k.name())))
+            .collect();
+        sets.dedup();
+        let note = format!(
+            "variant {variant}: {} not progressive (its prefixes are no sets of their own), so its equal-time \
+             runs render whole sets, in blocks of {g} spp, never stopping partway through one (a run may overshoot \
+             the budget; its seconds are what it spent)",
+            sets.join(", ") + if sets.len() > 1 { " are" } else { " is" }
+        );
+        if !notes.contains(&note) {
+            notes.push(note);
+        }
     }
     if t < budget {
         let note = format!(
@@ -417,12 +479,18 @@ fn mark_identical(
 
 /// Sets each row's efficiency ratio to the baseline's row at the same step (rows are grouped by
 /// variant, `steps` per variant); rows that render the baseline's image keep NaN and `same_as`.
-fn rank_against_baseline(rows: &mut [Row], baseline: &str, steps: usize) {
+/// Each ratio also gets a 95% bootstrap interval over both variants' runs (`runs` K per row, in
+/// the rows' order).
+fn rank_against_baseline(rows: &mut [Row], baseline: &str, steps: usize, runs: &[RunRow], k: usize) {
     let Some(bi) = rows.iter().position(|r| r.variant == baseline) else { return };
     let base: Vec<f64> = rows[bi..bi + steps].iter().map(|r| r.efficiency).collect();
+    let pairs = |i: usize| -> Vec<(f64, f64)> { runs[i * k..(i + 1) * k].iter().map(|r| (r.mse, r.seconds)).collect() };
     for (i, r) in rows.iter_mut().enumerate() {
         if r.same_as.is_none() {
             r.eff_vs_baseline = r.efficiency / base[i % steps];
+            if runs.len() >= (i + 1) * k && runs.len() >= (bi + steps) * k {
+                r.eff_vs_baseline_ci = report::robust::efficiency_ratio_ci(&pairs(i), &pairs(bi + i % steps), i as u64);
+            }
         }
     }
 }

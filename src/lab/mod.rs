@@ -72,6 +72,9 @@ pub enum LabError {
     /// A budget that is not a positive number of seconds.
     #[error("--budget {}: expected a positive number of seconds", crate::session::error::short_f64(*.0))]
     BadBudget(f64),
+    /// A budget ladder that is not increasing.
+    #[error("--budget: a budget ladder must be increasing CPU seconds, e.g. 0.25,0.5,1,2")]
+    BadBudgetLadder,
     /// A variant's statistics could not be computed.
     #[error("variant {variant}: {source}")]
     VariantStats {

@@ -29,14 +29,16 @@ pub fn rmse_interval(runs: &[&RunRow]) -> (f64, f64, f64) {
 /// labels.
 fn series_of(c: &Comparison, x_of: fn(&[&RunRow]) -> f64) -> (Vec<Series>, Vec<Annotation>) {
     let (mut series, mut ann): (Vec<Series>, Vec<Annotation>) = (Vec::new(), Vec::new());
-    for row in &c.rows {
-        let step = if row.spp.fract() == 0.0 && c.runs.iter().any(|r| r.step > 0) { row.spp as u32 } else { 0 };
-        let runs: Vec<&RunRow> = c.runs.iter().filter(|r| r.variant == row.variant && r.step == step).collect();
+    // Runs are in the rows' order, K per row (variant by variant, step by step).
+    let k = if c.rows.is_empty() { 0 } else { c.runs.len() / c.rows.len() };
+    for (row, chunk) in c.rows.iter().zip(c.runs.chunks(k.max(1))) {
+        let runs: Vec<&RunRow> = chunk.iter().filter(|r| r.variant == row.variant).collect();
         if runs.is_empty() {
             continue;
         }
         let (mean, lo, hi) = rmse_interval(&runs);
-        let label = if step > 0 { format!("{step} spp") } else { format!("{:.1} spp", row.spp) };
+        let step = runs[0].step;
+        let label = if step > 0 { format!("{step} spp") } else { format!("{:.0} spp", row.spp) };
         let i = match series.iter().position(|s| s.name == row.variant) {
             Some(i) => i,
             None => {
@@ -138,6 +140,63 @@ pub fn notes_block(notes: &[String]) -> String {
     format!("<ul class=\"notes\">{items}</ul>\n")
 }
 
+/// What a reader needs to reproduce a comparison: the reference (spp, samplers, noise and how it
+/// was estimated: compare's note), strata's version, commit and build, the CPU, the worker
+/// threads and the exact command (or the Python call's equivalent), as (key, value) lines.
+pub fn provenance(c: &Comparison, commands: &[String]) -> Vec<(String, String)> {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cores = std::thread::available_parallelism().map_or(0, usize::from);
+    let reference = c
+        .notes
+        .iter()
+        .find(|n| n.starts_with("reference: "))
+        .map_or("(no provenance in its metadata)", |n| &n["reference: ".len()..]);
+    let mut lines = vec![
+        ("reference".to_string(), reference.to_string()),
+        (
+            "strata".to_string(),
+            format!(
+                "{} (commit {}, build {})",
+                env!("CARGO_PKG_VERSION"),
+                crate::checkpoint::identity::COMMIT,
+                crate::checkpoint::identity::BUILD
+            ),
+        ),
+        ("CPU".to_string(), format!("{cpu} ({cores} logical cores seen)")),
+        ("threads".to_string(), format!("{} worker threads per render; seconds are their CPU seconds", c.threads)),
+        (
+            "statistics".to_string(),
+            format!(
+                "K = {} runs per row; 95% intervals: MSE - ref. var. Student t, bias Student t, MSE, relMSE and the \
+                 efficiency ratio percentile bootstrap over runs ({} resamples); robust statistic: trimmed MSE, the \
+                 largest {}% of squared errors dropped",
+                c.runs.iter().map(|r| r.run).max().map_or(0, |m| m + 1),
+                report::robust::RESAMPLES,
+                (1.0 - report::robust::TRIM_KEEP) * 100.0
+            ),
+        ),
+    ];
+    lines.extend(commands.iter().map(|cmd| ("command".to_string(), cmd.clone())));
+    lines
+}
+
+/// [`provenance`] as an HTML table.
+fn provenance_html(lines: &[(String, String)]) -> String {
+    let rows: String = lines
+        .iter()
+        .map(|(k, v)| format!("<tr><th>{}</th><td><code>{}</code></td></tr>", html::escape(k), html::escape(v)))
+        .collect();
+    format!("<h3>Provenance</h3>\n<table class=\"provenance\">{rows}</table>\n")
+}
+
 /// `report.html` of a comparison.
 pub fn compare_html(
     c: &Comparison,
@@ -149,12 +208,13 @@ pub fn compare_html(
     let reference = Shot { label: "reference".into(), rgb: c.reference.rgb.clone() };
     let shots = c.images.iter().map(|(name, rgb)| Shot { label: name.clone(), rgb: rgb.clone() }).collect();
     let mut blocks = vec![
+        provenance_html(&provenance(c, commands)),
         notes_block(&c.notes),
         format!(
             "<h3>Results (K = {} runs per row; efficiency against {})</h3>\n{}",
             c.runs.iter().map(|r| r.run).max().map_or(0, |m| m + 1),
             html::escape(&c.baseline),
-            report::html_table(report::table::COMPARE_COLUMNS, &c.rows)
+            report::html_table(&report::table::compare_columns(&c.rows), &c.rows)
         ),
         slopes_html(&c.convergence),
         format!("<h3>Convergence</h3>\n{}", html::inline_svg(by_time)),
@@ -194,6 +254,10 @@ pub fn write_outputs(c: &Comparison, dir: &Path, title: &str, commands: &[String
     md += &slopes_markdown(&c.convergence);
     for n in &c.notes {
         md += &format!("\nNote: {n}\n");
+    }
+    md += "\nProvenance:\n\n";
+    for (k, v) in provenance(c, commands) {
+        md += &format!("- {k}: {v}\n");
     }
     let json = serde_json::to_string_pretty(&report::to_json(&c.rows))?;
     let runs_json = serde_json::to_string_pretty(&c.runs)?;

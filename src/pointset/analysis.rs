@@ -89,6 +89,49 @@ pub fn radial_spectrum(sets: &[Vec<[f64; 2]>], max_freq: usize) -> Vec<f64> {
     sum.iter().zip(&count).map(|(s, &c)| if c > 0 { s / c as f64 } else { f64::NAN }).collect()
 }
 
+/// Expected squared L2 star discrepancy of `n` independent uniform points in [0, 1)^2:
+/// `(2^-2 - 3^-2) / n = 5 / (36 n)`.
+pub fn random_discrepancy2(n: usize) -> f64 {
+    5.0 / (36.0 * n as f64)
+}
+
+/// A prefix of a set is "as good as a fresh set of its size" when its RMS L2 star discrepancy
+/// (over the sets measured) is at most this many times that of fresh independent random sets of
+/// the same size: random sets (every prefix a random set) pass, a lattice's or a row-ordered
+/// jittered set's prefixes (which cover a strip of the square) fail by 3x and more.
+pub const PROGRESSIVE_MAX_RATIO: f64 = 1.5;
+
+/// Prefix sizes the progressiveness test looks at: powers of two from 8 below `points`, at most
+/// 2048 (the test is O(n^2) per set).
+pub fn prefix_sizes(points: usize) -> Vec<usize> {
+    (3..=11).map(|m| 1usize << m).filter(|&n| n < points).collect()
+}
+
+/// Whether sets are progressive, and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Progressiveness {
+    /// (prefix size n, RMS discrepancy of the sets' first n points / fresh random sets' of n)
+    pub prefixes: Vec<(usize, f64)>,
+    /// every prefix within [`PROGRESSIVE_MAX_RATIO`] (false when no prefix of 8+ points exists:
+    /// such a set is used whole, which costs nothing)
+    pub progressive: bool,
+}
+
+/// Measures whether `sets` (all of one size) are progressive: each prefix of 8, 16, ... points
+/// (below the sets' size) against fresh random sets of the same size ([`PROGRESSIVE_MAX_RATIO`]).
+pub fn progressiveness(sets: &[Vec<[f64; 2]>]) -> Progressiveness {
+    let points = sets.first().map_or(0, Vec::len);
+    let prefixes: Vec<(usize, f64)> = prefix_sizes(points)
+        .into_iter()
+        .map(|n| {
+            let d2 = sets.iter().map(|s| l2_star_discrepancy(&s[..n]).powi(2)).sum::<f64>() / sets.len() as f64;
+            (n, (d2 / random_discrepancy2(n)).sqrt())
+        })
+        .collect();
+    let progressive = !prefixes.is_empty() && prefixes.iter().all(|&(_, r)| r <= PROGRESSIVE_MAX_RATIO);
+    Progressiveness { prefixes, progressive }
+}
+
 /// A test integrand on [0, 1)^2 with its exact integral.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrand {
@@ -174,8 +217,9 @@ pub struct Convergence {
     pub integrand: &'static str,
     /// (N, RMSE)
     pub points: Vec<(f64, f64)>,
-    /// slope of log RMSE against log N
-    pub slope: f64,
+    /// slope of log RMSE against log N (None with fewer than two N: a set that is not
+    /// progressive is measured at its size only, its prefixes being no sets of their own)
+    pub slope: Option<f64>,
 }
 
 /// Error curves of `kind` on both integrands for every N of `ns`.
@@ -185,7 +229,8 @@ pub fn convergence(kind: SamplerKind, ns: &[u32], trials: u32, seed: u64) -> Vec
         .map(|&f| {
             let points: Vec<(f64, f64)> =
                 ns.iter().map(|&n| (f64::from(n), integration_rmse(kind, f, n, trials, seed))).collect();
-            Convergence { integrand: f.name(), slope: loglog_slope(&points), points }
+            let slope = (points.len() >= 2).then(|| loglog_slope(&points));
+            Convergence { integrand: f.name(), slope, points }
         })
         .collect()
 }

@@ -89,9 +89,10 @@ fn registry_slopes_match_theory_and_christensen_2018() {
     ];
     for (kind, disk, gauss) in cases {
         let c = convergence(kind, &ns, 400, 2018);
-        println!("{kind:?}: disk {:.3}, gaussian {:.3}", c[0].slope, c[1].slope);
-        assert!((c[0].slope - disk).abs() < 0.1, "{kind:?} disk slope {} (theory {disk})", c[0].slope);
-        assert!((c[1].slope - gauss).abs() < 0.1, "{kind:?} gaussian slope {} (theory {gauss})", c[1].slope);
+        let (d, g) = (c[0].slope.unwrap(), c[1].slope.unwrap());
+        println!("{kind:?}: disk {d:.3}, gaussian {g:.3}");
+        assert!((d - disk).abs() < 0.1, "{kind:?} disk slope {d} (theory {disk})");
+        assert!((g - gauss).abs() < 0.1, "{kind:?} gaussian slope {g} (theory {gauss})");
     }
 }
 
@@ -99,4 +100,40 @@ fn registry_slopes_match_theory_and_christensen_2018() {
 fn slope_fit() {
     let pts: Vec<(f64, f64)> = [4.0, 16.0, 64.0].iter().map(|&n: &f64| (n, 3.0 * n.powf(-0.75))).collect();
     assert!((loglog_slope(&pts) + 0.75).abs() < 1e-12);
+}
+
+/// Sets of registry layout `kind`: set j is pixel j's first `n` points (dimension 0).
+fn layout_sets(kind: SamplerKind, sets: u32, n: u32) -> Vec<Vec<[f64; 2]>> {
+    let set = PointSet::new(kind, n);
+    (0..sets).map(|j| (0..n).map(|k| set.point(j, 0, 0, k, 2018).map(f64::from)).collect()).collect()
+}
+
+#[test]
+fn progressiveness_tells_sequences_from_sets() {
+    // Sequences (independent, Sobol', pmj02) are progressive; a Fibonacci lattice and a jittered
+    // set in row order (their prefixes cover a strip of the square) are not.
+    for (kind, sets) in [(SamplerKind::INDEPENDENT, 1), (SamplerKind::INDEPENDENT, 4), (SamplerKind::SOBOL, 4)] {
+        for n in [64u32, 256, 1024] {
+            let p = progressiveness(&layout_sets(kind, sets, n));
+            assert!(p.progressive, "{} x{sets} of {n}: {:?}", kind.name(), p.prefixes);
+        }
+    }
+    let pmj = SamplerKind::parse("pmj02").unwrap();
+    assert!(progressiveness(&layout_sets(pmj, 4, 256)).progressive);
+    for (n, g) in [(144usize, 89usize), (233, 144), (987, 610)] {
+        let fib: Vec<[f64; 2]> = (0..n).map(|i| [i as f64 / n as f64, ((i * g) % n) as f64 / n as f64]).collect();
+        let p = progressiveness(&[fib]);
+        assert!(!p.progressive && p.prefixes.iter().any(|&(_, r)| r > 3.0), "fibonacci {n}: {:?}", p.prefixes);
+    }
+    let mut rng = 12345u64;
+    let mut u = || {
+        rng = rng.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let jittered: Vec<[f64; 2]> =
+        (0..256).map(|i| [((i % 16) as f64 + u()) / 16.0, ((i / 16) as f64 + u()) / 16.0]).collect();
+    let p = progressiveness(&[jittered]);
+    assert!(!p.progressive, "{:?}", p.prefixes);
+    // Too small to tell: used whole.
+    assert!(!progressiveness(&[vec![[0.25, 0.25], [0.75, 0.75], [0.25, 0.75], [0.75, 0.25]]]).progressive);
 }

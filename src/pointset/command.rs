@@ -83,6 +83,9 @@ pub struct Report {
     pub spectrum: Vec<f64>,
     /// error curves and slopes
     pub convergence: Vec<Convergence>,
+    /// a file's progressiveness (its prefixes against fresh random sets of their size); None for
+    /// a registry layout, whose sets are made at each size
+    pub progressive: Option<analysis::Progressiveness>,
 }
 
 /// Sets measured one by one (the O(N^2) measures); the spectrum averages the same sets.
@@ -101,26 +104,29 @@ pub fn layout_sets(kind: SamplerKind, args: &Args) -> Result<PointSets, PointSet
 /// Runs `strata pointset`: measures, writes the outputs asked for, returns the report and its
 /// text table.
 pub fn run(args: &Args) -> Result<(Report, String), PointSetError> {
-    let (ps, kind, ns) = match SamplerKind::parse(&args.target) {
+    let (ps, kind, ns, progressive) = match SamplerKind::parse(&args.target) {
         Some(kind) => {
             let ps = layout_sets(kind, args)?;
-            (ps, kind, (2..=12).map(|m| 1u32 << m).collect::<Vec<u32>>())
+            (ps, kind, (2..=12).map(|m| 1u32 << m).collect::<Vec<u32>>(), None)
         }
         None => {
             let path = PathBuf::from(args.target.strip_prefix("file:").unwrap_or(&args.target));
             let ps = formats::read(&path)?;
             let kind = super::sampler_from_sets(&ps, &format!("file:{}", path.display()), args.options)?;
-            // Prefixes of the file's sets: powers of two from 4 up to its size, and its size.
+            let prog = analysis::progressiveness(&ps.sets_2d(MAX_SETS_MEASURED));
+            // Prefixes of a progressive file's sets: powers of two from 4 up to its size, and its
+            // size; a set that is not progressive only at its size (a render uses it whole).
             let p = ps.points as u32;
-            let mut ns: Vec<u32> = (2..=12).map(|m| 1u32 << m).filter(|&n| n < p).collect();
+            let mut ns: Vec<u32> =
+                if prog.progressive { (2..=12).map(|m| 1u32 << m).filter(|&n| n < p).collect() } else { Vec::new() };
             ns.push(p);
-            (ps, kind, ns)
+            (ps, kind, ns, Some(prog))
         }
     };
     if let Some(e) = &args.export {
         formats::write(e, &ps)?;
     }
-    let measured: Vec<Vec<[f64; 2]>> = (0..ps.sets.min(MAX_SETS_MEASURED)).map(|s| ps.set_2d(s)).collect();
+    let measured = ps.sets_2d(MAX_SETS_MEASURED);
     let sets = measured
         .iter()
         .enumerate()
@@ -141,6 +147,7 @@ pub fn run(args: &Args) -> Result<(Report, String), PointSetError> {
         sets,
         spectrum: analysis::radial_spectrum(&measured, args.max_freq),
         convergence: analysis::convergence(kind, &ns, args.trials, args.seed),
+        progressive,
     };
     if let Some(dir) = &args.out {
         write_outputs(dir, &report)?;
@@ -159,10 +166,27 @@ pub fn table(r: &Report) -> String {
             row.set, row.points, row.l2_star_discrepancy, row.min_distance, row.min_distance_relative
         );
     }
+    if let Some(p) = &r.progressive {
+        let ratios: Vec<String> = p.prefixes.iter().map(|(n, q)| format!("{n}: {q:.2}")).collect();
+        s += &format!(
+            "  progressive: {} (prefix discrepancy / fresh random sets', at most {}: {})\n",
+            if p.progressive { "yes" } else { "no: renders use whole sets, no slope is fitted over prefixes" },
+            analysis::PROGRESSIVE_MAX_RATIO,
+            if ratios.is_empty() { "no prefix of 8+ points".to_string() } else { ratios.join(", ") }
+        );
+    }
     for c in &r.convergence {
         let first = c.points.first().map_or(0.0, |p| p.0);
         let last = c.points.last().map_or(0.0, |p| p.0);
-        s += &format!("  integration error, {:<8} N = {first}..{last}: slope {:+.3}\n", c.integrand, c.slope);
+        match (c.slope, c.points.first()) {
+            (Some(k), _) => {
+                s += &format!("  integration error, {:<8} N = {first}..{last}: slope {k:+.3}\n", c.integrand)
+            }
+            (None, Some((n, e))) => {
+                s += &format!("  integration error, {:<8} N = {n}: RMSE {e:.4e} (whole sets only)\n", c.integrand)
+            }
+            (None, None) => {}
+        }
     }
     s.pop();
     s
@@ -172,29 +196,52 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> PointSetError + '_ {
     move |source| PointSetError::Io { path: path.to_path_buf(), source }
 }
 
+/// The spectrum plot's lowest power (white noise is 1): below it the estimate is rounding, not
+/// signal (a lattice's zeros come out near 1e-31), and the axis would spend 30 decades on it.
+pub const SPECTRUM_FLOOR: f64 = 1e-4;
+
 /// spectrum.csv/svg, integration.csv/svg and pointset.json in `dir`.
 pub fn write_outputs(dir: &Path, r: &Report) -> Result<(), PointSetError> {
     use crate::report::{loglog_svg, Series};
     std::fs::create_dir_all(dir).map_err(io(dir))?;
+    use crate::report::table::exact;
+    // Numbers in the shortest form that reads back to the same f64 (`4.5e-31`, not 0.000...045).
     let mut spectrum = String::from("frequency,power\n");
     for (f, p) in r.spectrum.iter().enumerate().skip(1) {
-        spectrum += &format!("{f},{p}\n");
+        spectrum += &format!("{f},{}\n", exact(*p));
     }
     let mut integration = String::from("integrand,n,rmse\n");
     for c in &r.convergence {
         for (n, e) in &c.points {
-            integration += &format!("{},{n},{e}\n", c.integrand);
+            integration += &format!("{},{n},{}\n", c.integrand, exact(*e));
         }
     }
+    // The plot's power axis stops at a noise floor (a lattice's exact zeros come out as 1e-31 of
+    // rounding); the slope-0 guide is white noise, power 1.
+    let floored = r.spectrum.iter().skip(1).any(|&p| p < SPECTRUM_FLOOR);
     let spec_series = [Series {
-        name: r.name.clone(),
-        points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p)).collect(),
+        name: if floored { format!("{} (power < {SPECTRUM_FLOOR:e} drawn at it)", r.name) } else { r.name.clone() },
+        points: r.spectrum.iter().enumerate().skip(1).map(|(f, &p)| (f as f64, p.max(SPECTRUM_FLOOR))).collect(),
     }];
-    let spec_svg = loglog_svg(&spec_series, &format!("radial power spectrum: {}", r.name), "frequency", "power", 0.0);
+    let spec_svg = crate::report::loglog_svg_guided(
+        &spec_series,
+        &[],
+        &format!("radial power spectrum: {}", r.name),
+        "frequency",
+        "power (white noise = 1: the guide)",
+        0.0,
+        Some((1.0, 1.0)),
+    );
     let int_series: Vec<Series> = r
         .convergence
         .iter()
-        .map(|c| Series { name: format!("{} (slope {:+.2})", c.integrand, c.slope), points: c.points.clone() })
+        .map(|c| Series {
+            name: match c.slope {
+                Some(k) => format!("{} (slope {k:+.2})", c.integrand),
+                None => format!("{} (whole sets)", c.integrand),
+            },
+            points: c.points.clone(),
+        })
         .collect();
     let int_svg =
         loglog_svg(&int_series, &format!("integration error: {}", r.name), "points N", "RMSE", analysis::RANDOM_SLOPE);

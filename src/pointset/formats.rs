@@ -172,7 +172,7 @@ pub fn parse_npy(name: &str, bytes: &[u8]) -> Result<PointSets, PointSetError> {
     let bad = |why: String| PointSetError::Format { source_name: name.into(), why };
     let npy = npyz::NpyFile::new(bytes).map_err(|e| bad(format!("not a NumPy .npy file: {e}")))?;
     let shape: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
-    check_npy_length(bytes, &shape, &npy.dtype().descr()).map_err(bad)?;
+    check_npy_length(bytes, &shape, &npy.dtype().descr()).map_err(|e| bad(e.to_string()))?;
     let (sets, points, dims) = match shape[..] {
         [p, d] => (1, p, d),
         [s, p, d] => (s, p, d),
@@ -204,30 +204,58 @@ pub fn parse_npy(name: &str, bytes: &[u8]) -> Result<PointSets, PointSetError> {
     PointSets::new(name, sets, points, dims, data)
 }
 
+/// Why an `.npy` file's length does not match its header.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum NpyLengthError {
+    /// the header's length field is missing
+    #[error("truncated header")]
+    TruncatedHeader,
+    /// the declared shape overflows 64 bits of bytes
+    #[error("shape {0:?} is too large")]
+    TooLarge(Vec<usize>),
+    /// the file ends before the data its header declares
+    #[error("truncated: the header declares shape {shape:?} of {descr} ({data} bytes of data), the file ends {short} bytes short")]
+    Truncated {
+        /// the declared shape
+        shape: Vec<usize>,
+        /// the declared item type
+        descr: String,
+        /// bytes of data declared
+        data: u64,
+        /// bytes missing
+        short: u64,
+    },
+    /// bytes after the declared array
+    #[error("{extra} trailing bytes after the {shape:?} array its header declares")]
+    Trailing {
+        /// bytes past the array
+        extra: u64,
+        /// the declared shape
+        shape: Vec<usize>,
+    },
+}
+
 /// Checks that an `.npy` file holds exactly the data its header declares (`shape` of items of
 /// `descr`): a short file is named as truncated, bytes after the array are refused.
-fn check_npy_length(bytes: &[u8], shape: &[usize], descr: &str) -> Result<(), String> {
+fn check_npy_length(bytes: &[u8], shape: &[usize], descr: &str) -> Result<(), NpyLengthError> {
     let major = bytes.get(6).copied().unwrap_or(0);
     let start = match major {
         1 => bytes.get(8..10).map(|b| 10 + u16::from_le_bytes([b[0], b[1]]) as u64),
         _ => bytes.get(8..12).map(|b| 12 + u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64),
     }
-    .ok_or("truncated header")?;
+    .ok_or(NpyLengthError::TruncatedHeader)?;
     let item: u64 = descr.chars().filter(char::is_ascii_digit).collect::<String>().parse().unwrap_or(0);
     let data = shape
         .iter()
         .try_fold(item, |n, &d| n.checked_mul(d as u64))
-        .ok_or_else(|| format!("shape {shape:?} is too large"))?;
+        .ok_or_else(|| NpyLengthError::TooLarge(shape.to_vec()))?;
     let want = start.saturating_add(data);
     let have = bytes.len() as u64;
     if have < want {
-        return Err(format!(
-            "truncated: the header declares shape {shape:?} of {descr} ({data} bytes of data), the file ends {} bytes short",
-            want - have
-        ));
+        return Err(NpyLengthError::Truncated { shape: shape.to_vec(), descr: descr.into(), data, short: want - have });
     }
     if have > want {
-        return Err(format!("{} trailing bytes after the {shape:?} array its header declares", have - want));
+        return Err(NpyLengthError::Trailing { extra: have - want, shape: shape.to_vec() });
     }
     Ok(())
 }

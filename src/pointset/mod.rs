@@ -167,6 +167,11 @@ impl PointSets {
         &self.data[i..i + self.dims]
     }
 
+    /// The 2D points of the first `max` sets (at most all of them).
+    pub fn sets_2d(&self, max: usize) -> Vec<Vec<[f64; 2]>> {
+        (0..self.sets.min(max)).map(|s| self.set_2d(s)).collect()
+    }
+
     /// The 2D points (coordinates 0 and 1) of set `s`.
     pub fn set_2d(&self, s: usize) -> Vec<[f64; 2]> {
         (0..self.points).map(|p| self.point(s, p)).map(|c| [c[0], c.get(1).copied().unwrap_or(0.0)]).collect()

@@ -1,5 +1,5 @@
 //! Sampler specs naming point sets: `file:PATH` with optional `?key=value&...` options
-//! (`scramble=shift|owen|xor|none`, `sets=hash|pixel`, `pad=NAME`), and their registration as a
+//! (`scramble=shift|owen|xor|none`, `sets=hash|pixel`, `pad=NAME`, `shuffle=dim|none`), and their registration as a
 //! run-time [`SamplerKind`] (see [`crate::sampler::file`] for what the options mean).
 
 use super::{formats, PointSetError, PointSets};
@@ -16,11 +16,14 @@ pub struct Options {
     pub map: SetMap,
     /// pad a one-coordinate set's second coordinate from this registry layout
     pub pad: Option<SamplerKind>,
+    /// shuffle the point index per dimension (default), or keep one index for every dimension
+    /// (`shuffle=none`: a deliberate correlation)
+    pub shuffle: bool,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { scramble: Scramble::Shift, map: SetMap::Hash, pad: None }
+        Self { scramble: Scramble::Shift, map: SetMap::Hash, pad: None, shuffle: true }
     }
 }
 
@@ -41,7 +44,14 @@ impl Options {
                         .ok_or_else(|| err(format!("unknown sampler (registry: {})", SamplerKind::names())))?,
                 )
             }
-            _ => return Err(err("known options: scramble, sets, pad".into())),
+            "shuffle" => {
+                self.shuffle = match v.trim() {
+                    "dim" => true,
+                    "none" => false,
+                    _ => return Err(err("expected dim (each dimension its own index order) or none".into())),
+                }
+            }
+            _ => return Err(err("known options: scramble, sets, pad, shuffle".into())),
         }
         Ok(())
     }
@@ -58,6 +68,9 @@ impl Options {
         }
         if let Some(p) = self.pad {
             kv.push(format!("pad={}", p.name()));
+        }
+        if !self.shuffle {
+            kv.push("shuffle=none".into());
         }
         if kv.is_empty() {
             String::new()
@@ -140,6 +153,13 @@ pub fn sampler_from_sets(ps: &PointSets, name: &str, options: Options) -> Result
     let (sets, points) =
         (u32::try_from(ps.sets).map_err(|_| too_big())?, u32::try_from(ps.points).map_err(|_| too_big())?);
     let table = PointTable::new(sets, points, xy).ok_or_else(too_big)?;
-    let layout = FileLayout { table, map: options.map, scramble: options.scramble, pad: options.pad };
+    let layout = FileLayout {
+        table,
+        map: options.map,
+        scramble: options.scramble,
+        pad: options.pad,
+        shuffle: options.shuffle,
+        progressive: super::analysis::progressiveness(&ps.sets_2d(4)).progressive,
+    };
     Ok(file::register(&format!("{name}{}", options.suffix()), &ps.digest, layout)?)
 }

@@ -118,7 +118,9 @@ fn specs_parse_options_and_refuse_unknown_ones() {
     assert_eq!(Options::default().suffix(), "");
     assert!(SamplerSpec::parse("sobol").is_none());
     assert!(err(SamplerSpec::parse("file:a?scramble=rot").unwrap()).contains("expected shift, owen, xor or none"));
-    assert!(err(SamplerSpec::parse("file:a?colour=red").unwrap()).contains("known options: scramble, sets, pad"));
+    assert!(
+        err(SamplerSpec::parse("file:a?colour=red").unwrap()).contains("known options: scramble, sets, pad, shuffle")
+    );
     assert!(err(resolve_sampler("file:/nonexistent/pts.npy")).starts_with("/nonexistent/pts.npy: "));
     assert!(err(resolve_sampler("sobel")).contains("or file:PATH"));
     assert_eq!(resolve_sampler("pmj").unwrap(), SamplerKind::PMJ02);
@@ -129,7 +131,8 @@ fn one_coordinate_sets_need_pad() {
     let ps = PointSets::new("<array x>", 1, 4, 1, vec![0.0, 0.25, 0.5, 0.75]).unwrap();
     let e = err(sampler_from_sets(&ps, "array", Options::default()));
     assert!(e.contains("1 coordinate per point; a sampler dimension takes 2 (add ?pad=sobol"), "{e}");
-    let opts = Options { pad: Some(SamplerKind::SOBOL), scramble: Scramble::None, ..Options::default() };
+    let opts =
+        Options { pad: Some(SamplerKind::SOBOL), scramble: Scramble::None, shuffle: false, ..Options::default() };
     let k = sampler_from_sets(&ps, "array", opts).unwrap();
     let set = PointSet::new(k, 4);
     for i in 0..4 {
@@ -143,8 +146,48 @@ fn one_coordinate_sets_need_pad() {
 fn a_loaded_file_is_a_sampler() {
     let p = tmp("s.txt");
     formats::write(&p, &sample_sets()).unwrap();
-    let k = resolve_sampler(&format!("file:{}?scramble=none&sets=pixel", p.display())).unwrap();
-    assert!(k.name().starts_with("file:") && k.name().ends_with("s.txt?scramble=none&sets=pixel"));
+    let k = resolve_sampler(&format!("file:{}?scramble=none&sets=pixel&shuffle=none", p.display())).unwrap();
+    assert!(k.name().starts_with("file:") && k.name().ends_with("s.txt?scramble=none&sets=pixel&shuffle=none"));
     assert_eq!(PointSet::new(k, 3).point(1, 0, 0, 1, 0), [0.25, 0.75]);
     assert_eq!(crate::sampler::file::file_info(k).map(|(_, s, p)| (s, p)), Some((2, 3)));
+}
+
+#[test]
+fn pointset_plots_floor_the_spectrum_guide_white_noise_and_write_round_trip_csv() {
+    // A lattice's spectrum has exact zeros that come out as 1e-31 of rounding: the plot's power
+    // axis stops at the floor, the slope-0 guide sits at power 1 (white noise), not at the first
+    // point, and the CSV writes 4.5e-31 in a form that reads back, not 0.000...045.
+    use super::command::{write_outputs, Report, SPECTRUM_FLOOR};
+    let conv = super::analysis::Convergence { integrand: "disk", points: vec![(144.0, 1.25e-3)], slope: None };
+    let r = Report {
+        name: "fib".into(),
+        sampler: "file:fib".into(),
+        sets: Vec::new(),
+        spectrum: vec![f64::NAN, 0.004, 4.5e-31, 0.1 + 0.2, 2.5],
+        convergence: vec![conv],
+        progressive: None,
+    };
+    let dir = tmp("plots");
+    write_outputs(&dir, &r).unwrap();
+    let csv = std::fs::read_to_string(dir.join("spectrum.csv")).unwrap();
+    assert!(csv.contains("2,4.5e-31\n") && !csv.contains("0.0000"), "{csv}");
+    for line in csv.lines().skip(1) {
+        let (f, p) = line.split_once(',').unwrap();
+        let f: usize = f.parse().unwrap();
+        assert_eq!(p.parse::<f64>().unwrap().to_bits(), r.spectrum[f].to_bits(), "{line}");
+    }
+    let svg = std::fs::read_to_string(dir.join("spectrum.svg")).unwrap();
+    let exps: Vec<i32> = svg
+        .split("<tspan dy=\"-6\" font-size=\"9\">")
+        .skip(1)
+        .map(|t| t.split('<').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(exps.iter().all(|&e| f64::from(e) >= SPECTRUM_FLOOR.log10()), "axis decades {exps:?}");
+    // The guide (slope 0) is horizontal at power 1: the y of 10^0 on the axis.
+    let guide = svg.split("class=\"guide\" points=\"").nth(1).unwrap().split('"').next().unwrap();
+    let ys: Vec<f64> = guide.split(' ').map(|p| p.split(',').nth(1).unwrap().parse().unwrap()).collect();
+    let scale = crate::report::LogScale::covering([SPECTRUM_FLOOR, 2.5, 1.0], 410.0, 50.0);
+    assert!(ys.iter().all(|y| (y - scale.map(1.0)).abs() < 0.01), "guide at {ys:?}, power 1 at {}", scale.map(1.0));
+    let int = std::fs::read_to_string(dir.join("integration.csv")).unwrap();
+    assert!(int.contains("disk,144,1.25e-3"), "{int}");
 }

@@ -21,6 +21,7 @@ pub mod flip;
 pub mod html;
 pub mod metrics;
 pub mod plot;
+pub mod robust;
 pub mod slope;
 pub mod student_t;
 pub mod table;
@@ -28,7 +29,7 @@ pub mod ztest;
 
 pub use bars::{stacked_bars_svg, Bar};
 pub use metrics::{efficiency, mse, rel_mse, EightBit, ReferenceInfo, RunStats};
-pub use plot::{loglog_svg, loglog_svg_annotated, Annotation, LogScale, Series};
+pub use plot::{loglog_svg, loglog_svg_annotated, loglog_svg_guided, Annotation, LogScale, Series};
 pub use slope::{loglog_slope, Slope};
 pub use student_t::{student_t_quantile, MAX_DOF};
 pub use table::{g3, html_table, markdown_table, to_csv, to_grouped_json, to_json, to_markdown, Column, Row, Style};

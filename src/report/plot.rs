@@ -92,10 +92,28 @@ pub fn loglog_svg_annotated(
     y_label: &str,
     guide_slope: f64,
 ) -> String {
+    loglog_svg_guided(series, annotations, title, x_label, y_label, guide_slope, None)
+}
+
+/// [`loglog_svg_annotated`] with the guide through `anchor` (x, y) instead of the first point
+/// (e.g. a spectrum's white-noise level, slope 0 at power 1); the y axis then covers it too.
+pub fn loglog_svg_guided(
+    series: &[Series],
+    annotations: &[Annotation],
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    guide_slope: f64,
+    anchor: Option<(f64, f64)>,
+) -> String {
     let plottable = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0;
     let kept: Vec<Vec<(f64, f64)>> =
         series.iter().map(|s| s.points.iter().copied().filter(plottable).collect()).collect();
-    let (xs, ys) = scales(&kept);
+    let (xs, mut ys) = scales(&kept);
+    if let Some((_, y)) = anchor.filter(|a| plottable(a)) {
+        let with = LogScale::covering(kept.iter().flatten().map(|p| p.1).chain([y]), BOTTOM, TOP);
+        ys = with;
+    }
     let mut svg = String::new();
     let mut put = |s: String| svg.push_str(&s);
 
@@ -148,7 +166,9 @@ pub fn loglog_svg_annotated(
     ));
 
     // Guide: log y = log y0 + slope (log x - log x0), drawn across the x axis.
-    let anchor = kept.first().and_then(|p| p.first()).filter(|_| guide_slope.is_finite());
+    let first = kept.first().and_then(|p| p.first()).copied();
+    let anchor = anchor.filter(|a| plottable(a)).or(first);
+    let anchor = anchor.as_ref().filter(|_| guide_slope.is_finite());
     let mut legend_y = TOP + 10.0;
     if let Some(&(x0, y0)) = anchor {
         let at = |l: f64| (xs.map_log10(l), ys.map_log10(y0.log10() + guide_slope * (l - x0.log10())));
@@ -169,6 +189,8 @@ pub fn loglog_svg_annotated(
         put("<!-- no guide line: the first series has no plottable point or the slope is not finite -->\n".into());
     }
 
+    // Point labels placed so far: (x, y of the baseline start, width).
+    let mut placed: Vec<(f64, f64, f64)> = Vec::new();
     for (i, s) in series.iter().enumerate() {
         let colour = colour(i);
         let mut coords = String::new();
@@ -190,13 +212,24 @@ pub fn loglog_svg_annotated(
                 );
             }
             if let Some(label) = ann.and_then(|a| a.labels.get(j)) {
-                let _ = writeln!(
-                    markers,
-                    "<text class=\"point-label\" x=\"{:.2}\" y=\"{:.2}\" font-size=\"10\" fill=\"{colour}\">{}</text>",
-                    px + 5.0,
-                    py - 5.0,
-                    escape(label)
-                );
+                // Above right, below right, above left, below left: the first place no label
+                // holds yet; none free, the label is left out (the point and the legend stay).
+                let w = 5.5 * label.chars().count() as f64;
+                let spots =
+                    [(px + 5.0, py - 5.0), (px + 5.0, py + 14.0), (px - 5.0 - w, py - 5.0), (px - 5.0 - w, py + 14.0)];
+                let free = |&(x, y): &(f64, f64)| {
+                    placed
+                        .iter()
+                        .all(|&(a, b, aw): &(f64, f64, f64)| x + w < a || a + aw < x || y < b - 11.0 || b < y - 11.0)
+                };
+                if let Some(&(x, y)) = spots.iter().find(|p| free(p)) {
+                    placed.push((x, y, w));
+                    let _ = writeln!(
+                        markers,
+                        "<text class=\"point-label\" x=\"{x:.2}\" y=\"{y:.2}\" font-size=\"10\" fill=\"{colour}\">{}</text>",
+                        escape(label)
+                    );
+                }
             }
             let sep = if coords.is_empty() { "" } else { " " };
             let _ = write!(coords, "{sep}{px:.2},{py:.2}");
@@ -233,20 +266,32 @@ fn scales(kept: &[Vec<(f64, f64)>]) -> (LogScale, LogScale) {
 }
 
 /// Grid lines, ticks and labels of one axis: labelled decades (every decade, or every n-th when
-/// there are more than 10), and unlabelled ticks at 2..9 times each decade when there are at most 8.
+/// there are more than 10), and ticks at 2..9 times each decade when there are at most 8; an axis
+/// of at most 2 decades also labels the ticks at 2 and 5 times each decade in plain numbers (a
+/// budget ladder's 0.25..2 s would otherwise show one label).
 fn axis(scale: &LogScale, horizontal: bool) -> String {
     let decades = scale.hi - scale.lo;
     let step = (decades + 9) / 10;
     let mut s = String::new();
-    // (position, tick length, label)
-    let mut ticks: Vec<(f64, f64, Option<i32>)> = Vec::new();
+    // (position, tick length, label: a decade's exponent, or a plain number)
+    let mut ticks: Vec<(f64, f64, Option<i32>, Option<String>)> = Vec::new();
+    let plain = |k: i32, e: i32| {
+        if e >= 0 {
+            format!("{}", f64::from(k) * 10f64.powi(e))
+        } else {
+            format!("{}", f64::from(k) / 10f64.powi(-e))
+        }
+    };
     for e in scale.lo..=scale.hi {
-        ticks.push((scale.map_log10(e as f64), 6.0, ((e - scale.lo) % step == 0).then_some(e)));
+        ticks.push((scale.map_log10(e as f64), 6.0, ((e - scale.lo) % step == 0).then_some(e), None));
         if decades <= 8 && e < scale.hi {
-            ticks.extend((2..10).map(|k| (scale.map_log10(e as f64 + (k as f64).log10()), 3.0, None)));
+            ticks.extend((2..10).map(|k| {
+                let label = (decades <= 2 && (k == 2 || k == 5)).then(|| plain(k, e));
+                (scale.map_log10(e as f64 + (k as f64).log10()), if label.is_some() { 4.5 } else { 3.0 }, None, label)
+            }));
         }
     }
-    for (p, len, label) in ticks {
+    for (p, len, label, minor) in ticks {
         if horizontal {
             if len > 3.0 {
                 let _ = writeln!(s, "<line x1=\"{p:.2}\" y1=\"{TOP}\" x2=\"{p:.2}\" y2=\"{BOTTOM}\" stroke=\"#ddd\"/>");
@@ -262,6 +307,10 @@ fn axis(scale: &LogScale, horizontal: bool) -> String {
             }
             let _ =
                 writeln!(s, "<line x1=\"{LEFT}\" y1=\"{p:.2}\" x2=\"{}\" y2=\"{p:.2}\" stroke=\"black\"/>", LEFT + len);
+        }
+        if let Some(text) = minor {
+            let (x, y, anchor) = if horizontal { (p, BOTTOM + 18.0, "middle") } else { (LEFT - 8.0, p + 4.0, "end") };
+            let _ = writeln!(s, "<text class=\"minor\" x=\"{x:.2}\" y=\"{y:.2}\" text-anchor=\"{anchor}\" font-size=\"10\" fill=\"#444\">{text}</text>");
         }
         if let Some(e) = label {
             let (x, y, anchor) = if horizontal { (p, BOTTOM + 20.0, "middle") } else { (LEFT - 8.0, p + 4.0, "end") };
@@ -458,5 +507,45 @@ mod tests {
         let svg = loglog_svg(&[wide], "t", "x", "y", -1.0);
         check_xml(&svg);
         assert!(svg.contains(">-30</tspan>") && svg.contains(">30</tspan>") && !svg.contains(">-29</tspan>"));
+    }
+
+    #[test]
+    fn point_labels_do_not_collide_and_short_axes_are_labelled() {
+        // A budget ladder's seconds (0.25..2: one decade) and labels of two variants at nearly the
+        // same points: before, every label sat 5 px above-right of its point, on top of the other.
+        let s = vec![
+            Series { name: "a".into(), points: vec![(0.25, 1e-2), (0.5, 7e-3), (1.0, 5e-3), (2.0, 3.5e-3)] },
+            Series {
+                name: "b".into(),
+                points: vec![(0.251, 1.01e-2), (0.502, 7.05e-3), (1.0, 5.02e-3), (2.01, 3.5e-3)],
+            },
+        ];
+        let labels = |n: &str| Annotation {
+            y_range: Vec::new(),
+            labels: ["70 spp", "141 spp", "283 spp", "570 spp"].iter().map(|l| format!("{n} {l}")).collect(),
+        };
+        let svg = loglog_svg_annotated(&s, &[labels("a"), labels("b")], "t", "x", "y", RMSE_SLOPE);
+        let boxes: Vec<(f64, f64, f64)> = svg
+            .lines()
+            .filter(|l| l.contains("class=\"point-label\""))
+            .map(|l| {
+                let attr = |k: &str| {
+                    l.split(&format!("{k}=\"")).nth(1).unwrap().split('"').next().unwrap().parse::<f64>().unwrap()
+                };
+                let text = l.split('>').nth(1).unwrap().split('<').next().unwrap();
+                (attr("x"), attr("y"), 5.5 * text.chars().count() as f64)
+            })
+            .collect();
+        assert!(boxes.len() >= 6, "most labels are kept: {}", boxes.len());
+        for (i, a) in boxes.iter().enumerate() {
+            for b in &boxes[i + 1..] {
+                let apart = a.0 + a.2 < b.0 || b.0 + b.2 < a.0 || (a.1 - b.1).abs() > 11.0;
+                assert!(apart, "labels overlap: {a:?} {b:?}");
+            }
+        }
+        // The x axis spans one decade (0.1..1 and 1..10: two): 0.2, 0.5, 2 and 5 are written out.
+        for t in [">0.2<", ">0.5<", ">2<", ">5<"] {
+            assert!(svg.contains(t), "no tick label {t}");
+        }
     }
 }

@@ -41,6 +41,15 @@ pub struct Row {
     pub eff_vs_baseline: f64,
     /// the variant that rendered bit-identical images (then the two are not ranked)
     pub same_as: Option<String>,
+    /// mean over runs of the MSE over the smallest 99.9% of squared errors
+    /// ([`crate::report::robust::trimmed_mse`]: one firefly does not decide a ranking); NaN when not computed
+    pub mse_trimmed: f64,
+    /// 95% bootstrap interval over the runs of the mean MSE; NaN when not computed
+    pub mse_boot_ci: (f64, f64),
+    /// 95% bootstrap interval over the runs of the mean relMSE; NaN when not computed
+    pub rel_mse_boot_ci: (f64, f64),
+    /// 95% bootstrap interval over both variants' runs of [`Row::eff_vs_baseline`]; NaN when not computed
+    pub eff_vs_baseline_ci: (f64, f64),
 }
 
 impl Row {
@@ -61,6 +70,10 @@ impl Row {
             flip: f64::NAN,
             eff_vs_baseline: f64::NAN,
             same_as: None,
+            mse_trimmed: f64::NAN,
+            mse_boot_ci: (f64::NAN, f64::NAN),
+            rel_mse_boot_ci: (f64::NAN, f64::NAN),
+            eff_vs_baseline_ci: (f64::NAN, f64::NAN),
         })
     }
 
@@ -177,7 +190,7 @@ pub fn csv_table(columns: &[Column], rows: &[Row]) -> String {
 }
 
 /// A number in the shortest form that parses back to the same f64 (`1.5e-3`; `inf`/`NaN`).
-fn exact(x: f64) -> String {
+pub fn exact(x: f64) -> String {
     format!("{x:e}")
 }
 
@@ -241,6 +254,13 @@ pub const CSV_COLUMNS: &[Column] = &[
     Column { header: "same_as", cell: |r, _| r.same_as.clone().unwrap_or_default() },
     Column { header: "mse_corrected_ci_lo", cell: |r, _| exact(r.stats.mse_corrected_ci.0) },
     Column { header: "mse_corrected_ci_hi", cell: |r, _| exact(r.stats.mse_corrected_ci.1) },
+    Column { header: "mse_trimmed", cell: |r, _| exact(r.mse_trimmed) },
+    Column { header: "mse_boot_ci_lo", cell: |r, _| exact(r.mse_boot_ci.0) },
+    Column { header: "mse_boot_ci_hi", cell: |r, _| exact(r.mse_boot_ci.1) },
+    Column { header: "rel_mse_boot_ci_lo", cell: |r, _| exact(r.rel_mse_boot_ci.0) },
+    Column { header: "rel_mse_boot_ci_hi", cell: |r, _| exact(r.rel_mse_boot_ci.1) },
+    Column { header: "eff_vs_baseline_ci_lo", cell: |r, _| exact(r.eff_vs_baseline_ci.0) },
+    Column { header: "eff_vs_baseline_ci_hi", cell: |r, _| exact(r.eff_vs_baseline_ci.1) },
 ];
 
 /// The CSV header written by [`to_csv`]; `bias_ci` is split into two columns. `seconds` is the
@@ -249,7 +269,7 @@ pub const CSV_COLUMNS: &[Column] = &[
 /// `eff_vs_baseline` the efficiency over the baseline's at the same spp step, `same_as` the
 /// variant that rendered the same images, `mse_corrected_ci_lo/hi` the 95% interval of
 /// `mse_corrected` (the runs' spread and the reference's noise).
-pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share,first_sample,mse_corrected,flip,eff_vs_baseline,same_as,mse_corrected_ci_lo,mse_corrected_ci_hi";
+pub const CSV_HEADER: &str = "variant,seconds,spp,mse,rel_mse,bias,bias_ci_lo,bias_ci_hi,variance,efficiency,sampler_ns_per_sample,sampler_share,first_sample,mse_corrected,flip,eff_vs_baseline,same_as,mse_corrected_ci_lo,mse_corrected_ci_hi,mse_trimmed,mse_boot_ci_lo,mse_boot_ci_hi,rel_mse_boot_ci_lo,rel_mse_boot_ci_hi,eff_vs_baseline_ci_lo,eff_vs_baseline_ci_hi";
 
 /// Samples per pixel as an integer when it is one (ladders), else with one decimal (the mean over
 /// the runs of an equal-time budget).
@@ -281,6 +301,11 @@ pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "sampler ns/sample", cell: |r, _| ns1(r.sampler_ns_per_sample) },
     Column { header: "% of render in sampler", cell: |r, _| pct1(r.sampler_share) },
     Column { header: "MSE", cell: |r, _| sci(r.stats.mse) },
+    Column {
+        header: "MSE 95% CI (bootstrap)",
+        cell: |r, _| format!("{} .. {}", sci(r.mse_boot_ci.0), sci(r.mse_boot_ci.1)),
+    },
+    Column { header: "trimmed MSE (99.9%)", cell: |r, _| sci(r.mse_trimmed) },
     Column { header: "MSE - ref. var.", cell: |r, _| sci(r.stats.mse_corrected()) },
     Column {
         header: "its 95% CI",
@@ -292,6 +317,17 @@ pub const COMPARE_COLUMNS: &[Column] = &[
     Column { header: "bias 95% CI", cell: |r, _| format!("[{}, {}]", sci(r.stats.bias_ci.0), sci(r.stats.bias_ci.1)) },
     Column { header: "variance", cell: |r, _| sci(r.stats.variance) },
     Column { header: "efficiency 1/(MSE s)", cell: |r, _| sci(r.efficiency) },
+    Column {
+        header: "eff. ratio 95% CI (bootstrap)",
+        cell: |r, _| {
+            let (lo, hi) = r.eff_vs_baseline_ci;
+            if lo.is_finite() && hi.is_finite() {
+                format!("{lo:.2}x .. {hi:.2}x")
+            } else {
+                "n/a".into()
+            }
+        },
+    },
     Column { header: "eff. vs baseline, same spp", cell: |r, _| vs_baseline(r) },
 ];
 
@@ -329,7 +365,25 @@ pub fn to_csv(rows: &[Row]) -> String {
 /// baseline variant's at the same spp step ([`Row::eff_vs_baseline`]), or the variant it renders
 /// the same image as.
 pub fn to_markdown(rows: &[Row]) -> String {
-    markdown_table(COMPARE_COLUMNS, rows, Style::Aligned)
+    markdown_table(&compare_columns(rows), rows, Style::Aligned)
+}
+
+/// [`COMPARE_COLUMNS`] for these rows: the efficiency ratio is headed "same spp" only when the
+/// rows it compares (one step of each variant) have the same spp; equal-time steps, whose
+/// variants reach different spp, are headed "same budget".
+pub fn compare_columns(rows: &[Row]) -> Vec<Column> {
+    let variants = rows.iter().map(|r| &r.variant).collect::<std::collections::BTreeSet<_>>().len().max(1);
+    let steps = (rows.len() / variants).max(1);
+    let same_spp = (0..steps).all(|s| {
+        let mut spp = rows.iter().skip(s).step_by(steps).map(|r| r.spp);
+        let first = spp.next();
+        spp.all(|x| Some(x) == first)
+    });
+    let mut cols = COMPARE_COLUMNS.to_vec();
+    if let Some(c) = cols.iter_mut().find(|c| c.header.starts_with("eff. vs baseline")).filter(|_| !same_spp) {
+        c.header = "eff. vs baseline, same budget";
+    }
+    cols
 }
 
 /// A row of `rows.json` of `strata compare`.
@@ -354,6 +408,10 @@ struct FlatRow<'a> {
     eff_vs_baseline: f64,
     same_as: Option<&'a str>,
     mse_corrected_ci: (f64, f64),
+    mse_trimmed: f64,
+    mse_boot_ci: (f64, f64),
+    rel_mse_boot_ci: (f64, f64),
+    eff_vs_baseline_ci: (f64, f64),
 }
 
 /// The JSON of `strata compare`: an array of objects with the keys `variant`, `seconds` (the
@@ -384,6 +442,10 @@ pub fn to_json(rows: &[Row]) -> serde_json::Value {
             eff_vs_baseline: r.eff_vs_baseline,
             same_as: r.same_as.as_deref(),
             mse_corrected_ci: r.stats.mse_corrected_ci,
+            mse_trimmed: r.mse_trimmed,
+            mse_boot_ci: r.mse_boot_ci,
+            rel_mse_boot_ci: r.rel_mse_boot_ci,
+            eff_vs_baseline_ci: r.eff_vs_baseline_ci,
         })
         .collect();
     serde_json::to_value(flat).expect("rows serialize to JSON")

@@ -54,7 +54,7 @@ fn csv_has_header_one_line_per_row_and_parses_back() {
     assert_eq!(lines[0], CSV_HEADER);
     for (line, row) in lines[1..].iter().zip(&rows) {
         let f = parse_csv_line(line);
-        assert_eq!(f.len(), 19, "{line}");
+        assert_eq!(f.len(), 26, "{line}");
         let ci: Vec<f64> = f[17..19].iter().map(|s| s.parse().unwrap()).collect();
         assert_eq!(ci, [row.stats.mse_corrected_ci.0, row.stats.mse_corrected_ci.1], "{line}");
         let x: Vec<f64> = f[1..12].iter().map(|s| s.parse().unwrap()).collect();
@@ -109,6 +109,10 @@ fn json_has_the_compare_keys_and_round_trips_the_numbers() {
         "eff_vs_baseline",
         "same_as",
         "mse_corrected_ci",
+        "mse_trimmed",
+        "mse_boot_ci",
+        "rel_mse_boot_ci",
+        "eff_vs_baseline_ci",
     ];
     want.sort_unstable();
     let mut keys = keys;
@@ -215,7 +219,8 @@ fn sampler_columns_show_the_profile_or_say_not_profiled() {
     let lines: Vec<&str> = md.lines().collect();
     assert!(lines[0].contains("sampler ns/sample") && lines[0].contains("% of render in sampler"));
     assert!(lines[2].contains(" 12.5 |") && lines[2].contains(" 25.0% |"), "{}", lines[2]);
-    assert_eq!(lines[3].matches(" n/a |").count(), 2, "{}", lines[3]);
+    // Not profiled (2), and no runs to bootstrap the efficiency ratio's interval from (1).
+    assert_eq!(lines[3].matches(" n/a |").count(), 3, "{}", lines[3]);
     assert!(to_csv(&[plain.clone()]).lines().nth(1).unwrap().contains(",NaN,NaN,"));
     assert!(to_json(&[plain])[0]["sampler_share"].is_null());
 }
@@ -228,4 +233,18 @@ fn row_from_stats() {
     let row = Row::new("v", 2.0, 16.0, &stats).unwrap();
     assert_eq!((row.stats.mse, row.efficiency, row.stats.bias), (0.25, 2.0, 0.0));
     assert!(Row::new("v", f64::NAN, 16.0, &stats).is_err());
+}
+
+#[test]
+fn the_efficiency_ratio_says_same_budget_when_spp_differ() {
+    // Equal spp: every variant at 64 spp per step.
+    let header = |rows: &[Row]| compare_columns(rows).iter().find(|c| c.header.starts_with("eff. vs")).unwrap().header;
+    assert_eq!(header(&rows()), "eff. vs baseline, same spp");
+    // Equal time (a budget ladder of two steps): variants reach different spp at a step.
+    let mut r = vec![row("a", 0.25, 0.004), row("a", 0.5, 0.002), row("b", 0.25, 0.003), row("b", 0.5, 0.0015)];
+    for (x, spp) in r.iter_mut().zip([70.0, 141.0, 101.5, 203.0]) {
+        x.spp = spp;
+    }
+    assert_eq!(header(&r), "eff. vs baseline, same budget");
+    assert!(to_markdown(&r).contains("same budget") && !to_markdown(&r).contains("same spp"));
 }

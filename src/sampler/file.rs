@@ -25,6 +25,19 @@
 //! A table with one coordinate per point (`dims == 1`) is refused unless a registry layout pads
 //! it ([`FileLayout::pad`]): its points' second coordinate then comes from that layout.
 //!
+//! **The point index is shuffled per dimension** ([`FileLayout::shuffle`], the default; `none`
+//! keeps one index for every dimension, a deliberate correlation): otherwise the pixel and the
+//! light dimension of a sample take the same point of one set, and a 2D lattice becomes a
+//! correlated 4D pattern (pbrt-v4's padded samplers shuffle for the same reason). The key is
+//! `h` again, so each (pixel, dimension, block) has its own order. How depends on the set
+//! ([`FileLayout::progressive`], measured when the set is loaded: `pointset::analysis`):
+//!
+//! - a set that is not progressive is used whole (equal-time runs take whole blocks), so its
+//!   index is a keyed pseudo-random permutation of `0..points` ([`permute_lanes`]);
+//! - a progressive set is used by prefixes, so its index is XORed with a key below the largest
+//!   power of two `m <= points` (indices `>= m` are kept): the first 2^k indices become another
+//!   aligned block of 2^k, which for a (0, 2)-sequence (Sobol', pmj02) is again a net.
+//!
 //! Registry: [`SamplerKind`] is a `u8` index; indices past the static [`SAMPLERS`] name loaded
 //! layouts ([`register`]), leaked once per distinct (content, options), so kinds stay `Copy` and
 //! every call site (camera, lights, replay, compare) works unchanged. At most [`MAX_LOADED`]
@@ -156,6 +169,54 @@ pub struct FileLayout {
     /// for a table of one coordinate per point: the registry layout whose second coordinate
     /// pads it (None: the table has two)
     pub pad: Option<SamplerKind>,
+    /// shuffle the point index per (pixel, dimension, block) (default; see the module docs)
+    pub shuffle: bool,
+    /// the sets' prefixes are sets as good as fresh ones of their size (measured on loading):
+    /// used by prefixes; otherwise used whole (equal time runs whole sets)
+    pub progressive: bool,
+}
+
+/// A keyed pseudo-random permutation of `0..n` per lane (`i < n`): bijective rounds on the
+/// smallest power-of-two domain `>= n` (xor with the key, odd multiplies, xorshifts, a keyed add),
+/// walked back into `0..n` (the same round again until the value lands inside: a cycle of the
+/// bijection through `i` returns to `0..n`), then a keyed rotation `(x + r) mod n` so every
+/// image is equally likely whatever the rounds' bias. Lanes walk together and keep their first
+/// value inside, so one lane and eight agree bit for bit.
+pub fn permute_lanes<L: Lanes>(i: L, n: u32, key: L) -> L {
+    if n <= 1 {
+        return L::splat(0);
+    }
+    let bits = 32 - (n - 1).leading_zeros();
+    let m = L::splat(if bits == 32 { u32::MAX } else { (1u32 << bits) - 1 });
+    let half = (bits / 2).max(1);
+    let nn = L::splat(n);
+    let (zero, one) = (L::splat(0), L::splat(1));
+    let round = |x: L| {
+        let x = x.xor(key.and(m)).mul(L::splat(0x2c1b_3c6d)).and(m);
+        let x = x.xor(x.shr(half));
+        let x = x.add(key.shr(11)).and(m).mul(key.shr(3).or(one).mul(L::splat(0x297a_2d39)).or(one)).and(m);
+        x.xor(x.shr(half))
+    };
+    let (mut x, mut out, mut done) = (i, i, zero);
+    loop {
+        x = round(x);
+        // Not done yet and inside: this lane's value.
+        out = done.lt_select(one, x.lt_select(nn, x, out), out);
+        done = done.or(x.lt_select(nn, one, zero));
+        let all = std::cell::Cell::new(true);
+        done.map(|d| {
+            if d == 0 {
+                all.set(false);
+            }
+            d
+        });
+        if all.get() {
+            break;
+        }
+    }
+    let r = mix(key, L::splat(7)).mulhi(nn);
+    let y = out.add(r);
+    y.lt_select(nn, y, y.sub(nn))
 }
 
 impl Layout for FileLayout {
@@ -168,6 +229,14 @@ impl Layout for FileLayout {
         // advance) gets its own set and randomization: blocks of `points` points, each unbiased.
         let (block, i) = (i.map(|i| i / points), i.map(|i| i % points));
         let h = hash(TAG_FILE, seed, dim, [pixel, block]);
+        let i = match (self.shuffle, self.progressive) {
+            (false, _) => i,
+            (true, false) => permute_lanes(i, points, mix(h, L::splat(3))),
+            (true, true) => {
+                let m = 1u32 << (31 - points.leading_zeros());
+                i.lt_select(L::splat(m), i.xor(mix(h, L::splat(3)).and(L::splat(m - 1))), i)
+            }
+        };
         let s = match self.map {
             SetMap::Hash => h.mulhi(L::splat(t.sets)),
             SetMap::Pixel => pixel.map(|p| p % t.sets),
@@ -195,6 +264,7 @@ struct Loaded {
     digest: &'static str,
     points: u32,
     sets: u32,
+    progressive: bool,
 }
 
 static LOADED: [OnceLock<Loaded>; MAX_LOADED] = [const { OnceLock::new() }; MAX_LOADED];
@@ -212,8 +282,13 @@ pub enum RegisterError {
 /// Registers `layout` under `name` (e.g. `file:pts.npy`) with content `digest` (a hash of the
 /// points and options: equal digests give the same kind, so loading a file twice costs nothing).
 pub fn register(name: &str, digest: &str, layout: FileLayout) -> Result<SamplerKind, RegisterError> {
-    let key =
-        format!("{digest}/{}/{}/{}", layout.map.name(), layout.scramble.name(), layout.pad.map_or("-", |k| k.name()));
+    let key = format!(
+        "{digest}/{}/{}/{}/{}",
+        layout.map.name(),
+        layout.scramble.name(),
+        layout.pad.map_or("-", |k| k.name()),
+        if layout.shuffle { "shuffle" } else { "in-order" }
+    );
     let mut keys = KEYS.lock().unwrap_or_else(|p| p.into_inner());
     if let Some((_, kind)) = keys.iter().find(|(k, _)| *k == key) {
         return Ok(*kind);
@@ -223,11 +298,13 @@ pub fn register(name: &str, digest: &str, layout: FileLayout) -> Result<SamplerK
         return Err(RegisterError::Full);
     }
     let leak = |s: String| -> &'static str { Box::leak(s.into_boxed_str()) };
-    let (points, sets) = (layout.table.points, layout.table.sets);
+    let (points, sets, progressive) = (layout.table.points, layout.table.sets, layout.progressive);
     let description = leak(format!(
-        "{sets} sets of {points} points, {} scramble, set by {}",
+        "{sets} sets of {points} points ({}), {} scramble, set by {}, index {}",
+        if progressive { "progressive" } else { "not progressive: used in whole sets" },
         layout.scramble.name(),
-        layout.map.name()
+        layout.map.name(),
+        if layout.shuffle { "shuffled per dimension" } else { "shared by every dimension" }
     ));
     let biased = layout.scramble == Scramble::None;
     let layout: &'static FileLayout = Box::leak(Box::new(layout));
@@ -235,7 +312,7 @@ pub fn register(name: &str, digest: &str, layout: FileLayout) -> Result<SamplerK
     if biased {
         info = info.biased();
     }
-    let loaded = Loaded { info, digest: leak(digest.to_string()), points, sets };
+    let loaded = Loaded { info, digest: leak(digest.to_string()), points, sets, progressive };
     if LOADED[j].set(loaded).is_err() {
         unreachable!("slot {j} is filled only here, under the lock");
     }
@@ -267,6 +344,12 @@ pub fn file_info(kind: SamplerKind) -> Option<(&'static str, u32, u32)> {
     })
 }
 
+/// For a loaded kind whose sets are not progressive: its points per set (a run must use whole
+/// sets of them, never a prefix); None for progressive sets and registry kinds.
+pub fn whole_set_points(kind: SamplerKind) -> Option<u32> {
+    kind.loaded_index().map(loaded).filter(|l| !l.progressive).map(|l| l.points)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,7 +365,8 @@ mod tests {
     }
 
     fn kind_of(table: PointTable, map: SetMap, scramble: Scramble, digest: &str) -> SamplerKind {
-        register("file:test", digest, FileLayout { table, map, scramble, pad: None }).unwrap()
+        let layout = FileLayout { table, map, scramble, pad: None, shuffle: false, progressive: true };
+        register("file:test", digest, layout).unwrap()
     }
 
     #[test]
@@ -386,6 +470,137 @@ mod tests {
             let var = est.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / f64::from(pixels - 1);
             let se = (var / f64::from(pixels)).sqrt();
             assert!((mean - (0.5 + 1.0 / 3.0)).abs() < 4.0 * se, "{scramble:?}: mean {mean} se {se}");
+        }
+    }
+
+    /// The 144-point Fibonacci lattice (i / 144, frac(i * 89 / 144)) as one set.
+    fn fibonacci144() -> PointTable {
+        let xy =
+            (0..144u32).map(|i| [fixed24(f64::from(i) / 144.0), fixed24(f64::from(i * 89 % 144) / 144.0)]).collect();
+        PointTable::new(1, 144, xy).unwrap()
+    }
+
+    #[test]
+    fn permutation_is_a_bijection_and_lanes_agree() {
+        use crate::simd::U8;
+        for n in [2u32, 3, 7, 16, 144, 1000] {
+            for key in [0u32, 1, 0xdead_beef, 77] {
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let j = permute_lanes(i, n, key);
+                    assert!(j < n && !seen[j as usize], "n {n} key {key}: {i} -> {j}");
+                    seen[j as usize] = true;
+                }
+                let i8 = U8::new(std::array::from_fn(|l| (l as u32 * 5 + 1) % n));
+                let k8 = U8::new(std::array::from_fn(|l| key.wrapping_add(l as u32 * 0x9e37)));
+                let got = permute_lanes(i8, n, k8).to_array();
+                for (l, &g) in got.iter().enumerate() {
+                    assert_eq!(g, permute_lanes(i8.to_array()[l], n, k8.to_array()[l]));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn shuffle_gives_each_dimension_its_own_index() {
+        // One lattice for every dimension, unscrambled: in order, sample k takes lattice point k in
+        // dimension 0 and in dimension 1 (a correlated 4D pattern); shuffled, each dimension still
+        // uses every point of the set once, but pairs them at random.
+        let t = fibonacci144();
+        let index = |p: [f32; 2]| t.xy.iter().position(|q| *q == p.map(fixed24_f32)).unwrap();
+        for (shuffle, digest) in [(false, "fib in order"), (true, "fib shuffled")] {
+            let layout = FileLayout {
+                table: t.clone(),
+                map: SetMap::Hash,
+                scramble: Scramble::None,
+                pad: None,
+                shuffle,
+                progressive: false,
+            };
+            let set = PointSet::new(register("file:fib", digest, layout).unwrap(), 144);
+            for pixel in [0, 9, 1234] {
+                let d0: Vec<usize> = (0..144).map(|k| index(set.point(pixel, 0, 0, k, 3))).collect();
+                let d1: Vec<usize> = (0..144).map(|k| index(set.point(pixel, 0, 1, k, 3))).collect();
+                for d in [&d0, &d1] {
+                    let mut sorted = d.clone();
+                    sorted.sort_unstable();
+                    assert_eq!(sorted, (0..144).collect::<Vec<_>>(), "every point once per dimension");
+                }
+                let same = d0.iter().zip(&d1).filter(|(a, b)| a == b).count();
+                if shuffle {
+                    assert!(same <= 6, "pixel {pixel}: {same} of 144 samples share their point");
+                } else {
+                    assert_eq!(same, 144);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn progressive_sets_keep_aligned_prefixes() {
+        // A progressive set of 256 is shuffled by an XOR below 256: the first 2^k indices of a
+        // dimension are an aligned block of 2^k points of the set, in some order.
+        let t = table(1, 256);
+        let layout = FileLayout {
+            table: t.clone(),
+            map: SetMap::Hash,
+            scramble: Scramble::None,
+            pad: None,
+            shuffle: true,
+            progressive: true,
+        };
+        let set = PointSet::new(register("file:prog", "progressive xor", layout).unwrap(), 256);
+        let index = |p: [f32; 2]| t.xy.iter().position(|q| *q == p.map(fixed24_f32)).unwrap();
+        for dim in 0..4 {
+            for k in [1usize, 4, 16, 64] {
+                let mut got: Vec<usize> = (0..k as u32).map(|i| index(set.point(5, 0, dim, i, 1))).collect();
+                got.sort_unstable();
+                assert_eq!(got[k - 1] - got[0], k - 1, "dim {dim}, prefix {k}: {got:?}");
+                assert_eq!(got[0] % k, 0);
+            }
+        }
+        assert_eq!(
+            whole_set_points(
+                register(
+                    "file:prog",
+                    "progressive xor",
+                    FileLayout {
+                        table: t,
+                        map: SetMap::Hash,
+                        scramble: Scramble::None,
+                        pad: None,
+                        shuffle: true,
+                        progressive: true
+                    }
+                )
+                .unwrap()
+            ),
+            None
+        );
+    }
+
+    #[test]
+    fn shuffled_lanes_agree() {
+        use crate::simd::U8;
+        for progressive in [false, true] {
+            let layout = FileLayout {
+                table: table(3, 16),
+                map: SetMap::Hash,
+                scramble: Scramble::Shift,
+                pad: None,
+                shuffle: true,
+                progressive,
+            };
+            let k = register("file:x8", if progressive { "x8 shuffled p" } else { "x8 shuffled" }, layout).unwrap();
+            assert_eq!(whole_set_points(k), (!progressive).then_some(16));
+            let set = PointSet::for_image(k, 5, 9);
+            let pixel = U8::new([0, 1, 2, 3, 100, 1000, 77, 5]);
+            let kk = U8::new([0, 1, 2, 3, 4, 0, 1, 2]);
+            let (x, y) = set.point_x8(pixel, U8::splat(2), 3, kk, 11);
+            let (x, y) = (x.to_array(), y.to_array());
+            for l in 0..8 {
+                assert_eq!(set.point(pixel.to_array()[l], 2, 3, kk.to_array()[l], 11), [x[l], y[l]]);
+            }
         }
     }
 }

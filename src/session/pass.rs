@@ -135,6 +135,8 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
     }
     // `--profile`: the phase profiler runs over every pass (it never changes the image).
     let profiling = opts.profile.is_some().then(crate::profile::enable);
+    // A time budget ends on whole sets of a point set that is not progressive.
+    let block = if opts.time_budget.is_some() { whole_set_spp(&integrator) } else { 1 };
     while s < target.end {
         if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
             interrupted = true;
@@ -150,6 +152,7 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
             if let Some(per) = progress.secs_per_spp() {
                 n = n.min(((left / per) as u32).max(1));
             }
+            n = n.div_ceil(block).saturating_mul(block).min(target.end - s);
         }
         let st = progress.watch(n, started, |tiles_done| {
             render::render_counted(&scene, &integrator, &mut film, s..s + n, &pool, tiles_done)
@@ -191,6 +194,29 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
     };
     header = checkpoint::header_for(header, &film);
     Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted, lock })
+}
+
+/// The spp granularity of an equal-time run of `it`: runs must end on whole sets of every loaded
+/// point set that is not progressive (`sampler::file::whole_set_points`), never partway through
+/// one (`docs/POINTSETS.md`'s block rule). The pixel and path dimensions use indices `0..spp`, the
+/// light dimensions `0..spp * light_samples`, so a set of N points needs spp a multiple of N, and
+/// of `N / gcd(N, light_samples)` for the light. 1 when every layout is progressive.
+pub fn whole_set_spp(it: &crate::integrator::Integrator) -> u32 {
+    fn gcd(a: u64, b: u64) -> u64 {
+        if b == 0 {
+            a
+        } else {
+            gcd(b, a % b)
+        }
+    }
+    let [pixel, light, path] = it.kinds();
+    let n_light = u64::from(it.light_set.n().max(1));
+    let need = [(pixel, 1), (light, n_light), (path, 1)].into_iter().filter_map(|(k, per)| {
+        let n = u64::from(crate::sampler::file::whole_set_points(k)?);
+        Some(n / gcd(n, per))
+    });
+    let lcm = need.fold(1u64, |a, b| a / gcd(a, b) * b);
+    u32::try_from(lcm).unwrap_or(u32::MAX)
 }
 
 /// Sets the returned flag on SIGINT or SIGTERM (a render checks it between passes, then writes a

@@ -293,3 +293,43 @@ fn the_references_variance_layer_enters_the_bias_test_and_the_corrected_mse() {
     assert!(mean.abs() > t * se, "this case must need the reference's noise: {mean} +- {}", t * se);
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// Issue 31: `--budget 0.005,0.01,0.02` is a budget ladder: one row per budget and variant, a slope
+/// against CPU seconds for each variant, and the efficiency column headed "same budget" (the
+/// variants reach different spp). Before, a list of budgets was refused.
+#[test]
+fn a_budget_ladder_gives_slopes_against_time() {
+    let (c, d) = (common::corpus_required(), common::tmpdir("cmp-budgets"));
+    let direct9 = c.join("hw2/direct9.test");
+    reference(&direct9, "32x24", 4096, &[], &d.join("ref"));
+    let o = compare(
+        &direct9,
+        &d.join("ref.exr"),
+        "32x24",
+        &[
+            "--runs",
+            "3",
+            "--budget",
+            "0.005,0.01,0.02",
+            "--variant",
+            "independent=--light-sampler independent",
+            "--variant",
+            "sobol=--light-sampler sobol",
+        ],
+        &d.join("out"),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let rows = rows(&d.join("out"));
+    assert_eq!(rows.len(), 6, "one row per variant and budget");
+    let table = std::fs::read_to_string(d.join("out/table.md")).unwrap();
+    assert!(table.contains("eff. vs baseline, same budget"), "{table}");
+    for v in ["independent", "sobol"] {
+        let line = table.lines().find(|l| l.starts_with(&format!("| {v} |")) && l.matches('|').count() == 4).unwrap();
+        let vs_seconds = line.split('|').nth(3).unwrap().trim();
+        assert!(vs_seconds.starts_with('-'), "{v}: slope against CPU seconds {vs_seconds} ({table})");
+    }
+    let runs: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(d.join("out/runs.json")).unwrap()).unwrap();
+    let budgets: std::collections::BTreeSet<String> = runs.iter().map(|r| r["budget"].to_string()).collect();
+    assert_eq!(budgets.len(), 3, "{budgets:?}");
+}

@@ -39,7 +39,7 @@ fn base(scene: &Path, spp: u32) -> RenderOptions {
 fn exported(kind: SamplerKind, file: &Path, points: u32, dim: u32, seed: u64) -> SamplerKind {
     let args = Args { sets: 24 * 16, points, dim, width: 24, seed, ..Args::default() };
     formats::write(file, &layout_sets(kind, &args).unwrap()).unwrap();
-    resolve_sampler(&format!("file:{}?scramble=none&sets=pixel", file.display())).unwrap()
+    resolve_sampler(&format!("file:{}?scramble=none&sets=pixel&shuffle=none", file.display())).unwrap()
 }
 
 #[test]
@@ -220,4 +220,61 @@ fn file_samplers_work_in_shards_and_profile() {
     assert!(p.status.success(), "{}", String::from_utf8_lossy(&p.stderr));
     let json = std::fs::read_to_string(dir.join("p.json")).unwrap();
     assert!(json.contains(&format!("light {spec}")), "the replay names the file sampler");
+}
+
+/// Mean over a variant's runs of `mse_corrected * spp` (the error of one sample's worth: equal
+/// for every spp at the Monte Carlo rate, lower is better).
+fn error_per_sample(runs: &[serde_json::Value], variant: &str) -> f64 {
+    let mine: Vec<f64> = runs
+        .iter()
+        .filter(|r| r["variant"] == variant)
+        .map(|r| r["mse_corrected"].as_f64().unwrap() * r["spp"].as_f64().unwrap())
+        .collect();
+    mine.iter().sum::<f64>() / mine.len() as f64
+}
+
+/// Issue 31: a 144-point Fibonacci lattice (not progressive) at equal time runs whole sets of 144
+/// spp (never a prefix), says so, and ranks against independent samples as it does at exactly
+/// 144 spp (within its noise). Before, a budget stopped wherever it ran out (70-101 spp of 144),
+/// and the lattice's prefix (a strip of the square) ranked it far below independent.
+#[test]
+fn a_lattice_at_equal_time_runs_whole_sets_and_ranks_as_at_its_size() {
+    let dir = tmpdir("pointset-equal-time");
+    let scene = scene(&dir);
+    let fib = dir.join("fib144.txt");
+    let text: String =
+        (0..144).map(|i| format!("{} {}\n", f64::from(i) / 144.0, f64::from(i * 89 % 144) / 144.0)).collect();
+    std::fs::write(&fib, text).unwrap();
+    let st = strata().arg("reference").arg(&scene).args(["--spp", "8192", "-q", "-o"]).arg(dir.join("ref")).status();
+    assert!(st.unwrap().success());
+    let variants = [
+        format!("fib=--integrator direct --light-samples 1 --sampler file:{}", fib.display()),
+        "ind=--integrator direct --light-samples 1 --sampler independent".to_string(),
+    ];
+    let compare = |mode: &[&str], out: &str| -> Vec<serde_json::Value> {
+        let mut c = strata();
+        c.arg("compare").arg(&scene).arg("--reference").arg(dir.join("ref.exr"));
+        c.args(["--runs", "6", "--threads", "2", "-q"]).args(mode).arg("--out").arg(dir.join(out));
+        for v in &variants {
+            c.arg("--variant").arg(v);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str(&std::fs::read_to_string(dir.join(out).join("runs.json")).unwrap()).unwrap()
+    };
+    let at_144 = compare(&["--spp-ladder", "144"], "ladder");
+    let eq = compare(&["--budget", "0.05"], "budget");
+    for r in eq.iter().filter(|r| r["variant"] == "fib") {
+        let spp = r["spp"].as_u64().unwrap();
+        assert!(spp >= 144 && spp % 144 == 0, "an equal-time run ended partway through a set: {spp} spp");
+    }
+    let table = std::fs::read_to_string(dir.join("budget/table.md")).unwrap();
+    assert!(table.contains("is not progressive") && table.contains("blocks of 144 spp"), "{table}");
+    let (r144, req) = (
+        error_per_sample(&at_144, "fib") / error_per_sample(&at_144, "ind"),
+        error_per_sample(&eq, "fib") / error_per_sample(&eq, "ind"),
+    );
+    println!("error per sample, lattice / independent: at 144 spp {r144:.3}, at equal time {req:.3}");
+    assert!(r144 < 0.5, "the lattice beats independent samples at its size: {r144}");
+    assert!(req < 0.5 && req / r144 < 2.5 && r144 / req < 2.5, "equal time {req} against 144 spp {r144}");
 }
