@@ -43,6 +43,9 @@ pub struct Material {
     pub brdf: BrdfKind,
     /// GGX alpha, used as is (default 1)
     pub roughness: f32,
+    /// The BSDF of a registry entry other than the course's (`interface::COURSE`: kd, ks, brdf,
+    /// shininess and roughness above are the BSDF)
+    pub bsdf: super::interface::BsdfParams,
 }
 
 impl Default for Material {
@@ -55,6 +58,7 @@ impl Default for Material {
             ambient: Vec3::splat(0.2),
             brdf: BrdfKind::Phong,
             roughness: 1.0,
+            bsdf: super::interface::BsdfParams::COURSE,
         }
     }
 }

@@ -14,6 +14,7 @@
 //! Adding a lobe: its file (a type implementing [`Lobe`] with a new `BIT`), one entry in
 //! [`AllLobes`], its tests (and, for a faster specialized kernel, one line in `with_lobe_set!`).
 
+use super::interface::BsdfSet;
 use super::material::{Material, Material8};
 use crate::bsdf::desc::BrdfKind;
 use crate::simd::{Mask8, Vec3x8, F8};
@@ -43,8 +44,10 @@ pub trait Lobe {
 
 /// A type-level list of lobes: `()` or `(L, Rest)`.
 pub trait LobeSet: 'static {
-    /// The [`Lobes`] bits of the set.
+    /// The [`Lobes`] bits of the set (its BSDFs' included).
     const BITS: u32;
+    /// The registry BSDFs compiled in with the lobes (`()`: the course's materials only).
+    type Bsdfs: BsdfSet;
     /// Scalar f_spec and pdf of the lobe of `m.kind` if it is in the set, else zero.
     fn eval_pdf(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32);
     /// Scalar sample of the lobe of `m.kind` (None if it is not in the set).
@@ -67,6 +70,7 @@ pub trait LobeSet: 'static {
 
 impl LobeSet for () {
     const BITS: u32 = 0;
+    type Bsdfs = ();
     #[inline]
     fn eval_pdf(_: &Material, _: Vec3, _: Vec3) -> (Vec3, f32) {
         (Vec3::ZERO, 0.0)
@@ -91,6 +95,7 @@ impl LobeSet for () {
 
 impl<H: Lobe + 'static, T: LobeSet> LobeSet for (H, T) {
     const BITS: u32 = H::BIT | T::BITS;
+    type Bsdfs = T::Bsdfs;
     #[inline]
     fn eval_pdf(m: &Material, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         if m.kind == H::KIND {
@@ -137,8 +142,39 @@ impl<H: Lobe + 'static, T: LobeSet> LobeSet for (H, T) {
     }
 }
 
-/// Every lobe: the general kernel's set. A new lobe is added here.
-pub type AllLobes = (super::Phong, (super::Ggx, ()));
+/// The end of a lobe list that compiles in the registry BSDFs `B` (no course lobe of its own).
+pub struct WithBsdfs<B>(std::marker::PhantomData<B>);
+
+impl<B: BsdfSet> LobeSet for WithBsdfs<B> {
+    const BITS: u32 = B::BITS;
+    type Bsdfs = B;
+    #[inline]
+    fn eval_pdf(_: &Material, _: Vec3, _: Vec3) -> (Vec3, f32) {
+        (Vec3::ZERO, 0.0)
+    }
+    #[inline]
+    fn sample(_: &Material, _: Vec3, _: [f32; 2]) -> Option<Vec3> {
+        None
+    }
+    #[inline]
+    fn eval_pdf_x8(_: &Material8, _: Vec3x8, _: Vec3x8, _: Mask8, acc: (Vec3x8, F8)) -> (Vec3x8, F8) {
+        acc
+    }
+    #[inline]
+    fn sample_x8(_: &Material8, _: Vec3x8, _: [F8; 2], _: Mask8, wi: Vec3x8) -> Vec3x8 {
+        wi
+    }
+    fn used_by(m: &crate::bsdf::desc::Material) -> u32 {
+        B::bit_of(m.bsdf.kind)
+    }
+    fn names(bits: u32, out: &mut Vec<&'static str>) {
+        B::names(bits, out)
+    }
+}
+
+/// Every lobe and every registry BSDF: the general kernel's set. A new lobe is added here (a new
+/// BSDF to the `registry!` of `bsdf/mod.rs`).
+pub type AllLobes = (super::Phong, (super::Ggx, WithBsdfs<super::AllBsdfs>));
 /// Diffuse only (no specular lobe compiled in).
 pub type Diffuse = ();
 /// Diffuse and modified Phong.

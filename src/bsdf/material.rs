@@ -3,6 +3,7 @@
 //! The specular lobes come from a [`LobeSet`]; scalar code and the `eval_pdf`/`sample` entry points
 //! use [`AllLobes`], kernels the set compiled for the scene (`*_k::<L>`).
 
+use super::interface::{self, BsdfSet, Params8, Sample8, COURSE};
 use super::lobe::{AllLobes, LobeSet};
 use super::{diffuse, BrdfKind, ImportanceSampling};
 use crate::sampling::{fmadd, sample_uniform_hemisphere, sample_uniform_hemisphere_x8};
@@ -106,6 +107,27 @@ pub struct Material8 {
     pub alpha: F8,
     /// lanes using GGX (all-ones) rather than Phong (all-zeros)
     pub ggx: Mask8,
+    /// the registry BSDF of each lane ([`interface::COURSE`] lanes use the fields above)
+    pub bsdf: Params8,
+    /// lanes hit from the back of the surface (the frame faces the viewer; one-sided BSDFs are
+    /// evaluated in the surface's own frame, see [`interface::flip_to_surface`])
+    pub back: Mask8,
+}
+
+/// [`Material8::sample_bsdf_k`]'s result: the direction, pdf and value of every lane, and on the
+/// `general` lanes (registry BSDFs) the interface's [`Sample8`] (weight, lobe flags, eta).
+#[derive(Clone, Copy, Debug)]
+pub struct Sampled8 {
+    /// sampled direction (local frame)
+    pub wi: Vec3x8,
+    /// solid-angle pdf (delta lobes: the lobe probability, see `general.flags`)
+    pub pdf: F8,
+    /// f(wo, wi) on the course lanes
+    pub f: Vec3x8,
+    /// lanes sampled through the BSDF interface: use `bsdf.weight`, not f cos / pdf
+    pub general: Mask8,
+    /// the interface's sample on the `general` lanes
+    pub bsdf: Sample8,
 }
 
 impl Material8 {
@@ -117,6 +139,8 @@ impl Material8 {
             shininess: F8::new(m.map(|m| m.shininess)),
             alpha: F8::new(m.map(|m| m.alpha)),
             ggx: crate::simd::mask_from_bools(m.map(|m| m.kind == BrdfKind::Ggx)),
+            bsdf: Params8::COURSE,
+            back: F8::ZERO,
         }
     }
 
@@ -156,7 +180,47 @@ impl Material8 {
                 and_mask(t.mul_add(ps, (F8::ONE - t) * diffuse::pdf_x8(wi, active)), active)
             }
         };
+        if <L::Bsdfs as BsdfSet>::BITS != 0 {
+            let general = self.general(active);
+            if general.any() {
+                let (fb, pb) = interface::eval_pdf_x8::<L::Bsdfs>(&self.bsdf, self.back, wo, wi, general);
+                return (Vec3x8::select(general, fb, f), general.select(pb, pdf));
+            }
+        }
         (f, pdf)
+    }
+
+    /// The `active` lanes whose BSDF is a registry entry (not the course's material).
+    #[inline]
+    pub fn general(&self, active: Mask8) -> Mask8 {
+        active & !self.bsdf.lanes_of(COURSE)
+    }
+
+    /// [`Material8::sample_k`] with the registry BSDFs of `L`: course lanes as `sample_k` (under
+    /// `strategy`), the others through the BSDF interface (their own sampling, `u_lobe` picking the
+    /// lobe; `strategy` does not apply).
+    #[inline]
+    pub fn sample_bsdf_k<L: LobeSet>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        u: [F8; 2],
+        u_lobe: F8,
+        active: Mask8,
+    ) -> Sampled8 {
+        let (wi, pdf, f) = self.sample_k::<L>(strategy, wo, u, u_lobe, active);
+        let mut s = Sampled8 { wi, pdf, f, general: F8::ZERO, bsdf: Sample8::NONE };
+        if <L::Bsdfs as BsdfSet>::BITS != 0 {
+            let general = self.general(active);
+            if general.any() {
+                let b = interface::sample_x8::<L::Bsdfs>(&self.bsdf, self.back, wo, u_lobe, u, general);
+                s.wi = Vec3x8::select(general, b.wi, s.wi);
+                s.pdf = general.select(b.pdf, s.pdf);
+                s.general = general;
+                s.bsdf = b;
+            }
+        }
+        s
     }
 
     /// Eight-lane [`Material::eval`].

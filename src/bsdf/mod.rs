@@ -23,7 +23,9 @@
 //!   `active: Mask8` last; inactive lanes get zero f, pdf and direction.
 
 pub mod diffuse;
+pub mod fresnel;
 mod ggx;
+pub mod interface;
 pub mod lobe;
 pub mod material;
 // Used by the rough BSDFs (roughconductor, roughdielectric, roughplastic); until they land, only by its tests.
@@ -37,5 +39,28 @@ pub mod desc;
 pub use desc::{BrdfKind, ImportanceSampling};
 pub use ggx::Ggx;
 pub use lobe::{AllLobes, Diffuse, DiffuseGgx, DiffusePhong, Lobe, LobeSet, Lobes};
-pub use material::{Material, Material8};
+pub use material::{Material, Material8, Sampled8};
 pub use phong::Phong;
+
+/// The BSDF registry: one line per BSDF file (`file: Type,`): declares the module, re-exports the
+/// type and appends it to [`AllBsdfs`], the list the general kernel compiles in (and the generic
+/// tests of `bsdf/tests.rs` iterate).
+macro_rules! registry {
+    ($($file:ident: $ty:ident,)*) => {
+        $(pub mod $file; pub use $file::$ty;)*
+        /// Every registered BSDF (besides the course's materials): the general kernel's set.
+        pub type AllBsdfs = registry!(@list $($ty)*);
+    };
+    (@list) => { () };
+    (@list $h:ident $($t:ident)*) => { ($h, registry!(@list $($t)*)) };
+}
+
+registry! {
+    conductor: Conductor,
+    dielectric: Dielectric,
+    plastic: Plastic,
+}
+
+pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};
+#[cfg(test)]
+mod registry_tests;

@@ -6,7 +6,7 @@
 use super::samples::Samples;
 use super::stats::{Counters, RayKind, RayLog};
 use crate::accel::{Ray8, RayHit8};
-use crate::bsdf::Material8;
+use crate::bsdf::{BsdfSet, LobeSet, Material8};
 use crate::camera::PixelPacket;
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::simd::{Mask8, Vec3x8, F8};
@@ -102,8 +102,14 @@ pub(super) fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
     Vec3x8::new(m.select(v.x, F8::ZERO), m.select(v.y, F8::ZERO), m.select(v.z, F8::ZERO))
 }
 
-/// The material of a hit record.
+/// The material of a hit record, with the registry BSDF rows looked up only in a kernel that
+/// compiles registry BSDFs in.
 #[inline]
-pub(super) fn material(sh: &SurfaceHit8) -> Material8 {
-    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx }
+pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8 {
+    let bsdf = if <L::Bsdfs as BsdfSet>::BITS != 0 {
+        scene.bsdf_params(sh.material, sh.valid)
+    } else {
+        crate::bsdf::Params8::COURSE
+    };
+    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx, bsdf, back: sh.back }
 }

@@ -192,7 +192,7 @@ fn shade_all<L: LobeSet>(
                     group.sample(it, scene, sh, u, v, shade)
                 };
                 // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-                let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
+                let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(scene, sh, &ls, ok) else { continue };
                 sc.contrib.push(match group {
                     Group::Quad(_) => f.scale(g),
                     Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
@@ -316,7 +316,7 @@ fn shade_one<L: LobeSet>(
                 it.light_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, v))
             };
             j += 1;
-            let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(sh, &ls, ok) else { continue };
+            let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(scene, sh, &ls, ok) else { continue };
             let g = g * ls.area * ls.inv_pmf * inv_n;
             sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));
             let o = sh.ng.mul_add(sc.eps[i], sh.p);
@@ -346,7 +346,12 @@ pub(super) struct LightTerm {
 /// The light term of light points `ls` at hits `sh` on lanes `active`; None where it lights no
 /// lane.
 #[inline]
-pub(super) fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active: Mask8) -> Option<LightTerm> {
+pub(super) fn light_term<L: LobeSet>(
+    scene: &Scene,
+    sh: &SurfaceHit8,
+    ls: &LightSample8,
+    active: Mask8,
+) -> Option<LightTerm> {
     let to = ls.y - sh.p;
     let d2 = to.length_squared();
     let inv_d = F8::ONE / d2.sqrt();
@@ -364,7 +369,7 @@ pub(super) fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active
         // The path tracer's material code, in the local shading frame.
         let frame = Frame8::from_normal(sh.n);
         let strategy = crate::scene::desc::ImportanceSampling::Cosine;
-        material(sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
+        material::<L>(scene, sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
     };
     Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
 }
@@ -373,7 +378,12 @@ pub(super) fn light_term<L: LobeSet>(sh: &SurfaceHit8, ls: &LightSample8, active
 /// the lanes lit (cos(th_i) > 0, and above the geometric surface on smooth-shaded lanes); None
 /// where no lane is lit (for lights at a direction rather than a point: environment, delta).
 #[inline]
-fn light_term_f<L: LobeSet>(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Option<(Vec3x8, F8, Mask8)> {
+fn light_term_f<L: LobeSet>(
+    scene: &Scene,
+    sh: &SurfaceHit8,
+    wi: Vec3x8,
+    active: Mask8,
+) -> Option<(Vec3x8, F8, Mask8)> {
     let cos_i = sh.n.dot(wi);
     let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
     let lit = active & cos_i.simd_gt(F8::ZERO) & leaves;
@@ -383,7 +393,7 @@ fn light_term_f<L: LobeSet>(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Opti
     let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
     let frame = Frame8::from_normal(sh.n);
     let strategy = crate::scene::desc::ImportanceSampling::Cosine;
-    let f = material(sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
+    let f = material::<L>(scene, sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
     Some((f, lit.select(cos_i, F8::ZERO), lit))
 }
 

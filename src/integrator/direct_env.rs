@@ -56,7 +56,7 @@ pub(super) fn shade_outside<L: LobeSet>(
                     }
                 };
                 let ok = shade[i] & pdf.simd_gt(F8::ZERO);
-                let Some((f, cos, lit)) = light_term_f::<L>(sh, wi, ok) else { continue };
+                let Some((f, cos, lit)) = light_term_f::<L>(scene, sh, wi, ok) else { continue };
                 contrib.push(masked(f.mul_elem(le).scale(cos / pdf * inv_n), lit));
                 let o = sh.ng.mul_add(eps[i], sh.p);
                 let (ray, lit) = Ray8::new(o, wi, F8::ZERO, F8::splat(f32::INFINITY), lit);
@@ -74,7 +74,7 @@ pub(super) fn shade_outside<L: LobeSet>(
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 light.sample_x8(sh.p, shade[i])
             };
-            let Some((f, cos, lit)) = light_term_f::<L>(sh, wi, ok) else { continue };
+            let Some((f, cos, lit)) = light_term_f::<L>(scene, sh, wi, ok) else { continue };
             contrib.push(masked(f.mul_elem(li).scale(cos), lit));
             let o = sh.ng.mul_add(eps[i], sh.p);
             let tfar = match light.position() {

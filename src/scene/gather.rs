@@ -4,6 +4,7 @@
 
 use super::build::Scene;
 use crate::accel::{Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
+use crate::bsdf::interface::COURSE;
 use crate::scene::desc::{BrdfKind, Material};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
@@ -44,6 +45,11 @@ pub struct SurfaceHit8 {
     pub le: Vec3x8,
     /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
     pub light: U8,
+    /// material index per lane (into `Scene::materials`; 0 on misses): the registry BSDF's row
+    /// ([`Scene::bsdf_params`])
+    pub material: U8,
+    /// hit lanes that hit the back of the surface (the normals were flipped to face the ray)
+    pub back: Mask8,
 }
 
 impl SurfaceHit8 {
@@ -64,6 +70,8 @@ impl SurfaceHit8 {
         ambient: Vec3x8::ZERO,
         le: Vec3x8::ZERO,
         light: U8::MAX,
+        material: U8::ZERO,
+        back: F8::ZERO,
     };
 }
 
@@ -100,7 +108,7 @@ impl Scene {
         let first = prim[bits.trailing_zeros() as usize];
         let same = F8::from_bits(hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES)) & hits.prim.simd_eq(U8::splat(first)));
         let one_triangle = same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
-        let Lanes8 { n, m, light, le, any_tri } = if one_triangle {
+        let Lanes8 { n, m, light, le, any_tri, mat } = if one_triangle {
             self.one_triangle(first as usize, valid)
         } else {
             self.lane_by_lane(bits, valid, geom, prim, p, dir)
@@ -108,7 +116,8 @@ impl Scene {
         // Shade two-sided: flip the normal to face the incoming ray (the scalar Vec3::dot's
         // operation order, so the sign is the same as per lane).
         let facing = (n.x * dir.x + n.y * dir.y) + n.z * dir.z;
-        let ng = Vec3x8::select(valid & facing.simd_gt(F8::ZERO), -n, n);
+        let back = valid & facing.simd_gt(F8::ZERO);
+        let ng = Vec3x8::select(back, -n, n);
         let (ns, smooth) = if any_tri && !self.desc.triangle_normals.is_empty() {
             self.smooth_normals(bits, geom, prim, hits, dir, ng)
         } else {
@@ -129,6 +138,8 @@ impl Scene {
         out.ambient = m.ambient;
         out.le = le;
         out.light = light;
+        out.material = mat;
+        out.back = back;
         if !self.material_texture.is_empty() {
             self.texture_hits(bits, hits, out);
         }
@@ -144,6 +155,7 @@ impl Scene {
             light: U8::MAX,
             le: Vec3x8::ZERO,
             any_tri: true,
+            mat: valid.to_bits() & U8::splat(self.tri_material[t]),
         }
     }
 
@@ -190,7 +202,8 @@ impl Scene {
                 _ => {}
             }
         }
-        Lanes8 { n: n.get(), m: self.gather_materials(bits, valid, &mat), light: U8::new(light), le: le.get(), any_tri }
+        let m = self.gather_materials(bits, valid, &mat);
+        Lanes8 { n: n.get(), m, light: U8::new(light), le: le.get(), any_tri, mat: U8::new(mat) }
     }
 
     /// Shading normals from the triangles' vertex normals (see the module docs) on the triangle
@@ -218,13 +231,35 @@ impl Scene {
             let s = (c[0] * (1.0 - u - v) + c[1] * u + c[2] * v).normalize_or_zero();
             let g = ng.lane(i);
             let s = if s.dot(g) < 0.0 { -s } else { s };
-            // The guard: the ray must arrive from above the shading normal too.
-            if s.dot(-dir.lane(i)) > 0.0 {
+            // The guard: the ray must arrive from above the shading normal too. Registry BSDFs
+            // (Mitsuba's) see such a hit from the back of their shading frame, as Mitsuba does.
+            let registry = || self.materials[self.tri_material[prim[i] as usize] as usize].bsdf.kind != COURSE;
+            if s.dot(-dir.lane(i)) > 0.0 || registry() {
                 ns.set(i, s);
                 smooth[i] = true;
             }
         }
         (ns.get(), crate::simd::mask_from_bools(smooth))
+    }
+
+    /// The registry BSDF rows of the materials `ids` on the `valid` lanes (the course's
+    /// elsewhere), eight lanes: what a kernel compiled with registry BSDFs shades.
+    #[inline]
+    pub fn bsdf_params(&self, ids: U8, valid: Mask8) -> crate::bsdf::Params8 {
+        let bits = valid.to_bitmask();
+        let ids = ids.to_array();
+        let row = |i: usize| {
+            if bits & (1 << i) != 0 {
+                &self.materials[ids[i] as usize].bsdf
+            } else {
+                &crate::bsdf::BsdfParams::COURSE
+            }
+        };
+        let first = ids[bits.trailing_zeros().min(7) as usize];
+        if bits == 0xff && ids.iter().all(|&m| m == first) {
+            return crate::bsdf::Params8::splat(&self.materials[first as usize].bsdf);
+        }
+        crate::bsdf::Params8::from_lanes(std::array::from_fn(row))
     }
 
     /// The fields of material `m0` on the hit lanes `valid`, the miss record's on the others.
@@ -291,6 +326,7 @@ const MISS_MATERIAL: Material = Material {
     ambient: Vec3::ZERO,
     brdf: BrdfKind::Phong,
     roughness: 1.0,
+    bsdf: crate::bsdf::BsdfParams::COURSE,
 };
 
 /// The fields of a [`SurfaceHit8`] looked up per hit (the rest is 8-wide arithmetic).
@@ -302,6 +338,8 @@ struct Lanes8 {
     le: Vec3x8,
     /// some lane hit a triangle
     any_tri: bool,
+    /// material index per lane (0 on misses)
+    mat: U8,
 }
 
 /// Material fields of 8 lanes (a part of [`SurfaceHit8`]).

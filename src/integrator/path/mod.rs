@@ -25,7 +25,8 @@ use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
 use super::stats::RayKind;
 use crate::accel::{Hits8, Ray8, RayHit8};
-use crate::bsdf::LobeSet;
+use crate::bsdf::interface::flags as lobe_flags;
+use crate::bsdf::{BsdfSet, LobeSet};
 use crate::light::emitters::LightSample8;
 use crate::light::select::{LightChoice, LightSelection};
 use crate::profile::Phase;
@@ -215,11 +216,11 @@ fn path_tile<L: LobeSet>(
             scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
             let missed = *traced & !sh.valid;
             if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
-                let le = sky::escaped(it, sky, v, paths.get(PDF, ci), missed);
+                let le = sky::escaped::<L>(it, sky, v, paths.get(PDF, ci), missed);
                 add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
             }
             if let Some(env) = scene.envmap.as_ref().filter(|_| has_env && missed.any()) {
-                let le = sky::escaped_envmap(it, env, v, r.ray.dir(), paths.get(PDF, ci), missed);
+                let le = sky::escaped_envmap::<L>(it, env, v, r.ray.dir(), paths.get(PDF, ci), missed);
                 add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
             }
             if sh.valid.none() {
@@ -234,7 +235,7 @@ fn path_tile<L: LobeSet>(
                 beta: paths.get3(BETA, ci),
             };
             let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
-            let le = b.emission(&vx, paths.get(PDF, ci), pp, pn);
+            let le = b.emission::<L>(&vx, paths.get(PDF, ci), pp, pn);
             add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
             b.shade::<L>(&vx);
         }
@@ -299,9 +300,10 @@ struct Bounce<'a> {
 impl Bounce<'_> {
     /// Emission found at the vertex: materials always; area lights (quads, emissive triangles)
     /// by the NEE mode, weighted with MIS against the light-sampling pdf (`pdf` is the pdf the
-    /// direction was sampled with; `pp`, `pn` the previous vertex for a point-dependent choice).
+    /// direction was sampled with, negative after a delta lobe: weight 1; `pp`, `pn` the previous
+    /// vertex for a point-dependent choice).
     #[inline]
-    fn emission(&self, vx: &Vertex, pdf: F8, pp: Vec3x8, pn: Vec3x8) -> Vec3x8 {
+    fn emission<L: LobeSet>(&self, vx: &Vertex, pdf: F8, pp: Vec3x8, pn: Vec3x8) -> Vec3x8 {
         let (it, sh, v) = (self.it, vx.sh, self.v);
         let hit = sh.valid;
         let mut le = masked(sh.emitted, hit);
@@ -330,6 +332,12 @@ impl Bounce<'_> {
                 power_heuristic_x8(pdf, p_light, is_light)
             }
         };
+        // A direction from a delta lobe: no light sample could have found the light.
+        let light_w = if <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::DELTA != 0 {
+            pdf.simd_lt(F8::ZERO).select(F8::ONE, light_w)
+        } else {
+            light_w
+        };
         le += masked(sh.le, hit).scale(light_w);
         le
     }
@@ -356,12 +364,22 @@ impl Bounce<'_> {
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
         let frame = Frame8::from_normal(sh.n);
         let wo = frame.to_local(sh.wo);
-        let mat = material(sh);
+        let mat = material::<L>(scene, sh);
+        // Registry BSDFs that transmit: directions may cross the surface (compile-time).
+        let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;
         let eps = scene.offset_eps(sh.p);
         // Offsets along the geometric normal (the shading one may point into the surface).
         let o = sh.ng.mul_add(eps, sh.p);
-        // Smooth-shaded lanes: directions must also leave the geometric surface.
+        // Smooth-shaded lanes: directions must also leave the geometric surface (on the side of
+        // the shading normal they leave: transmitted ones below both).
         let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+        let leaves_either = |wi: Vec3x8| {
+            let (a, b) = (sh.ng.dot(wi), sh.n.dot(wi));
+            !sh.smooth | (a.simd_gt(F8::ZERO) & b.simd_gt(F8::ZERO)) | (a.simd_lt(F8::ZERO) & b.simd_lt(F8::ZERO))
+        };
+        // The origin below the surface, for directions that cross it.
+        let o_below = sh.ng.mul_add(-eps, sh.p);
+        let general = if <L::Bsdfs as BsdfSet>::BITS != 0 { mat.general(shade) } else { F8::ZERO };
         // A light choice of its own: drawn only under `--light-choice dimension` with several
         // lights to pick from (skipping a dimension changes no other).
         let picks = it.light_selection.picks_one() && n_lights > 1;
@@ -387,9 +405,19 @@ impl Bounce<'_> {
                 let d2 = to.length_squared();
                 let inv_d = F8::ONE / d2.sqrt();
                 let wi = to.scale(inv_d);
-                let cos_i = sh.n.dot(wi);
+                let mut cos_i = sh.n.dot(wi);
                 let cos_l = -ln.dot(wi);
-                let lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
+                let mut lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
+                // Transmitting lanes: lights below the surface too.
+                let below = if transmits && general.any() {
+                    let below = ok & general & cos_i.simd_lt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
+                    let below = below & leaves_either(wi);
+                    lit |= below;
+                    cos_i = cos_i.abs();
+                    below
+                } else {
+                    F8::ZERO
+                };
                 if lit.none() {
                     return;
                 }
@@ -397,6 +425,15 @@ impl Bounce<'_> {
                     let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
                     mat.eval_pdf_k::<L>(it.path.strategy, wo, frame.to_local(wi), lit)
                 };
+                // No shadow ray where a registry BSDF has no value (delta lobes only).
+                let lit = if <L::Bsdfs as BsdfSet>::BITS != 0 {
+                    lit & !(general & f.max_elem().simd_le(F8::ZERO))
+                } else {
+                    lit
+                };
+                if lit.none() {
+                    return;
+                }
                 // L f cos_i / p_light with p_light = pmf d^2 / (A cos_l) (solid angle).
                 let mut g = cos_i * cos_l * area * inv_pmf * inv_d * inv_d;
                 if let Some(k) = scale {
@@ -413,6 +450,7 @@ impl Bounce<'_> {
                 };
                 let c = beta.mul_elem(f).mul_elem(l_rad).scale(g * w_light);
                 let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
+                let o = if transmits { Vec3x8::select(below, o_below, o) } else { o };
                 let d = y - o;
                 // The lit lanes, left-packed onto the bounce's shadow rays.
                 let pack = Pack::of(lit);
@@ -474,15 +512,30 @@ impl Bounce<'_> {
                 (F8::ZERO, F8::ZERO)
             };
             let u2 = self.smp.table_point(&self.dk[2], false, Phase::SamplerPath, pixel, s);
-            let (wi_l, pdf, f) = {
+            let sampled = {
                 let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
-                mat.sample_k::<L>(it.path.strategy, wo, [u2.0, u2.1], u_lobe, shade)
+                mat.sample_bsdf_k::<L>(it.path.strategy, wo, [u2.0, u2.1], u_lobe, shade)
             };
+            let (wi_l, mut pdf, f) = (sampled.wi, sampled.pdf, sampled.f);
             let cos = wi_l.z;
             let wi = frame.to_world(wi_l);
-            let ok =
+            let mut ok =
                 shade & pdf.simd_gt(F8::ZERO) & cos.simd_gt(F8::ZERO) & f.max_elem().simd_gt(F8::ZERO) & leaves(wi);
             let mut nb = beta.mul_elem(f).scale(ok.select(cos / pdf, F8::ZERO));
+            let mut o = o;
+            if <L::Bsdfs as BsdfSet>::BITS != 0 && sampled.general.any() {
+                // Registry BSDF lanes: their weight f |cos| / pdf, either side of the surface.
+                let (g, b) = (sampled.general, &sampled.bsdf);
+                let g_ok = g & b.pdf.simd_gt(F8::ZERO) & b.weight.max_elem().simd_gt(F8::ZERO) & leaves_either(wi);
+                ok = (ok & !g) | g_ok;
+                nb = Vec3x8::select(g, beta.mul_elem(b.weight), nb);
+                nb = Vec3x8::select(ok, nb, Vec3x8::ZERO);
+                if transmits {
+                    o = Vec3x8::select(g & sh.ng.dot(wi).simd_lt(F8::ZERO), o_below, o);
+                }
+                // A delta lobe's direction: the next hit's emission gets weight 1 (pdf < 0).
+                pdf = (g & b.has(lobe_flags::DELTA)).select(F8::splat(-1.0), pdf);
+            }
             let mut alive = ok & nb.max_elem().simd_gt(F8::ZERO) & nb.is_finite();
             if it.path.russian_roulette {
                 let q = nb.max_elem().min(F8::ONE);

@@ -5,7 +5,8 @@
 //! from their own dimensions, `DIM_SKY_BASE + (v - 1)` for vertex v, so a scene with a sky keeps
 //! every other dimension of the path (and a scene without one renders exactly as before).
 
-use crate::bsdf::{LobeSet, Material8};
+use crate::bsdf::interface::flags as lobe_flags;
+use crate::bsdf::{BsdfSet, LobeSet, Material8};
 use crate::integrator::settings::Integrator;
 use crate::light::envmap::Envmap;
 use crate::light::sky::Sky;
@@ -18,10 +19,19 @@ use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 pub const DIM_SKY_BASE: u32 = 64 + 4 * 4096;
 
 /// Sky radiance, weighted by the next-event mode, brought by the rays of vertex `v` that left the
-/// scene (`missed`), their direction sampled with `pdf`.
+/// scene (`missed`), their direction sampled with `pdf` (negative after a delta lobe: weighted as
+/// at the camera vertex, no light sample could have found it).
 #[inline]
-pub(super) fn escaped(it: &Integrator, sky: &Sky, v: u32, pdf: F8, missed: Mask8) -> Vec3x8 {
-    sky.escaped_x8(it.path.nee != Nee::Off, it.path.nee == Nee::Mis, v, pdf, missed)
+pub(super) fn escaped<L: LobeSet>(it: &Integrator, sky: &Sky, v: u32, pdf: F8, missed: Mask8) -> Vec3x8 {
+    let (on, mis) = (it.path.nee != Nee::Off, it.path.nee == Nee::Mis);
+    let le = sky.escaped_x8(on, mis, v, pdf, missed);
+    if <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::DELTA != 0 {
+        let delta = missed & pdf.simd_lt(F8::ZERO);
+        if delta.any() {
+            return Vec3x8::select(delta, sky.escaped_x8(on, mis, 1, pdf, delta), le);
+        }
+    }
+    le
 }
 
 /// The sky's next event at the shaded lanes `shade` of a vertex with throughput `beta`: one
@@ -59,7 +69,14 @@ pub(super) fn next_event<L: LobeSet>(
 /// Envmap radiance, weighted by the next-event mode as [`escaped`] weighs the sky's, brought by
 /// the rays of vertex `v` that left the scene (`missed`) along `dir`, sampled with `pdf`.
 #[inline]
-pub(super) fn escaped_envmap(it: &Integrator, env: &Envmap, v: u32, dir: Vec3x8, pdf: F8, missed: Mask8) -> Vec3x8 {
+pub(super) fn escaped_envmap<L: LobeSet>(
+    it: &Integrator,
+    env: &Envmap,
+    v: u32,
+    dir: Vec3x8,
+    pdf: F8,
+    missed: Mask8,
+) -> Vec3x8 {
     let (le, p_env) = env.radiance_pdf_x8(dir, missed);
     let w = if v == 1 || it.path.nee == Nee::Off {
         missed.select(F8::ONE, F8::ZERO)
@@ -67,6 +84,11 @@ pub(super) fn escaped_envmap(it: &Integrator, env: &Envmap, v: u32, dir: Vec3x8,
         power_heuristic_x8(pdf, p_env, missed)
     } else {
         F8::ZERO
+    };
+    let w = if <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::DELTA != 0 {
+        (missed & pdf.simd_lt(F8::ZERO)).select(F8::ONE, w)
+    } else {
+        w
     };
     le.scale(w)
 }

@@ -166,6 +166,30 @@ impl<'e> Props<'e> {
         }))
     }
 
+    /// Colour property `name` that may not be a texture (`default` when absent): a texture is
+    /// refused with file:line, naming the property.
+    pub fn rgb_only(&self, name: &str, default: Vec3) -> Result<Vec3, SceneError> {
+        match self.color(name, false)? {
+            None => Ok(default),
+            Some(Color::Rgb(c)) => Ok(c),
+            Some(Color::Texture(t)) => {
+                Err(t.at.err(format!("{}: a texture for \"{name}\" is not supported yet", self.elem.what())))
+            }
+        }
+    }
+
+    /// Index-of-refraction property `name`: a `<float>` or a `<string>` naming a material of
+    /// Mitsuba's table (`bk7`, `water`, ...), `default` (a table name) when absent.
+    pub fn ior(&self, name: &str, default: &str) -> Result<f32, SceneError> {
+        let Some(e) = self.get(name) else { return values::ior(self.elem, default) };
+        self.expect(e, name, &["float", "string"])?;
+        let v = values::ior(e, e.need("value")?)?;
+        if !(v.is_finite() && v > 0.0) {
+            return Err(e.at.err(format!("\"{name}\" must be a positive index of refraction, not {v}")));
+        }
+        Ok(v)
+    }
+
     /// The nested objects of `tag` (named or not), marked read.
     pub fn objects(&self, tag: &str) -> Vec<&'e Elem> {
         self.items

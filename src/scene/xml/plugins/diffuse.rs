@@ -20,6 +20,11 @@ pub fn lambert(r: Vec3) -> Material {
     Material { diffuse: r, ambient: Vec3::ZERO, ..Material::default() }
 }
 
+/// The material of a registry BSDF row: no course lobes, no ambient term.
+pub fn registry_material(bsdf: crate::bsdf::BsdfParams) -> Material {
+    Material { diffuse: Vec3::ZERO, ambient: Vec3::ZERO, bsdf, ..Material::default() }
+}
+
 fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
     match p.color("reflectance", false)? {

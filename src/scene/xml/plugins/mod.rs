@@ -3,9 +3,11 @@
 //! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
 
 mod area;
+mod conductor;
 mod constant;
 mod cube;
 mod cylinder;
+mod dielectric;
 mod diffuse;
 mod direct;
 mod directional;
@@ -18,6 +20,7 @@ mod obj;
 mod orthographic;
 mod path;
 mod perspective;
+mod plastic;
 mod ply;
 mod point;
 mod projector;
@@ -115,12 +118,12 @@ pub const PLUGINS: &[Plugin] = &[
     envmap::PLUGIN,
     diffuse::PLUGIN,
     twosided::PLUGIN,
-    refused("bsdf", "conductor", BSDFS),
+    conductor::PLUGIN,
     refused("bsdf", "roughconductor", BSDFS),
-    refused("bsdf", "dielectric", BSDFS),
+    dielectric::PLUGIN,
     refused("bsdf", "roughdielectric", BSDFS),
     refused("bsdf", "thindielectric", BSDFS),
-    refused("bsdf", "plastic", BSDFS),
+    plastic::PLUGIN,
     refused("bsdf", "roughplastic", BSDFS),
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),

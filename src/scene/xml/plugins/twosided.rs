@@ -1,4 +1,6 @@
-//! `<bsdf type="twosided">` of a `diffuse`: strata shades diffuse surfaces on both sides already.
+//! `<bsdf type="twosided">` of one BSDF: its back mirrored onto its front
+//! (`BsdfParams::twosided`). strata's `diffuse` is shaded on both sides already. Two different
+//! BSDFs for the two sides are refused.
 
 use super::{Build, Plugin, Run};
 use crate::scene::desc::Material;
@@ -12,8 +14,11 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
     let inner = p.objects("bsdf");
     match inner.as_slice() {
-        [one] if one.attr("type") == Some("diffuse") => b.bsdf(one),
-        [one] => Err(one.at.err(format!("twosided of {} is not supported (only of diffuse)", one.what()))),
+        [one] => {
+            let mut m = b.bsdf(one)?;
+            m.bsdf.twosided = true;
+            Ok(m)
+        }
         _ => Err(p.elem.at.err("twosided takes one nested <bsdf> (two different sides are not supported)")),
     }
 }

@@ -1,0 +1,37 @@
+//! `<bsdf type="conductor">`: a smooth metal (`bsdf::conductor`). `material` (a name of Mitsuba's
+//! table, default `none`: a perfect mirror) or `eta` and `k` (default 0 and 1), and
+//! `specular_reflectance` (default 1). One-sided (black from the back) unless in a `twosided`.
+
+use super::{Build, Plugin, Run};
+use crate::scene::desc::Material;
+use crate::scene::error::SceneError;
+use crate::scene::xml::props::Props;
+use crate::scene::xml::values;
+use glam::Vec3;
+
+/// Registry entry.
+pub const PLUGIN: Plugin = Plugin { tag: "bsdf", kind: "conductor", run: Run::Bsdf(run) };
+
+/// Mitsuba's (eta, k) of a conductor element: `material` or `eta`/`k`, not both.
+pub fn eta_k(p: &Props) -> Result<(Vec3, Vec3), SceneError> {
+    let material = match p.get("material") {
+        Some(e) => Some((e, e.need("value")?)),
+        None => None,
+    };
+    match material {
+        Some((e, name)) if name != "none" => {
+            if p.has("eta") || p.has("k") {
+                return Err(e.at.err(format!("{}: give either \"material\" or \"eta\"/\"k\", not both", p.elem.what())));
+            }
+            values::conductor(e, name)
+        }
+        _ => Ok((p.rgb_only("eta", Vec3::ZERO)?, p.rgb_only("k", Vec3::ONE)?)),
+    }
+}
+
+fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+    p.ignore("id");
+    let (eta, k) = eta_k(p)?;
+    let specular = p.rgb_only("specular_reflectance", Vec3::ONE)?;
+    Ok(super::diffuse::registry_material(crate::bsdf::conductor::params(eta, k, specular)))
+}
