@@ -23,7 +23,7 @@ pub(crate) mod real;
 #[cfg(test)]
 mod tests;
 
-use crate::simd::{Vec3x8, F8};
+use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;
 use real::{beckmann_a_lambda, erf, erfinv, exp, ln, sincos_2pi, Real};
 use std::f32::consts::FRAC_1_PI;
@@ -55,6 +55,44 @@ impl Distribution {
     pub fn from_name(name: &str) -> Option<Self> {
         [Self::Beckmann, Self::Ggx].into_iter().find(|d| d.name() == name)
     }
+    /// The BSDF parameter slot value of (distribution, sample_visible): 0/1 Beckmann, 2/3 GGX
+    /// (+1 when sampling visible normals), read back by [`per_variant`].
+    pub fn code(self, sample_visible: bool) -> f32 {
+        (match self {
+            Self::Beckmann => 0.0,
+            Self::Ggx => 2.0,
+        }) + if sample_visible { 1.0 } else { 0.0 }
+    }
+}
+
+/// Eight lanes whose distribution comes from a [`Distribution::code`] slot: calls `f` once per
+/// (distribution, sample_visible) pair present among the `active` lanes, with that distribution
+/// (alphas per lane) and its lanes, and merges the results with `select(lanes, new, acc)` over
+/// `none`. Lanes of one material take one call.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn per_variant<T: Copy>(
+    code: F8,
+    alpha_u: F8,
+    alpha_v: F8,
+    active: Mask8,
+    none: T,
+    f: impl Fn(&Microfacet<F8>, Mask8) -> T,
+    select: impl Fn(Mask8, T, T) -> T,
+) -> T {
+    let mut acc = none;
+    for (kind, visible) in [
+        (Distribution::Ggx, true),
+        (Distribution::Beckmann, true),
+        (Distribution::Ggx, false),
+        (Distribution::Beckmann, false),
+    ] {
+        let lanes = active & code.simd_eq(F8::splat(kind.code(visible)));
+        if lanes.any() {
+            acc = select(lanes, f(&Microfacet::new(kind, alpha_u, alpha_v, visible), lanes), acc);
+        }
+    }
+    acc
 }
 
 /// A vector of [`Real`] lanes: `V3<f32>` is one vector, `V3<F8>` eight (structure of arrays).
@@ -180,19 +218,14 @@ impl<R: Real> Microfacet<R> {
         }
     }
 
-    /// Smith's G1(v, m): |v.z| / A(v) where (v.m) v.z > 0, else 0.
-    #[inline]
+    /// Smith's G1(v, m): |v.z| / A(v) where (v.m) v.z > 0, else 0 (the BSDFs use the projected
+    /// areas directly; the tests check this against its integral definition).
+    #[cfg(test)]
     pub(crate) fn g1(&self, v: V3<R>, m: V3<R>) -> R {
         let zero = R::splat(0.0);
         let area = self.projected_area(v);
         let ok = R::and((v.dot(m) * v.z).gt(zero), area.gt(zero));
         R::select(ok, v.z.abs() / R::select(ok, area, R::splat(1.0)), zero)
-    }
-
-    /// Smith's separable G(wi, wo, m) = G1(wi, m) G1(wo, m).
-    #[inline]
-    pub(crate) fn g(&self, wi: V3<R>, wo: V3<R>, m: V3<R>) -> R {
-        self.g1(wi, m) * self.g1(wo, m)
     }
 
     /// Density of [`Microfacet::sample`] per unit solid angle of m: D(m) max(0, w.m) / A(w) with

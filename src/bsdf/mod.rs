@@ -28,8 +28,6 @@ mod ggx;
 pub mod interface;
 pub mod lobe;
 pub mod material;
-// Used by the rough BSDFs (roughconductor, roughdielectric, roughplastic); until they land, only by its tests.
-#[allow(dead_code)]
 pub mod microfacet;
 mod phong;
 #[cfg(test)]
@@ -59,6 +57,8 @@ registry! {
     conductor: Conductor,
     dielectric: Dielectric,
     plastic: Plastic,
+    roughconductor: RoughConductor,
+    roughdielectric: RoughDielectric,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

@@ -378,12 +378,7 @@ pub(super) fn light_term<L: LobeSet>(
 /// the lanes lit (cos(th_i) > 0, and above the geometric surface on smooth-shaded lanes); None
 /// where no lane is lit (for lights at a direction rather than a point: environment, delta).
 #[inline]
-fn light_term_f<L: LobeSet>(
-    scene: &Scene,
-    sh: &SurfaceHit8,
-    wi: Vec3x8,
-    active: Mask8,
-) -> Option<(Vec3x8, F8, Mask8)> {
+fn light_term_f<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Option<(Vec3x8, F8, Mask8)> {
     let cos_i = sh.n.dot(wi);
     let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
     let lit = active & cos_i.simd_gt(F8::ZERO) & leaves;

@@ -407,7 +407,8 @@ impl Bounce<'_> {
                 let wi = to.scale(inv_d);
                 let mut cos_i = sh.n.dot(wi);
                 let cos_l = -ln.dot(wi);
-                let mut lit = ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
+                let mut lit =
+                    ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
                 // Transmitting lanes: lights below the surface too.
                 let below = if transmits && general.any() {
                     let below = ok & general & cos_i.simd_lt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);

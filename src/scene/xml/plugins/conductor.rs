@@ -21,7 +21,9 @@ pub fn eta_k(p: &Props) -> Result<(Vec3, Vec3), SceneError> {
     match material {
         Some((e, name)) if name != "none" => {
             if p.has("eta") || p.has("k") {
-                return Err(e.at.err(format!("{}: give either \"material\" or \"eta\"/\"k\", not both", p.elem.what())));
+                return Err(e
+                    .at
+                    .err(format!("{}: give either \"material\" or \"eta\"/\"k\", not both", p.elem.what())));
             }
             values::conductor(e, name)
         }

@@ -27,6 +27,8 @@ mod projector;
 mod rectangle;
 mod rfilter_box;
 mod rfilter_gaussian;
+mod roughconductor;
+mod roughdielectric;
 mod sampler;
 mod sdfgrid;
 mod serialized;
@@ -119,9 +121,9 @@ pub const PLUGINS: &[Plugin] = &[
     diffuse::PLUGIN,
     twosided::PLUGIN,
     conductor::PLUGIN,
-    refused("bsdf", "roughconductor", BSDFS),
+    roughconductor::PLUGIN,
     dielectric::PLUGIN,
-    refused("bsdf", "roughdielectric", BSDFS),
+    roughdielectric::PLUGIN,
     refused("bsdf", "thindielectric", BSDFS),
     plastic::PLUGIN,
     refused("bsdf", "roughplastic", BSDFS),
