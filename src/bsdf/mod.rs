@@ -59,6 +59,7 @@ registry! {
     plastic: Plastic,
     roughconductor: RoughConductor,
     roughdielectric: RoughDielectric,
+    roughplastic: RoughPlastic,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

@@ -29,6 +29,7 @@ mod rfilter_box;
 mod rfilter_gaussian;
 mod roughconductor;
 mod roughdielectric;
+mod roughplastic;
 mod sampler;
 mod sdfgrid;
 mod serialized;
@@ -126,7 +127,7 @@ pub const PLUGINS: &[Plugin] = &[
     roughdielectric::PLUGIN,
     refused("bsdf", "thindielectric", BSDFS),
     plastic::PLUGIN,
-    refused("bsdf", "roughplastic", BSDFS),
+    roughplastic::PLUGIN,
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
     refused("bsdf", "blendbsdf", BSDFS),
