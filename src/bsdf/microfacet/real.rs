@@ -210,7 +210,8 @@ pub(crate) fn ln<R: Real>(x: R) -> R {
 }
 
 /// erf(x)/x as a polynomial in x^2 on [0, 1] (1.2e-7 relative).
-const ERF_SMALL: [f32; 6] = [1.128_379_1, -0.376_123_2, 0.112_801_31, -0.026_709_95, 0.004_916_023_5, -0.000_562_539_6];
+const ERF_SMALL: [f32; 6] =
+    [std::f32::consts::FRAC_2_SQRT_PI, -0.376_123_2, 0.112_801_31, -0.026_709_95, 0.004_916_023_5, -0.000_562_539_6];
 /// e^(x^2) erfc(x) on [1, 5] as a polynomial in z - 1/3, z = 1/(1 + x) (1.7e-7 relative).
 const ERFC_SCALED: [f32; 9] = [
     0.255_395_68,
@@ -252,6 +253,7 @@ pub(crate) fn erf<R: Real>(x: R) -> R {
 /// erf^-1(x) on [-1, 1] (Giles' single-precision fit); x is clamped to +-(1 - 2^-24), so +-1 give
 /// about +-3.83 and the result is always finite.
 #[inline]
+#[allow(clippy::excessive_precision)] // Giles' coefficients as published
 pub(crate) fn erfinv<R: Real>(x: R) -> R {
     let lim = R::splat(1.0 - 5.960_464_5e-8);
     let x = x.minr(lim).maxr(-lim);
