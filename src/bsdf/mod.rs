@@ -34,6 +34,7 @@ mod ggx;
 pub mod interface;
 pub mod lobe;
 pub mod material;
+pub mod microfacet;
 mod phong;
 #[cfg(test)]
 mod tests;
@@ -63,6 +64,9 @@ registry! {
     dielectric: Dielectric,
     plastic: Plastic,
     thindielectric: ThinDielectric,
+    roughconductor: RoughConductor,
+    roughdielectric: RoughDielectric,
+    roughplastic: RoughPlastic,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

@@ -32,7 +32,7 @@ use glam::{DVec3, Vec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// Number of chi-square tests in the crate, for the Bonferroni correction.
-pub(crate) const CHI2_TESTS: usize = 39;
+pub(crate) const CHI2_TESTS: usize = 53;
 /// Family-wise significance level of all chi-square tests together.
 pub(crate) const SIGNIFICANCE: f64 = 0.01;
 /// Samples per chi-square test.

@@ -27,6 +27,9 @@ mod projector;
 mod rectangle;
 mod rfilter_box;
 mod rfilter_gaussian;
+mod roughconductor;
+mod roughdielectric;
+mod roughplastic;
 mod sampler;
 mod sdfgrid;
 mod serialized;
@@ -120,12 +123,12 @@ pub const PLUGINS: &[Plugin] = &[
     diffuse::PLUGIN,
     twosided::PLUGIN,
     conductor::PLUGIN,
-    refused("bsdf", "roughconductor", BSDFS),
+    roughconductor::PLUGIN,
     dielectric::PLUGIN,
-    refused("bsdf", "roughdielectric", BSDFS),
+    roughdielectric::PLUGIN,
     thindielectric::PLUGIN,
     plastic::PLUGIN,
-    refused("bsdf", "roughplastic", BSDFS),
+    roughplastic::PLUGIN,
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
     refused("bsdf", "blendbsdf", BSDFS),

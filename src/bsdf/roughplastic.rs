@@ -1,0 +1,210 @@
+//! `roughplastic`: a rough dielectric coating over a Lambertian base (Mitsuba's `roughplastic`):
+//! f = F(wi.h) D G / (4 wo.z wi.z) `specular_reflectance` + diff t(wo) t(wi) / (pi eta^2), where
+//! t(mu) is the rough coating's transmittance at the cosine mu (1 minus its directional albedo,
+//! tabulated at load at 64 cosines in [0, 1] and interpolated linearly, as Mitsuba does) and the
+//! base reflectance d is renormalized for the light the coating's inside reflects back:
+//! diff = d / (1 - R_int) (linear) or d / (1 - d R_int) (`nonlinear`), R_int the coating's
+//! internal diffuse reflectance (2 mean(albedo_inside(mu) mu) over the same cosines). The
+//! specular lobe is sampled (visible normals, reflected) with probability proportional to
+//! (1 - t(wo)) w, the cosine lobe to t(wo) (1 - w), w = mean(specular) / (mean(diffuse) +
+//! mean(specular)). Isotropic, one-sided.
+//!
+//! Slots: `color[0]` diff / (pi eta^2), `color[1]` specular reflectance, `color[2].x` the id of
+//! the transmittance table (a process-wide list, one per distinct (distribution, alpha, eta)),
+//! `scalar[0]` eta = int_ior / ext_ior, `scalar[1]` alpha, `scalar[2]` the distribution's
+//! [`Distribution::code`], `scalar[3]` w.
+
+use super::fresnel::dielectric_x8;
+use super::interface::{flags, flags_where, Bsdf, BsdfParams, Params8, Sample8};
+use super::microfacet::{per_variant, Distribution, Microfacet, V3};
+use super::roughconductor::reflection;
+use crate::sampling::{cosine_hemisphere_pdf_x8, sample_cosine_hemisphere_x8};
+use crate::simd::{Mask8, Vec3x8, F8};
+use glam::Vec3;
+use std::sync::RwLock;
+
+/// Cosines of the transmittance table (Mitsuba's resolution).
+const RES: usize = 64;
+/// Quadrature points per axis of the directional albedo.
+const QUAD: usize = 64;
+
+/// One transmittance table and what it was computed for.
+struct Table {
+    key: (u32, u32, u32),
+    t: [f32; RES],
+    internal: f32,
+}
+
+/// The process-wide list of transmittance tables ([`params`] adds, shading reads).
+static TABLES: RwLock<Vec<Table>> = RwLock::new(Vec::new());
+
+/// The rough plastic (see the module docs).
+pub struct RoughPlastic;
+
+/// The directional albedo of the rough dielectric reflection at the cosines `mu` (eight lanes):
+/// E[F(wo.m) G1(wi)] over the normals m visible from wo (a QUAD x QUAD midpoint grid of the
+/// sampler's square), wi = wo reflected about m.
+fn albedo(mf: &Microfacet<F8>, eta: f32, mu: F8) -> F8 {
+    let wo = Vec3x8::new((F8::ONE - mu * mu).max(F8::ZERO).sqrt(), F8::ZERO, mu);
+    let mut sum = F8::ZERO;
+    for a in 0..QUAD {
+        for b in 0..QUAD {
+            let u = [F8::splat((a as f32 + 0.5) / QUAD as f32), F8::splat((b as f32 + 0.5) / QUAD as f32)];
+            let m = Vec3x8::from(mf.sample(wo.into(), u).0);
+            let wo_m = wo.dot(m);
+            let wi = m.scale(F8::splat(2.0) * wo_m) - wo;
+            let r = dielectric_x8(wo_m, F8::splat(eta)).0;
+            let area = mf.projected_area(V3::from(wi));
+            let ok = wi.z.simd_gt(F8::ZERO) & wo_m.simd_gt(F8::ZERO) & area.simd_gt(F8::ZERO);
+            sum += ok.select(r * wi.z / ok.select(area, F8::ONE), F8::ZERO);
+        }
+    }
+    sum / F8::splat((QUAD * QUAD) as f32)
+}
+
+/// (transmittance table from outside, internal diffuse reflectance) of a coating.
+fn tables(kind: Distribution, alpha: f32, eta: f32) -> ([f32; RES], f32) {
+    let mf = Microfacet::new(kind, F8::splat(alpha), F8::splat(alpha), true);
+    let (mut t, mut internal) = ([0.0f32; RES], 0.0f64);
+    for c in 0..RES / 8 {
+        let mu = F8::new(std::array::from_fn(|i| ((c * 8 + i) as f32 / (RES - 1) as f32).max(1e-6)));
+        let outside = albedo(&mf, eta, mu);
+        let inside = albedo(&mf, 1.0 / eta, mu);
+        for i in 0..8 {
+            t[c * 8 + i] = 1.0 - outside.to_array()[i];
+            internal += (inside.to_array()[i] * mu.to_array()[i]) as f64;
+        }
+    }
+    (t, (2.0 * internal / RES as f64) as f32)
+}
+
+/// The transmittance t(mu) of each lane's table, linearly interpolated.
+#[inline]
+fn transmittance(id: F8, mu: F8) -> F8 {
+    let tables = TABLES.read().unwrap_or_else(|e| e.into_inner());
+    let (ids, mus) = (id.to_array(), mu.to_array());
+    F8::new(std::array::from_fn(|i| {
+        let Some(t) = tables.get(ids[i] as usize) else { return 0.0 };
+        let x = mus[i].clamp(0.0, 1.0) * (RES - 1) as f32;
+        let k = (x as usize).min(RES - 2);
+        let f = x - k as f32;
+        t.t[k].mul_add(1.0 - f, t.t[k + 1] * f)
+    }))
+}
+
+/// (specular probability, transmittance at wo) per lane.
+#[inline]
+fn lobe_choice(p: &Params8, wo: Vec3x8) -> (F8, F8) {
+    let t_o = transmittance(p.color[2].x, wo.z);
+    let w = p.scalar[3];
+    let ps = (F8::ONE - t_o) * w;
+    let pd = t_o * (F8::ONE - w);
+    let sum = ps + pd;
+    (sum.simd_gt(F8::ZERO).select(ps / sum, F8::ZERO), t_o)
+}
+
+impl Bsdf for RoughPlastic {
+    const ID: u32 = 12;
+    const NAME: &'static str = "roughplastic";
+    const FLAGS: u32 = flags::GLOSSY_REFLECTION | flags::DIFFUSE_REFLECTION;
+
+    #[inline]
+    fn eval_pdf(p: &Params8, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> (Vec3x8, F8) {
+        let up = active & wo.z.simd_gt(F8::ZERO) & wi.z.simd_gt(F8::ZERO);
+        let (fs, ps_dir, cos_h) = per_variant(
+            p.scalar[2],
+            p.scalar[1],
+            p.scalar[1],
+            up,
+            (F8::ZERO, F8::ZERO, F8::ZERO),
+            |mf, lanes| reflection(mf, wo, wi, lanes),
+            |m, a, b| (m.select(a.0, b.0), m.select(a.1, b.1), m.select(a.2, b.2)),
+        );
+        let fres = dielectric_x8(cos_h, p.scalar[0]).0;
+        let (prob_s, t_o) = lobe_choice(p, wo);
+        let t_i = transmittance(p.color[2].x, wi.z);
+        let spec = p.color[1].scale(fres * fs);
+        let diff = p.color[0].scale(t_o * t_i);
+        let f = Vec3x8::select(up, spec + diff, Vec3x8::ZERO);
+        let pdf = prob_s * ps_dir + (F8::ONE - prob_s) * cosine_hemisphere_pdf_x8(wi, up);
+        (f, up.select(pdf, F8::ZERO))
+    }
+
+    #[inline]
+    fn sample(p: &Params8, wo: Vec3x8, u_lobe: F8, u: [F8; 2], active: Mask8) -> Sample8 {
+        let active = active & wo.z.simd_gt(F8::ZERO);
+        let (prob_s, _) = lobe_choice(p, wo);
+        let spec = u_lobe.simd_lt(prob_s);
+        let wr = per_variant(
+            p.scalar[2],
+            p.scalar[1],
+            p.scalar[1],
+            active & spec,
+            Vec3x8::ZERO,
+            |mf, _| {
+                let m = Vec3x8::from(mf.sample(wo.into(), u).0);
+                m.scale(F8::splat(2.0) * wo.dot(m)) - wo
+            },
+            Vec3x8::select,
+        );
+        let wd = sample_cosine_hemisphere_x8(u, active & !spec).0;
+        let wi = Vec3x8::select(spec, wr, wd);
+        let (f, pdf) = Self::eval_pdf(p, wo, wi, active);
+        let ok = active & pdf.simd_gt(F8::ZERO) & wi.z.simd_gt(F8::ZERO);
+        let weight = f.scale(ok.select(wi.z / ok.select(pdf, F8::ONE), F8::ZERO));
+        Sample8 {
+            wi: Vec3x8::select(ok, wi, Vec3x8::ZERO),
+            weight: Vec3x8::select(ok, weight, Vec3x8::ZERO),
+            pdf: ok.select(pdf, F8::ZERO),
+            flags: flags_where(ok & spec, flags::GLOSSY_REFLECTION) | flags_where(ok & !spec, flags::DIFFUSE_REFLECTION),
+            eta: F8::ONE,
+        }
+    }
+
+    fn test_params() -> Vec<BsdfParams> {
+        let d = Vec3::new(0.02, 0.2, 0.1);
+        vec![
+            params(Distribution::Ggx, 0.1, true, 1.5168, d, Vec3::ONE, false),
+            params(Distribution::Ggx, 1.0, true, 1.5168, d, Vec3::ONE, true),
+            params(Distribution::Beckmann, 0.3, true, 1.49, Vec3::ONE, Vec3::ONE, true),
+            params(Distribution::Beckmann, 0.5, false, 1.9, Vec3::splat(0.5), Vec3::ONE, false),
+            params(Distribution::Ggx, 0.2, true, 4.0, Vec3::ZERO, Vec3::ONE, false),
+        ]
+    }
+}
+
+/// A rough plastic row: distribution, alpha, visible-normal sampling, relative index, diffuse and
+/// specular reflectance, `nonlinear`. Computes (once per distinct coating) the coating's
+/// transmittance table and internal reflectance.
+pub fn params(
+    kind: Distribution,
+    alpha: f32,
+    sample_visible: bool,
+    eta: f32,
+    diffuse: Vec3,
+    specular: Vec3,
+    nonlinear: bool,
+) -> BsdfParams {
+    let alpha = alpha.max(super::microfacet::ALPHA_MIN);
+    let key = (kind.code(false).to_bits(), alpha.to_bits(), eta.to_bits());
+    let found = TABLES.read().unwrap_or_else(|e| e.into_inner()).iter().position(|t| t.key == key);
+    let id = found.unwrap_or_else(|| {
+        let (t, internal) = tables(kind, alpha, eta);
+        let mut list = TABLES.write().unwrap_or_else(|e| e.into_inner());
+        list.iter().position(|t| t.key == key).unwrap_or_else(|| {
+            list.push(Table { key, t, internal });
+            list.len() - 1
+        })
+    });
+    let internal = TABLES.read().unwrap_or_else(|e| e.into_inner())[id].internal;
+    let renorm = |c: f32| if nonlinear { c / (1.0 - c * internal) } else { c / (1.0 - internal) };
+    let diff = Vec3::new(renorm(diffuse.x), renorm(diffuse.y), renorm(diffuse.z)) * (std::f32::consts::FRAC_1_PI / (eta * eta));
+    let (dm, sm) = (diffuse.element_sum() / 3.0, specular.element_sum() / 3.0);
+    let w = if dm + sm > 0.0 { sm / (dm + sm) } else { 0.0 };
+    BsdfParams {
+        kind: RoughPlastic::ID,
+        twosided: false,
+        color: [diff, specular, Vec3::new(id as f32, 0.0, 0.0)],
+        scalar: [eta, alpha, kind.code(sample_visible), w],
+    }
+}
