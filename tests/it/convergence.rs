@@ -239,7 +239,7 @@ fn solid_angle_warp_converges_with_lower_error_than_area_sampling() {
         name: "path-nee cornellNEE",
         scene: c.join("hw3/cornellNEE.test"),
         integrator: IntegratorKind::PathTracer,
-        selection: LightSelection::All,
+        selection: LightSelection::ALL,
         nee: None,
         strategy: None,
         max_depth: None,

@@ -94,7 +94,7 @@ fn solid_angle_agrees_with_area_sampling_on_quad_lights() {
     both("hw2 sphere all", RenderOptions { light_samples: Some(2), ..base(&sphere, (40, 30), 64, 1) });
     both(
         "hw2 sphere uniform",
-        RenderOptions { light_selection: Some(LightSelection::Uniform), ..base(&sphere, (40, 30), 128, 2) },
+        RenderOptions { light_selection: Some(LightSelection::UNIFORM), ..base(&sphere, (40, 30), 128, 2) },
     );
     let nee = c.join("hw3/cornellNEE.test");
     both("hw3 cornellNEE", base(&nee, (32, 32), 128, 3));
@@ -108,9 +108,10 @@ fn solid_angle_agrees_with_area_sampling_on_quad_lights() {
 #[test]
 fn solid_angle_agrees_with_area_sampling_on_emissive_triangles() {
     let scene = triangles_and_quads();
-    for (k, sel) in [LightSelection::All, LightSelection::Uniform, LightSelection::Power, LightSelection::Spatial]
-        .into_iter()
-        .enumerate()
+    for (k, sel) in
+        [LightSelection::ALL, LightSelection::UNIFORM, LightSelection::named("power"), LightSelection::named("spatial")]
+            .into_iter()
+            .enumerate()
     {
         let o = RenderOptions { light_selection: Some(sel), ..base(&scene, (32, 32), 256, 10 + k as u64) };
         both(&format!("triangles mis {sel}"), o);
@@ -120,8 +121,8 @@ fn solid_angle_agrees_with_area_sampling_on_emissive_triangles() {
         light_selection: Some(sel),
         ..base(&scene, (32, 32), 128, 20)
     };
-    both("triangles direct all", direct(LightSelection::All));
-    both("triangles direct power", direct(LightSelection::Power));
+    both("triangles direct all", direct(LightSelection::ALL));
+    both("triangles direct power", direct(LightSelection::named("power")));
 }
 
 /// The warp is in `--stats` (checked by every render above), in the render's identity (a
