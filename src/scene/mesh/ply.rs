@@ -215,7 +215,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh, Mes
         let is_vertex = std::ptr::eq(def, vertex_def);
         let is_face = std::ptr::eq(def, face_def);
         if is_vertex {
-            let plan = VertexPlan::new(def).map_err(|m| bad(Location::File, m))?;
+            let plan = VertexPlan::new(def).map_err(|m| bad(Location::File, m.to_string()))?;
             mesh.positions.reserve_exact(def.count);
             if plan.normal.is_some() {
                 mesh.normals.reserve_exact(def.count);
@@ -226,7 +226,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh, Mes
             mesh.vertex_attrs = plan.attrs.iter().map(|a| new_attr(a, def.count)).collect();
             vplan = Some(plan);
         } else if is_face {
-            let plan = FacePlan::new(def).map_err(|m| bad(Location::File, m))?;
+            let plan = FacePlan::new(def).map_err(|m| bad(Location::File, m.to_string()))?;
             mesh.indices.reserve(def.count);
             mesh.face_attrs = plan.attrs.iter().map(|a| new_attr(a, def.count)).collect();
             fplan = Some(plan);
@@ -251,9 +251,9 @@ pub fn parse_ply(path: &Path, bytes: &[u8], limits: &Limits) -> Result<Mesh, Mes
             }
             .map_err(|e| bad(at(), format!("bad `{}` element {i}: {e}", def.name)))?;
             if is_vertex {
-                vplan.as_ref().unwrap().read(&row, &mut mesh).map_err(|m| bad(at(), m))?;
+                vplan.as_ref().unwrap().read(&row, &mut mesh).map_err(|m| bad(at(), m.to_string()))?;
             } else if is_face {
-                fplan.as_ref().unwrap().read(&row, &mut mesh).map_err(|m| bad(at(), m))?;
+                fplan.as_ref().unwrap().read(&row, &mut mesh).map_err(|m| bad(at(), m.to_string()))?;
             }
         }
     }
@@ -279,15 +279,43 @@ fn find_header_end(bytes: &[u8]) -> Option<usize> {
     Some(at + nl + 1)
 }
 
+/// What is wrong with a PLY header's elements or one row of them (the loader adds file and line).
+#[derive(Debug, thiserror::Error)]
+enum PlyRowError {
+    /// a scalar column holds no number
+    #[error("{0} is not a number")]
+    NotANumber(&'static str),
+    /// a vertex field is infinite or NaN
+    #[error("{what} {value} is not finite")]
+    NotFinite {
+        /// which field (`vertex position`, `vertex normal`, `texture coordinate`)
+        what: &'static str,
+        /// its value as read
+        value: String,
+    },
+    /// a required column is missing from the header
+    #[error("{0}")]
+    MissingColumn(&'static str),
+    /// a face's index list is not a list of integers
+    #[error("vertex indices are not an integer list")]
+    NotAList,
+    /// a face with fewer than three vertices
+    #[error("a face has {0} vertices (at least 3 needed)")]
+    TooFewVertices(usize),
+    /// a vertex index outside u32 (or the u32::MAX sentinel)
+    #[error("vertex index {0} is out of range")]
+    IndexOutOfRange(i64),
+}
+
 fn new_attr(plan: &AttrPlan, count: usize) -> MeshAttr {
     MeshAttr { name: plan.name.clone(), dims: plan.dims, data: Vec::with_capacity(plan.dims * count) }
 }
 
-fn push_attrs(plans: &[AttrPlan], attrs: &mut [MeshAttr], row: &Row) -> Result<(), String> {
+fn push_attrs(plans: &[AttrPlan], attrs: &mut [MeshAttr], row: &Row) -> Result<(), PlyRowError> {
     for (plan, attr) in plans.iter().zip(attrs) {
         let mut v = [0.0f32; 3];
         for &(col, c, s) in &plan.columns {
-            v[c] = scalar(&row.0[col]).ok_or("attribute is not a number")? as f32 * s;
+            v[c] = scalar(&row.0[col]).ok_or(PlyRowError::NotANumber("attribute"))? as f32 * s;
         }
         attr.data.extend_from_slice(&v[..plan.dims]);
     }
@@ -324,8 +352,9 @@ struct VertexPlan {
 }
 
 impl VertexPlan {
-    fn new(def: &ElementDef) -> Result<Self, String> {
-        let position = columns(def, ["x", "y", "z"]).ok_or("the `vertex` element has no scalar `x`, `y` and `z`")?;
+    fn new(def: &ElementDef) -> Result<Self, PlyRowError> {
+        let position = columns(def, ["x", "y", "z"])
+            .ok_or(PlyRowError::MissingColumn("the `vertex` element has no scalar `x`, `y` and `z`"))?;
         let normal = columns(def, ["nx", "ny", "nz"]);
         let uv = [["u", "v"], ["s", "t"], ["texture_u", "texture_v"], ["texture_s", "texture_t"]]
             .into_iter()
@@ -337,24 +366,24 @@ impl VertexPlan {
         Ok(Self { position, normal, uv, attrs })
     }
 
-    fn read(&self, row: &Row, mesh: &mut Mesh) -> Result<(), String> {
-        let get = |k: usize| scalar(&row.0[k]).map(|v| v as f32).ok_or_else(|| "not a number".to_string());
+    fn read(&self, row: &Row, mesh: &mut Mesh) -> Result<(), PlyRowError> {
+        let get = |k: usize| scalar(&row.0[k]).map(|v| v as f32).ok_or(PlyRowError::NotANumber("a vertex field"));
         let p = Vec3::new(get(self.position[0])?, get(self.position[1])?, get(self.position[2])?);
         if !p.is_finite() {
-            return Err(format!("vertex position {p} is not finite"));
+            return Err(PlyRowError::NotFinite { what: "vertex position", value: p.to_string() });
         }
         mesh.positions.push(p);
         if let Some([a, b, c]) = self.normal {
             let n = Vec3::new(get(a)?, get(b)?, get(c)?);
             if !n.is_finite() {
-                return Err(format!("vertex normal {n} is not finite"));
+                return Err(PlyRowError::NotFinite { what: "vertex normal", value: n.to_string() });
             }
             mesh.normals.push(n.normalize_or_zero());
         }
         if let Some([a, b]) = self.uv {
             let uv = Vec2::new(get(a)?, get(b)?);
             if !uv.is_finite() {
-                return Err(format!("texture coordinate {uv} is not finite"));
+                return Err(PlyRowError::NotFinite { what: "texture coordinate", value: uv.to_string() });
             }
             mesh.uvs.push(uv);
         }
@@ -368,7 +397,7 @@ struct FacePlan {
 }
 
 impl FacePlan {
-    fn new(def: &ElementDef) -> Result<Self, String> {
+    fn new(def: &ElementDef) -> Result<Self, PlyRowError> {
         let indices = def
             .properties
             .values()
@@ -376,21 +405,19 @@ impl FacePlan {
                 (p.name == "vertex_indices" || p.name == "vertex_index")
                     && matches!(p.data_type, PropertyType::List(..))
             })
-            .ok_or("the `face` element has no list `vertex_indices` (or `vertex_index`)")?;
+            .ok_or(PlyRowError::MissingColumn("the `face` element has no list `vertex_indices` (or `vertex_index`)"))?;
         Ok(Self { indices, attrs: plan_attrs("face_", &other_columns(def, &[indices])) })
     }
 
-    fn read(&self, row: &Row, mesh: &mut Mesh) -> Result<(), String> {
-        let idx = list(&row.0[self.indices]).ok_or("vertex indices are not an integer list")?;
+    fn read(&self, row: &Row, mesh: &mut Mesh) -> Result<(), PlyRowError> {
+        let idx = list(&row.0[self.indices]).ok_or(PlyRowError::NotAList)?;
         if idx.len() < 3 {
-            return Err(format!("a face has {} vertices (at least 3 needed)", idx.len()));
+            return Err(PlyRowError::TooFewVertices(idx.len()));
         }
         let idx = idx
             .iter()
-            .map(|&i| {
-                u32::try_from(i).ok().filter(|&i| i != u32::MAX).ok_or(format!("vertex index {i} is out of range"))
-            })
-            .collect::<Result<Vec<u32>, String>>()?;
+            .map(|&i| u32::try_from(i).ok().filter(|&i| i != u32::MAX).ok_or(PlyRowError::IndexOutOfRange(i)))
+            .collect::<Result<Vec<u32>, PlyRowError>>()?;
         for k in 1..idx.len() - 1 {
             mesh.indices.push([idx[0], idx[k], idx[k + 1]]);
             if k > 1 {
