@@ -180,15 +180,35 @@ thread_local! {
     };
 }
 
+/// An `Instant` and the tick count at the same moment: of 64 tries, the one whose `Instant` read
+/// sits between the two closest tick readings (their midpoint is returned).
+fn paired_reading() -> (Instant, u64) {
+    let mut best = (Instant::now(), 0u64, u64::MAX);
+    for _ in 0..64 {
+        let a = now();
+        let i = Instant::now();
+        let b = now();
+        let width = b.wrapping_sub(a);
+        if width < best.2 {
+            best = (i, a + width / 2, width);
+        }
+    }
+    (best.0, best.1)
+}
+
 /// Turns profiling on or off for every thread (set it before a render, not during one). The first
 /// time it is turned on, the tick clock is calibrated against `Instant` (about 20 ms).
 pub fn set_enabled(on: bool) {
     if on && NS_PER_TICK.load(Ordering::SeqCst) == 0 {
-        let (t, c) = (Instant::now(), now());
+        // Both ends are tick readings bracketing an `Instant` reading, the tightest of several:
+        // a thread preempted between the two clocks' readings (a millisecond on a loaded machine,
+        // 5 % of the 20 ms) would otherwise skew every phase against the wall-clock total.
+        let (t, c) = paired_reading();
         while t.elapsed().as_millis() < 20 {
             std::hint::spin_loop();
         }
-        let (ns, ticks) = (t.elapsed().as_nanos() as f64, now().wrapping_sub(c));
+        let (t1, c1) = paired_reading();
+        let (ns, ticks) = (t1.duration_since(t).as_nanos() as f64, c1.wrapping_sub(c));
         NS_PER_TICK.store((ns / ticks.max(1) as f64).to_bits(), Ordering::SeqCst);
         let empty = (0..1000)
             .map(|_| {
