@@ -6,7 +6,8 @@
 //! convergence slope of independent light samples on direct9 is -1/2; compare runs on the XML
 //! material preview (glass and metal, issue 30).
 //!
-//! Needs `../shared/cse168` (CI always has it: a missing corpus fails these tests).
+//! Needs `../shared/cse168` (CI always has it: a missing corpus fails these tests), except the XML
+//! test, whose scene is in the repository (`scenes/materials.xml`).
 //! `STRATA_BIN` runs them against another build of `strata` (e.g. the one before this issue).
 
 use crate::common;
