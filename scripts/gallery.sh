@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Renders the README's gallery into docs/gallery/: the built-in Cornell box and real-world OBJs
 # from ../shared/corpora/obj-wild with default flags (automatic camera, default light), plus one
-# scene under --sky. Writes NAME.png per image and docs/gallery/README.md (each image with the
+# scene under --sky, and the material preview scenes/materials.xml (640x360). Writes NAME.png per image and docs/gallery/README.md (each image with the
 # exact command that made it). Usage: scripts/gallery.sh [SPP]  (default 256; 320x240 each).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -51,4 +51,18 @@ sponza|Dabrovic Sponza (an interior: camera inside, light under the roof)|$wild/
 sibenik|Sibenik cathedral (interior)|$wild/sibenik-blender/sibenik.obj
 dragon|Scanned dragon under a constant sky|$wild/scan-dragon-100k/dragon.obj --sky 0.8
 LIST
+# The material preview: strata's own Mitsuba XML scene at its own size (640x360).
+echo "gallery.sh: materials" >&2
+target/release/strata render scenes/materials.xml --spp "$spp" -q -o "$tmp/materials"
+cp "$tmp/materials.png" "$out/materials.png"
+{
+  echo "## Material preview (Mitsuba 3 XML: glass, rough glass, Au, rough Cu, plastic, rough plastic, diffuse)"
+  echo
+  echo "![Material preview](materials.png)"
+  echo
+  echo '```sh'
+  echo "strata render scenes/materials.xml --spp $spp"
+  echo '```'
+  echo
+} >> "$md"
 du -ch "$out"/*.png | tail -1 >&2
