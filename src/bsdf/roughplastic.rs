@@ -1,10 +1,12 @@
 //! `roughplastic`: a rough dielectric coating over a Lambertian base (Mitsuba's `roughplastic`):
 //! f = F(wi.h) D G / (4 wo.z wi.z) `specular_reflectance` + diff t(wo) t(wi) / (pi eta^2), where
-//! t(mu) is the rough coating's transmittance at the cosine mu (1 minus its directional albedo,
-//! tabulated at load at 64 cosines in [0, 1] and interpolated linearly, as Mitsuba does) and the
+//! t(mu) is the rough coating's transmittance at the cosine mu (the light refracted into the base
+//! and not shadowed on the way, as Mitsuba's `eval_transmittance`: not 1 minus the reflectance,
+//! since the shadowed light is in neither; tabulated at load at 64 cosines in [0, 1] and
+//! interpolated linearly, as Mitsuba does) and the
 //! base reflectance d is renormalized for the light the coating's inside reflects back:
 //! diff = d / (1 - R_int) (linear) or d / (1 - d R_int) (`nonlinear`), R_int the coating's
-//! internal diffuse reflectance (2 mean(albedo_inside(mu) mu) over the same cosines). The
+//! internal diffuse reflectance (2 mean(reflectance_inside(mu) mu) over the same cosines). The
 //! specular lobe is sampled (visible normals, reflected) with probability proportional to
 //! (1 - t(wo)) w, the cosine lobe to t(wo) (1 - w), w = mean(specular) / (mean(diffuse) +
 //! mean(specular)). Isotropic, one-sided.
@@ -25,7 +27,7 @@ use std::sync::RwLock;
 
 /// Cosines of the transmittance table (Mitsuba's resolution).
 const RES: usize = 64;
-/// Quadrature points per axis of the directional albedo.
+/// Quadrature points per axis of the coating's reflectance and transmittance.
 const QUAD: usize = 64;
 
 /// One transmittance table and what it was computed for.
