@@ -38,14 +38,8 @@ pub const CORPUS: &[(&str, Expect)] = &[
     ("bsdf_spheres/test_normalmap_roughconductor_path.xml", BSDFS),
     ("bsdf_spheres/test_pointlight_path.xml", BSDFS),
     ("bsdf_spheres/test_roughdielectric_path.xml", Expect::Pass),
-    (
-        "bsdf_spheres/test_roughplastic_linear_path.xml",
-        Expect::Fails("82.2 % of pixel channels accepted: roughplastic differs from Mitsuba's (not found yet)"),
-    ),
-    (
-        "bsdf_spheres/test_roughplastic_nonlinear_path.xml",
-        Expect::Fails("83.4 % of pixel channels accepted: roughplastic differs from Mitsuba's (not found yet)"),
-    ),
+    ("bsdf_spheres/test_roughplastic_linear_path.xml", Expect::Pass),
+    ("bsdf_spheres/test_roughplastic_nonlinear_path.xml", Expect::Pass),
     ("bsdf_spheres/test_textured_diffuse_path.xml", Expect::Pass),
     // Textured roughness (alpha_u/alpha_v as a <texture>) is refused with file:line.
     ("bsdf_spheres/test_textured_roughconductor_path.xml", Expect::Refused("not <texture>")),
