@@ -177,7 +177,7 @@ pub fn provenance(c: &Comparison, commands: &[String]) -> Vec<(String, String)> 
             format!(
                 "K = {} runs per row; 95% intervals: MSE - ref. var. Student t, bias Student t, MSE, relMSE and the \
                  efficiency ratio percentile bootstrap over runs ({} resamples); robust statistic: trimmed MSE, the \
-                 largest {}% of squared errors dropped",
+                 largest {:.1}% of squared errors dropped",
                 c.runs.iter().map(|r| r.run).max().map_or(0, |m| m + 1),
                 report::robust::RESAMPLES,
                 (1.0 - report::robust::TRIM_KEEP) * 100.0

@@ -385,5 +385,7 @@ fn compare_runs_on_an_xml_scene_with_glass_and_metal_and_writes_its_table() {
         assert_eq!(md.lines().filter(|l| l.starts_with(&format!("| {v} "))).count(), 3, "2 rows + 1 slope: {md}");
     }
     assert!(md.contains("materials.xml") && md.contains("Provenance"), "{md}");
+    // The provenance prints its numbers as a person would write them (was "0.10000000000000009%").
+    assert!(md.contains("the largest 0.1% of squared errors dropped"), "{md}");
     std::fs::remove_dir_all(&d).ok();
 }
