@@ -142,8 +142,8 @@ pub struct Comparison {
     pub notes: Vec<String>,
     /// the reference image (linear RGB) and its size
     pub reference: film::ExrImage,
-    /// each variant's image of run 1 at the last step
-    pub images: Vec<(String, Vec<[f32; 3]>)>,
+    /// each variant's images of every run at the last step (run 1 first)
+    pub images: Vec<(String, Vec<Vec<[f32; 3]>>)>,
     /// the baseline variant
     pub baseline: String,
     /// worker threads of the renders
@@ -349,7 +349,7 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
             row.setting = ran;
             rows.push(row);
             per_step.push(hashes);
-            last = runs_img.swap_remove(0);
+            last = runs_img;
         }
         images.push((v.name.clone(), last));
         renders.push(per_step);

@@ -8,6 +8,7 @@ pub mod compare;
 pub mod experiments;
 pub mod mitsuba;
 pub mod progress;
+pub mod report_figures;
 pub mod report_page;
 
 pub use compare::{

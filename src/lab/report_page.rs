@@ -4,7 +4,7 @@
 //! [`crate::report::html`].
 
 use super::compare::{Comparison, Convergence, RunRow};
-use super::{io_err, LabError};
+use super::{io_err, report_figures, LabError};
 use crate::film;
 use crate::report::html::{self, Page, Section, Shot};
 use crate::report::{self, student_t_quantile, Annotation, Series};
@@ -206,15 +206,46 @@ pub fn compare_html(
     by_spp: &Option<String>,
 ) -> String {
     let reference = Shot { label: "reference".into(), rgb: c.reference.rgb.clone() };
-    let shots = c.images.iter().map(|(name, rgb)| Shot { label: name.clone(), rgb: rgb.clone() }).collect();
+    let first = |runs: &[Vec<[f32; 3]>]| runs.first().cloned().unwrap_or_default();
+    let shots = c.images.iter().map(|(name, runs)| Shot { label: name.clone(), rgb: first(runs) }).collect();
+    let runs = c
+        .images
+        .iter()
+        .flat_map(|(name, runs)| {
+            runs.iter()
+                .enumerate()
+                .map(move |(r, rgb)| Shot { label: format!("{name} run {}", r + 1), rgb: rgb.clone() })
+        })
+        .collect();
+    let (w, h) = (c.reference.width, c.reference.height);
+    let names: Vec<&str> = c.images.iter().map(|(n, _)| n.as_str()).collect();
+    let errors: Vec<Vec<f32>> =
+        c.images.iter().map(|(_, runs)| report_figures::mean_error(runs, &c.reference.rgb)).collect();
+    let errors: Vec<&[f32]> = errors.iter().map(Vec::as_slice).collect();
+    let run1: Vec<Vec<[f32; 3]>> = c.images.iter().map(|(_, runs)| first(runs)).collect();
+    let run1: Vec<&[[f32; 3]]> = run1.iter().map(Vec::as_slice).collect();
+    let k = c.runs.iter().map(|r| r.run).max().map_or(0, |m| m + 1);
+    // The results in two tables (cost, then error), so that neither overflows a 1200-px page.
+    let cols = report::table::compare_columns(&c.rows);
+    let split = cols.iter().position(|col| col.header == "MSE").unwrap_or(cols.len());
+    let (cost, error): (Vec<_>, Vec<_>) = (
+        cols[..split].to_vec(),
+        cols.iter()
+            .enumerate()
+            .filter(|&(i, col)| i == 0 || i >= split || col.header == "spp")
+            .map(|(_, c)| *c)
+            .collect(),
+    );
     let mut blocks = vec![
+        report_figures::crops_html(&c.reference.rgb, w, h, &names, &run1, &errors),
+        report_figures::mean_error_html(&names, &errors, w, h, k),
         provenance_html(&provenance(c, commands)),
         notes_block(&c.notes),
         format!(
-            "<h3>Results (K = {} runs per row; efficiency against {})</h3>\n{}",
-            c.runs.iter().map(|r| r.run).max().map_or(0, |m| m + 1),
+            "<h3>Results (K = {k} runs per row; efficiency against {})</h3>\n<p>Cost per run:</p>\n{}<p>Error:</p>\n{}",
             html::escape(&c.baseline),
-            report::html_table(&report::table::compare_columns(&c.rows), &c.rows)
+            report::html_table(&cost, &c.rows),
+            report::html_table(&error, &c.rows)
         ),
         slopes_html(&c.convergence),
         format!("<h3>Convergence</h3>\n{}", html::inline_svg(by_time)),
@@ -227,8 +258,9 @@ pub fn compare_html(
     let page = Page {
         title: format!("strata compare: {title}"),
         intro:
-            "<p>Images: each variant's run 1 at the last step, sRGB (clamped), against the reference. Error maps of \
-                that image against the reference.</p>"
+            "<p>Images: each variant's run 1 at the last step, sRGB (clamped), against the reference; error maps of \
+                that image against the reference; then every run at the last step (a flip-book of its own), crops \
+                where the variants differ most and each variant's mean error over its runs.</p>"
                 .into(),
         sections: vec![Section {
             title: title.into(),
@@ -236,6 +268,7 @@ pub fn compare_html(
             height: c.reference.height,
             reference: Some(reference),
             shots,
+            runs,
             blocks,
         }],
         blocks: Vec::new(),

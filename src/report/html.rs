@@ -33,6 +33,9 @@ pub struct Section {
     pub reference: Option<Shot>,
     /// the variants' images
     pub shots: Vec<Shot>,
+    /// every run's image (labels `variant run r`): a flip-book of its own, after the error maps
+    /// (none: no such book)
+    pub runs: Vec<Shot>,
     /// HTML blocks after the images (tables, plots, notes), in order
     pub blocks: Vec<String>,
 }
@@ -189,9 +192,22 @@ fn section_html(i: usize, s: &Section) -> String {
             "<div class=\"book maps\"><div class=\"bar\"></div><div class=\"view\">{maps}</div><div class=\"legend\"></div></div>\n"
         )
     };
+    // The runs carry no hover values: half floats of every run would multiply the page's size.
+    let runs: String = s
+        .runs
+        .iter()
+        .map(|r| entry(&r.label, "run", "one run's render (sRGB, clamped)", w, h, &flip::to_srgb8(&r.rgb), None))
+        .collect();
+    let runs_html = if runs.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "<div class=\"book runs\"><div class=\"bar\"></div><div class=\"view\">{runs}</div><div class=\"legend\"></div></div>\n"
+        )
+    };
     format!(
         "<section id=\"s{i}\"><h2>{}</h2>\n<div class=\"books\"><div class=\"book images\"><div class=\"bar\"></div>\
-         <div class=\"view\">{book}</div><div class=\"legend\"></div></div>\n{maps_html}</div>\n\
+         <div class=\"view\">{book}</div><div class=\"legend\"></div></div>\n{maps_html}{runs_html}</div>\n\
          <p class=\"hover\">&nbsp;</p>\n{}\n</section>\n",
         escape(&s.title),
         s.blocks.join("\n")
@@ -208,12 +224,26 @@ h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.5em; }
 .bar button { margin: 0 0.3em 0.3em 0; font-size: 0.85em; }
 .bar button.on { background: #246; color: white; }
 .legend, .hover { font-size: 0.85em; color: #444; min-height: 1.2em; }
-table { border-collapse: collapse; font-size: 0.85em; margin: 0.8em 0; }
-td, th { border: 1px solid #bbb; padding: 0.2em 0.5em; text-align: right; white-space: nowrap; }
+table { border-collapse: collapse; font-size: 0.8em; margin: 0.8em 0; max-width: 100%; }
+td, th { border: 1px solid #bbb; padding: 0.2em 0.4em; text-align: right; white-space: nowrap; }
+th { white-space: normal; vertical-align: bottom; }
+td.text { white-space: normal; text-align: left; min-width: 10em; }
 td:first-child, th:first-child { text-align: left; }
-pre { background: #f4f4f4; padding: 0.6em; overflow-x: auto; }
+table.provenance td { white-space: normal; text-align: left; overflow-wrap: anywhere; }
+pre { background: #f4f4f4; padding: 0.6em; white-space: pre-wrap; overflow-wrap: anywhere; }
 .notes li { color: #842; }
 svg { max-width: 100%; height: auto; }
+figure img { max-width: 100%; height: auto; }
+figure { margin: 0; font-size: 0.8em; color: #444; }
+.figures, .crops, .crop-row { display: flex; flex-wrap: wrap; gap: 0.8em; align-items: flex-start; }
+.crops { gap: 1.5em; } .crop-row { margin-bottom: 0.8em; }
+.crop-label { width: 5.5em; font-size: 0.8em; }
+figure img.crop, figure img.crop-err, figure img.overview, figure img.mean-error { display: block; image-rendering: pixelated; }
+figure img.crop, figure img.crop-err { border: 1px solid #888; }
+figure img.crop-err { margin-top: 2px; }
+th.text { text-align: left; }
+.overview { position: relative; }
+.overview span { position: absolute; color: #fff; font-weight: bold; font-size: 0.9em; text-shadow: 0 0 2px #000; }
 "#;
 
 const SCRIPT: &str = r#"
@@ -231,7 +261,10 @@ const SCRIPT: &str = r#"
       if (!shots.length) { return; }
       var w = shots[0].width, h = shots[0].height;
       var box = book.querySelector('.view');
-      var fit = Math.max(1, Math.floor(Math.min(512 / w, 512 / h)));
+      // Views of at most 360 px a side (three fit in a row of a 1200-px page): small images
+      // enlarged by a whole factor, large ones shrunk.
+      var fit = Math.min(360 / w, 360 / h);
+      fit = fit >= 1 ? Math.floor(fit) : fit;
       view.scale = fit;
       box.style.width = (w * fit) + 'px';
       box.style.height = (h * fit) + 'px';
@@ -348,6 +381,8 @@ const SCRIPT: &str = r#"
           (v ? ' centre ' + [v[k], v[k + 1], v[k + 2]].join(' ') : ''));
       }
     });
+    var root = document.documentElement;
+    lines.push('layout scroll width ' + root.scrollWidth + ', client width ' + root.clientWidth);
     lines.push('errors ' + errors.length + (errors.length ? ': ' + errors.join(' | ') : ''));
     var pre = document.createElement('pre');
     pre.id = 'selftest';
@@ -407,6 +442,7 @@ mod tests {
                 height: 2,
                 reference: Some(shot("reference", 0.5)),
                 shots: vec![shot("x\"y", 0.25)],
+                runs: vec![shot("x\"y run 1", 0.25), shot("x\"y run 2", 0.3)],
                 blocks: vec![],
             }],
             blocks: vec![],
@@ -414,9 +450,11 @@ mod tests {
         };
         let html = page_html(&page);
         assert!(html.contains("<title>a &lt;b&gt; &amp; c</title>") && html.contains("data-label=\"x&quot;y\""));
-        // One image entry per shot and reference, three error maps per shot, PNG data URIs only.
-        assert_eq!(html.matches("<img class=\"shot\"").count(), 2 + 3);
-        assert_eq!(html.matches("src=\"data:image/png;base64,").count(), 5);
+        // One image entry per shot and reference, three error maps per shot, one frame per run,
+        // PNG data URIs only.
+        assert_eq!(html.matches("<img class=\"shot\"").count(), 2 + 3 + 2);
+        assert_eq!(html.matches("src=\"data:image/png;base64,").count(), 7);
+        assert_eq!(html.matches("data-kind=\"run\"").count(), 2);
         assert!(
             html.contains("strata compare --variant &#x27;a=--spp 1&#x27;") || html.contains("--variant 'a=--spp 1'")
         );

@@ -163,13 +163,16 @@ pub fn html_table(columns: &[Column], rows: &[Row]) -> String {
     let esc = |s: &str| super::html::escape(&s.replace("\\|", "|"));
     let mut out = String::from("<table>\n<tr>");
     for c in columns {
-        out += &format!("<th>{}</th>", esc(c.header));
+        let class = if c.header == "samplers" { " class=\"text\"" } else { "" };
+        out += &format!("<th{class}>{}</th>", esc(c.header));
     }
     out += "</tr>\n";
     for row in cells(columns, rows) {
         out += "<tr>";
-        for c in row {
-            out += &format!("<td>{}</td>", esc(&c));
+        for (c, col) in row.iter().zip(columns) {
+            // Lists of words (the samplers that ran) may wrap; numbers never do.
+            let class = if col.header == "samplers" { " class=\"text\"" } else { "" };
+            out += &format!("<td{class}>{}</td>", esc(c));
         }
         out += "</tr>\n";
     }

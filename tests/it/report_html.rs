@@ -107,3 +107,54 @@ fn report_html_flip_book_shows_every_variant_in_headless_chromium() {
     assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "screenshot of {} bytes", png.len());
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// Issue 31: the report is supplementary material. Its HTML carries insets of the regions where
+/// the variants differ most (one crop per variant and the reference, per region, with the
+/// regions outlined on an overview), each variant's mean squared error image over its runs, and a
+/// flip-book over every run (one frame per variant and run, not run 1 only). Before, the page had
+/// none of these.
+#[test]
+fn report_html_has_crops_by_error_a_mean_error_image_and_a_frame_per_run() {
+    let d = common::tmpdir("report-figures");
+    let page = compare_report(&d);
+    let html = std::fs::read_to_string(&page).unwrap();
+    let (variants, runs) = (["independent", "stratified", "halton"], 2);
+    // Crops: regions A.. each with the reference and every variant, chosen by error.
+    let crops = html.matches("<img class=\"crop\"").count();
+    assert!(crops > variants.len(), "no crops in report.html ({crops} crop images)");
+    assert_eq!(crops % (variants.len() + 1), 0, "each region shows the reference and every variant: {crops}");
+    assert!(html.contains("class=\"crop-overview\""), "no overview with the crops outlined");
+    for v in variants {
+        assert!(html.contains(&format!("data-crop-variant=\"{v}\"")), "no crop of {v}");
+        let mean = format!("<img class=\"mean-error\" data-variant=\"{v}\"");
+        assert_eq!(html.matches(&mean).count(), 1, "one mean error image of {v}");
+        // One flip-book frame per run of the variant, at the last step.
+        for r in 1..=runs {
+            let frame = format!("data-label=\"{v} run {r}\" data-kind=\"run\"");
+            assert_eq!(html.matches(&frame).count(), 1, "flip-book frame `{frame}`");
+        }
+    }
+    assert_eq!(html.matches("data-kind=\"run\"").count(), variants.len() * runs, "one frame per run");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Issue 31: the report fits a 1200-px window: in headless Chromium at 1200 px the page's scroll
+/// width is its client width (no horizontal overflow; the self-test writes both). Before, the
+/// provenance and results tables overflowed (scroll width 1979 px at 1200).
+#[test]
+fn report_html_fits_1200_px_without_horizontal_overflow() {
+    let d = common::tmpdir("report-width");
+    let page = compare_report(&d);
+    let url = format!("file://{}#selftest", page.display());
+    let (dom, log) = chromium(&url, &["--dump-dom", "--window-size=1200,1600"]);
+    let start = dom.find("<pre id=\"selftest\">").unwrap_or_else(|| panic!("no self-test output in the DOM:\n{log}"));
+    let line = dom[start..]
+        .lines()
+        .find(|l| l.starts_with("layout scroll width"))
+        .unwrap_or_else(|| panic!("no layout line in the self-test output:\n{log}"));
+    let nums: Vec<u32> = line.split_whitespace().filter_map(|w| w.trim_end_matches(',').parse().ok()).collect();
+    let (scroll, client) = (nums[0], nums[1]);
+    assert!((1100..=1200).contains(&client), "{line}");
+    assert!(scroll <= client, "the page overflows 1200 px: {line}");
+    std::fs::remove_dir_all(&d).ok();
+}
