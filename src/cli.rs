@@ -273,6 +273,20 @@ pub(crate) struct ReferenceCmd {
     pub(crate) replicas: Option<u32>,
 }
 
+impl ReferenceCmd {
+    /// The replicas: `--replicas`, else [`strata::session::reference::default_replicas`] of its
+    /// spp (1 when there is none: a shard, a resumed or checkpointed reference, a time budget).
+    pub(crate) fn replicas(&self) -> u32 {
+        let a = &self.render.args;
+        let single = a.samples.is_some() || a.resume.is_some() || a.checkpoint.is_some() || a.time_budget.is_some();
+        self.replicas.unwrap_or(if single {
+            1
+        } else {
+            strata::session::reference::default_replicas(a.spp.unwrap_or(1))
+        })
+    }
+}
+
 impl RenderCmd {
     /// The render flags, `--json` folded into `--stats`.
     pub(crate) fn into_args(self) -> RenderArgs {

@@ -36,6 +36,9 @@ pub enum FrontendError {
         /// clap's message about its options
         source: clap::Error,
     },
+    /// `strata reference` without `--spp`.
+    #[error("`strata reference` needs --spp N (a reference is a high-spp render, e.g. --spp 4096)")]
+    ReferenceSpp,
     /// Neither `--budget` nor `--spp-ladder`.
     #[error("give --budget SECONDS or --spp-ladder 1,2,4,...")]
     NoMode,
@@ -62,6 +65,26 @@ pub fn render_options(args: &[String]) -> Result<RenderOptions, FrontendError> {
     match Cli::try_parse_from(argv)?.cmd {
         Cmd::Render(a) => Ok(a.into_args().options()),
         _ => unreachable!("parsed as render"),
+    }
+}
+
+/// What `strata reference ARGS...` renders (`args` without the program and subcommand names):
+/// its render options, unbiased ([`session::reference::unbiased`]: `--first-sample jittered`
+/// unless given), and its replicas (`--replicas`, else the default of its spp). The binary and
+/// the Python module's `strata.reference` both run this.
+pub fn reference_options(args: &[String]) -> Result<(RenderOptions, u32), FrontendError> {
+    let argv = ["strata", "reference"].into_iter().map(String::from).chain(args.iter().cloned());
+    match Cli::try_parse_from(argv)?.cmd {
+        Cmd::Reference(cmd) => {
+            if cmd.render.args.spp.is_none() {
+                return Err(FrontendError::ReferenceSpp);
+            }
+            let replicas = cmd.replicas();
+            let mut opts = cmd.render.into_args().options();
+            session::reference::unbiased(&mut opts);
+            Ok((opts, replicas))
+        }
+        _ => unreachable!("parsed as reference"),
     }
 }
 
@@ -103,9 +126,10 @@ pub struct CompareArgs {
     pub out: PathBuf,
     /// profile outputs
     pub profile: ProfileOut,
-    /// the command the report says reproduces it (None: this process's command line; the Python
-    /// module sets the equivalent `strata compare ...`, not `python script.py`)
-    pub command: Option<String>,
+    /// the commands the report says reproduce it (empty: this process's command line; the Python
+    /// module gives its call, `strata.compare(...)`, and the equivalent `strata compare ...`, never
+    /// `python script.py`)
+    pub commands: Vec<String>,
 }
 
 /// What a compare run produced.
@@ -152,7 +176,7 @@ pub fn compare_args(args: &[String]) -> Result<CompareArgs, FrontendError> {
             threads,
             out,
             profile: ProfileOut { json: profile, svg: profile_svg },
-            command: None,
+            commands: Vec::new(),
         }),
         _ => unreachable!("parsed as compare"),
     }
@@ -222,8 +246,8 @@ pub fn run_compare(a: &CompareArgs) -> Result<CompareOutput, FrontendError> {
         a.scene.as_ref().map_or("built-in cornell".into(), |p| p.display().to_string()),
         a.reference.display()
     );
-    let command = a.command.clone().unwrap_or_else(command_line);
-    let markdown = lab::write_outputs(&c, &a.out, &title, &[command])?;
+    let commands = if a.commands.is_empty() { vec![command_line()] } else { a.commands.clone() };
+    let markdown = lab::write_outputs(&c, &a.out, &title, &commands)?;
     if let Some(f) = &a.profile.json {
         let text = serde_json::to_string_pretty(&c.profiles)?;
         session::profile::write_text(f, &text)?;

@@ -68,13 +68,12 @@ fn main() -> ExitCode {
             println!("ok");
             Ok(())
         }
-        Cmd::Reference(cmd) if resolve_replicas(&cmd) > 1 => {
-            let replicas = resolve_replicas(&cmd);
+        Cmd::Reference(cmd) if cmd.replicas() > 1 => {
+            let replicas = cmd.replicas();
             let args = cmd.render.into_args();
             let quiet = args.quiet;
             let mut opts = args.options();
-            // A reference is unbiased by default, whatever the scene's course conventions.
-            opts.first_sample.get_or_insert(strata::integrator::FirstSample::Jittered);
+            session::reference::unbiased(&mut opts);
             match session::reference::run_reference(&opts, replicas) {
                 Ok(rep) => {
                     if !quiet {
@@ -90,8 +89,7 @@ fn main() -> ExitCode {
             let quiet = args.quiet;
             let mut opts = args.options();
             if is_reference {
-                // A reference is unbiased by default, whatever the scene's course conventions.
-                opts.first_sample.get_or_insert(strata::integrator::FirstSample::Jittered);
+                session::reference::unbiased(&mut opts);
             }
             match session::stop_on_signals() {
                 Ok(flag) => {
@@ -232,23 +230,14 @@ fn main() -> ExitCode {
     }
 }
 
-/// The replicas of `strata reference`: `--replicas`, else [`session::reference::default_replicas`]
-/// of its spp (1 when there is none: a shard, a resumed or checkpointed reference).
-fn resolve_replicas(cmd: &ReferenceCmd) -> u32 {
-    let a = &cmd.render.args;
-    let single = a.samples.is_some() || a.resume.is_some() || a.checkpoint.is_some() || a.time_budget.is_some();
-    cmd.replicas.unwrap_or(if single { 1 } else { session::reference::default_replicas(a.spp.unwrap_or(1)) })
-}
-
 /// Refuses, as a usage error (exit status 2), what the parsed command line asks for but the
 /// subcommand would ignore: `reference` without `--spp`; `rays` and `profile` with flags that only
 /// a render writing an image uses (and `rays` with `--profile`).
 fn refuse_unused_flags(cmd: &Cmd) {
     let (name, args) = match cmd {
-        Cmd::Reference(cmd) if cmd.render.args.spp.is_none() => usage_error(
-            "reference",
-            "`strata reference` needs --spp N (a reference is a high-spp render, e.g. --spp 4096)".into(),
-        ),
+        Cmd::Reference(cmd) if cmd.render.args.spp.is_none() => {
+            usage_error("reference", strata::frontend::FrontendError::ReferenceSpp.to_string())
+        }
         Cmd::Rays { args, .. } => ("rays", args),
         Cmd::Profile { args, .. } => ("profile", args),
         _ => return,

@@ -91,11 +91,19 @@ fn parse_scene(py: Python<'_>, args: Vec<String>) -> PyResult<ParsedScene> {
 fn render(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedScene>) -> PyResult<Rendered> {
     let mut opts: RenderOptions = strata::frontend::render_options(&args).map_err(err)?;
     opts.parsed = scene.map(|s| Arc::clone(&s.desc));
-    let stop = Arc::new(AtomicBool::new(false));
-    opts.stop = Some(Arc::clone(&stop));
-    let outcome = py.detach(|| {
+    let out = render_detached(py, opts, write)?;
+    let (mean, var) = (out.film.mean(), out.film.variance_of_mean());
+    let stats = session::stats_json(&out).to_string();
+    let (w, h) = (out.film.width, out.film.height);
+    Ok((PyBytes::new(py, &rgb_bytes(&mean)).unbind(), PyBytes::new(py, &rgb_bytes(&var)).unbind(), w, h, stats))
+}
+
+/// Runs `job` on a scoped thread with the GIL released, polling Python's signal handlers: a
+/// signal sets `stop` (the render stops after its pass). Returns the job's result and the signal.
+fn detached<T: Send>(py: Python<'_>, stop: &AtomicBool, job: impl FnOnce() -> T + Send) -> (T, Option<PyErr>) {
+    py.detach(|| {
         std::thread::scope(|s| {
-            let job = s.spawn(|| if write { session::run_render(&opts) } else { session::render_to_film(&opts) });
+            let job = s.spawn(job);
             let mut signal = None;
             while !job.is_finished() {
                 std::thread::sleep(std::time::Duration::from_millis(20));
@@ -106,34 +114,92 @@ fn render(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedS
                     }
                 }
             }
-            let result = job.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
-            (result, signal)
+            (job.join().unwrap_or_else(|p| std::panic::resume_unwind(p)), signal)
         })
-    });
-    let out = match outcome {
+    })
+}
+
+/// One render of `opts` (writing the CLI's outputs with `write`), Ctrl-C raising
+/// `KeyboardInterrupt` after the pass (and the checkpoint the CLI would write).
+fn render_detached(py: Python<'_>, mut opts: RenderOptions, write: bool) -> PyResult<session::RenderOutput> {
+    let stop = Arc::new(AtomicBool::new(false));
+    opts.stop = Some(Arc::clone(&stop));
+    let outcome =
+        detached(py, &stop, || if write { session::run_render(&opts) } else { session::render_to_film(&opts) });
+    match outcome {
         (Ok(o), Some(e)) if e.is_instance_of::<PyKeyboardInterrupt>(py) => {
             let ck = o.checkpoint.as_ref().map_or(String::new(), |p| format!("; checkpoint {}", p.display()));
-            return Err(PyKeyboardInterrupt::new_err(format!(
-                "render interrupted after {} spp{ck}",
-                o.film.samples().len()
-            )));
+            Err(PyKeyboardInterrupt::new_err(format!("render interrupted after {} spp{ck}", o.film.samples().len())))
         }
+        (_, Some(e)) => Err(e),
+        (Err(e), None) => Err(err(e)),
+        (Ok(o), None) => Ok(o),
+    }
+}
+
+/// A reference for Python: a render's result and the EXR metadata the CLI writes, as (key, value)
+/// pairs.
+type Referenced = (Py<PyBytes>, Py<PyBytes>, u32, u32, String, Vec<(String, String)>);
+
+/// Runs `strata reference ARGS` exactly as the CLI does ([`strata::frontend::reference_options`]:
+/// `--first-sample jittered` unless given, the replicas and their variance layer); `write`: also
+/// write its outputs (`-o`). Returns (mean RGB f32 bytes, variance f32 bytes (the replicas'
+/// variance of the mean, or the i.i.d. one with one replica), width, height, stats JSON, EXR
+/// metadata).
+#[pyfunction]
+#[pyo3(signature = (args, write, scene=None))]
+fn reference(py: Python<'_>, args: Vec<String>, write: bool, scene: Option<&ParsedScene>) -> PyResult<Referenced> {
+    let (mut opts, replicas) = strata::frontend::reference_options(&args).map_err(err)?;
+    opts.parsed = scene.map(|s| Arc::clone(&s.desc));
+    let bytes = |v: &[[f32; 3]]| PyBytes::new(py, &rgb_bytes(v)).unbind();
+    if replicas < 2 {
+        let out = render_detached(py, opts, write)?;
+        let meta = session::output::metadata(&out);
+        let (w, h) = (out.film.width, out.film.height);
+        let stats = session::stats_json(&out).to_string();
+        return Ok((bytes(&out.film.mean()), bytes(&out.film.variance_of_mean()), w, h, stats, meta));
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    opts.stop = Some(Arc::clone(&stop));
+    let run = || {
+        if write {
+            session::reference::run_reference(&opts, replicas)
+        } else {
+            session::reference::render_replicas(&opts, replicas)
+        }
+    };
+    let rep = match detached(py, &stop, run) {
         (_, Some(e)) => return Err(e),
         (Err(e), None) => return Err(err(e)),
-        (Ok(o), None) => o,
+        (Ok(r), None) => r,
     };
-    let (mean, var) = (out.film.mean(), out.film.variance_of_mean());
-    let stats = session::stats_json(&out).to_string();
-    let (w, h) = (out.film.width, out.film.height);
-    Ok((PyBytes::new(py, &rgb_bytes(&mean)).unbind(), PyBytes::new(py, &rgb_bytes(&var)).unbind(), w, h, stats))
+    let meta = session::reference::replicated_metadata(&rep, opts.seed);
+    let stats = session::reference::replicated_stats(&rep, opts.seed).to_string();
+    let (w, h) = (rep.out.film.width, rep.out.film.height);
+    Ok((bytes(&rep.mean), bytes(&rep.variance), w, h, stats, meta))
+}
+
+/// The options `strata CMD ARGS` resolves to (`render`, `reference` or `compare`), as debug text:
+/// what the pytest suite compares between Python's calls and the CLI's flags, defaults included.
+#[pyfunction]
+fn resolve(cmd: &str, args: Vec<String>) -> PyResult<String> {
+    match cmd {
+        "render" => strata::frontend::render_options(&args).map(|o| format!("{o:?}")),
+        "reference" => strata::frontend::reference_options(&args).map(|o| format!("{o:?}")),
+        "compare" => strata::frontend::compare_args(&args).map(|o| format!("{o:?}")),
+        _ => return Err(err(format!("resolve: unknown command {cmd}"))),
+    }
+    .map_err(err)
 }
 
 /// Runs `strata compare ARGS` (writing its outputs as the CLI does); returns the rows as JSON.
+/// `call`: the Python call, which the report gives first under "Reproduce".
 #[pyfunction]
-fn compare(py: Python<'_>, args: Vec<String>) -> PyResult<String> {
+#[pyo3(signature = (args, call=None))]
+fn compare(py: Python<'_>, args: Vec<String>, call: Option<String>) -> PyResult<String> {
     let mut a = strata::frontend::compare_args(&args).map_err(err)?;
-    // The report's command: the CLI's equivalent of this call (arrays appear by their registered
-    // names), never `python script.py`.
+    // The report's commands: the Python call, then the CLI's equivalent of it (arrays appear by
+    // their registered names), never `python script.py`.
     let quote = |s: &String| {
         if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=:,@%+".contains(c)) {
             s.clone()
@@ -142,7 +208,7 @@ fn compare(py: Python<'_>, args: Vec<String>) -> PyResult<String> {
         }
     };
     let cli = format!("strata compare {}", args.iter().map(quote).collect::<Vec<_>>().join(" "));
-    a.command = Some(format!("{cli}  (from Python: strata.compare)"));
+    a.commands = call.into_iter().chain([format!("{cli}  (the CLI's equivalent)")]).collect();
     // The message crosses the thread boundary (FrontendError is large; Python gets text anyway).
     let out = py.detach(|| strata::frontend::run_compare(&a).map_err(|e| e.to_string())).map_err(err)?;
     Ok(strata::report::to_json(&out.rows).to_string())
@@ -207,6 +273,8 @@ fn _strata(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parse_scene, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(reference, m)?)?;
+    m.add_function(wrap_pyfunction!(resolve, m)?)?;
     m.add_function(wrap_pyfunction!(check_points, m)?)?;
     m.add_function(wrap_pyfunction!(mse, m)?)?;
     m.add_function(wrap_pyfunction!(relmse, m)?)?;

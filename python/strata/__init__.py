@@ -28,17 +28,21 @@ __version__ = _strata.version()
 
 class Image(np.ndarray):
     """A render: float32 H x W x 3 linear RGB (the per-pixel mean), with ``variance`` (the
-    variance of that mean, H x W x 3) and ``stats`` (the ``--stats`` JSON as a dict)."""
+    variance of that mean, H x W x 3), ``stats`` (the ``--stats`` JSON as a dict) and
+    ``metadata`` (the ``strata.*`` attributes of the EXR the CLI writes, as a dict; None for a
+    plain render)."""
 
-    def __new__(cls, rgb, variance, stats):
+    def __new__(cls, rgb, variance, stats, metadata=None):
         obj = np.asarray(rgb, dtype=np.float32).view(cls)
         obj.variance = variance
         obj.stats = stats
+        obj.metadata = metadata
         return obj
 
     def __array_finalize__(self, obj):
         self.variance = getattr(obj, "variance", None)
         self.stats = getattr(obj, "stats", None)
+        self.metadata = getattr(obj, "metadata", None)
 
 
 class Scene:
@@ -134,9 +138,23 @@ def read_exr(path):
 
 
 def reference(scene=None, **flags):
-    """``strata reference``: a render (same flags; give ``spp`` and ``out`` to keep the EXR with
-    its variance layer), returned as an :class:`Image`."""
-    return render(scene, **flags)
+    """``strata reference``, run by the same library function as the CLI: ``spp`` is required;
+    pixel sample 0 is jittered unless ``first_sample`` says otherwise (a reference is unbiased
+    whatever the scene's conventions); ``replicas`` independent renders (default: the largest
+    divisor of ``spp`` from 2 to 8) give the variance layer, their variance of the mean. ``out``
+    also writes the CLI's EXR (with that layer and its metadata) and PNG. Returns an
+    :class:`Image`: ``variance`` is the layer, ``stats`` the ``--stats`` JSON (``replicas``,
+    ``variance_estimate``, ...), ``metadata`` the EXR's ``strata.*`` attributes."""
+    write = flags.get("out") is not None
+    parsed = scene._parsed if isinstance(scene, Scene) else None
+    rgb, var, w, h, stats, meta = _strata.reference(_render_args(scene, flags), write, parsed)
+    shape = (h, w, 3)
+    return Image(
+        np.frombuffer(rgb, dtype="<f4").reshape(shape),
+        np.frombuffer(var, dtype="<f4").reshape(shape),
+        json.loads(stats),
+        dict(meta),
+    )
 
 
 def _variant_flags(name, v):
@@ -150,12 +168,9 @@ def _variant_flags(name, v):
     return " ".join(args)
 
 
-def compare(scene=None, *, reference, variants, **flags):
-    """``strata compare``: ``variants`` maps names to render flags (a string as on the command
-    line, or a dict of keyword arguments, point arrays included); the other keywords are
-    compare's flags (``runs``, ``budget``, ``spp_ladder``, ``size``, ``threads``, ``out``, ...).
-    Writes the CLI's outputs and returns the rows (a pandas DataFrame if pandas is installed,
-    else a list of dicts)."""
+def _compare_args(scene, reference, variants, flags):
+    """The ``strata compare`` arguments of a :func:`compare` call."""
+    flags = dict(flags)
     args = [] if scene is None else [os.fspath(scene.path if isinstance(scene, Scene) else scene)]
     args += ["--reference", os.fspath(reference)]
     # A Scene's flags hold as for render: its size is compare's --size (unless given), the rest
@@ -168,10 +183,40 @@ def compare(scene=None, *, reference, variants, **flags):
         if scene_flags:
             v = {**scene_flags, **v} if isinstance(v, dict) else shlex.join(_flag_args(scene_flags)) + " " + v
         args += ["--variant", f"{name}={_variant_flags(name, v)}"]
-    ladder = flags.pop("spp_ladder", None)
-    if ladder is not None:
-        args += ["--spp-ladder", ",".join(str(s) for s in ladder)]
-    rows = json.loads(_strata.compare(args + _flag_args(flags)))
+    for key in ("spp_ladder", "budget"):
+        value = flags.pop(key, None)
+        if isinstance(value, (list, tuple)):
+            value = ",".join(str(s) for s in value)
+        if value is not None:
+            args += ["--" + key.replace("_", "-"), str(value)]
+    return args + _flag_args(flags)
+
+
+def _literal(value):
+    """A keyword argument's value as the report's Python call shows it (arrays by shape)."""
+    if isinstance(value, np.ndarray):
+        return f"<array {list(value.shape)} {value.dtype}>"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k!r}: {_literal(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, Scene):
+        return f"strata.Scene({value.path!r}" + "".join(f", {k}={_literal(v)}" for k, v in value.flags.items()) + ")"
+    if isinstance(value, os.PathLike):
+        return repr(os.fspath(value))
+    return repr(value)
+
+
+def compare(scene=None, *, reference, variants, **flags):
+    """``strata compare``: ``variants`` maps names to render flags (a string as on the command
+    line, or a dict of keyword arguments, point arrays included); the other keywords are
+    compare's flags (``runs``, ``budget`` (one or a list: a budget ladder), ``spp_ladder``,
+    ``size``, ``threads``, ``out``, ...), with the CLI's defaults. Writes the CLI's outputs (the
+    report's "Reproduce" gives this call, then the CLI's equivalent) and returns the rows (a
+    pandas DataFrame if pandas is installed, else a list of dicts)."""
+    kwargs = {"reference": reference, "variants": variants, **flags}
+    call = "strata.compare(" + ", ".join(
+        ([] if scene is None else [_literal(scene)]) + [f"{k}={_literal(v)}" for k, v in kwargs.items()]
+    ) + ")"
+    rows = json.loads(_strata.compare(_compare_args(scene, reference, variants, flags), call))
     try:
         import pandas
     except ImportError:

@@ -28,6 +28,13 @@ pub fn default_replicas(spp: u32) -> u32 {
     (2..=DEFAULT_REPLICAS).rev().find(|&r| spp.is_multiple_of(r)).unwrap_or(1)
 }
 
+/// What `strata reference` does to its render flags: a reference is unbiased, whatever the
+/// scene's course conventions, so pixel sample 0 is jittered unless `--first-sample` says
+/// otherwise. The CLI and the Python module both call this.
+pub fn unbiased(opts: &mut RenderOptions) {
+    opts.first_sample.get_or_insert(crate::integrator::FirstSample::Jittered);
+}
+
 /// The seed of replica `r` of a reference with base seed `base`: a SplitMix64 finalizer of both,
 /// so replicas' streams are independent of each other and of `compare`'s runs (`run_seed`).
 pub fn replica_seed(base: u64, r: u32) -> u64 {
@@ -214,19 +221,26 @@ pub fn run_reference(opts: &RenderOptions, replicas: u32) -> Result<Replicated, 
         super::profile::write_text(p, &serde_json::to_string_pretty(&profile)?)?;
     }
     if let Some(p) = &opts.stats {
-        let mut j = stats_json(&rep.out);
-        j["spp"] = rep.spp().into();
-        j["seed"] = opts.seed.into();
-        j["total_render_seconds"] = rep.out.header.render_seconds.into();
-        j["total_cpu_seconds"] = rep.out.header.cpu_seconds.into();
-        j["replicas"] = rep.replicas.into();
-        j["replica_spp"] = rep.replica_spp.into();
-        j["replica_seeds"] = rep.seeds.clone().into();
-        j["variance_estimate"] = rep.variance_text().into();
-        let text = serde_json::to_string_pretty(&j)?;
+        let text = serde_json::to_string_pretty(&replicated_stats(&rep, opts.seed))?;
         film::write_atomic(p, text.as_bytes()).map_err(|source| SessionError::Output { path: p.clone(), source })?;
     }
     Ok(rep)
+}
+
+/// The `--stats` JSON of a replicated reference: a render's, with the totals over the replicas,
+/// the base seed, the replicas, their spp and seeds, and how the variance was estimated
+/// (`variance_estimate`).
+pub fn replicated_stats(rep: &Replicated, base_seed: u64) -> serde_json::Value {
+    let mut j = stats_json(&rep.out);
+    j["spp"] = rep.spp().into();
+    j["seed"] = base_seed.into();
+    j["total_render_seconds"] = rep.out.header.render_seconds.into();
+    j["total_cpu_seconds"] = rep.out.header.cpu_seconds.into();
+    j["replicas"] = rep.replicas.into();
+    j["replica_spp"] = rep.replica_spp.into();
+    j["replica_seeds"] = rep.seeds.clone().into();
+    j["variance_estimate"] = rep.variance_text().into();
+    j
 }
 
 /// The one-line summary of a replicated reference.
