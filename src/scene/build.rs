@@ -327,6 +327,14 @@ pub enum BuildError {
         /// The names the meshes have.
         have: String,
     },
+    /// A scene feature the particle tracer does not support.
+    #[error("{}: the particle tracer (`ptracer`) does not support {what}; use `path`", file.display())]
+    ParticleTracer {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// the feature
+        what: &'static str,
+    },
     /// The scene has no `camera` command (the scene file).
     #[error("{}: no camera command", .0.display())]
     NoCamera(std::path::PathBuf),
@@ -427,6 +435,9 @@ impl Scene {
     /// edges vanishes or is not finite) of either kind are dropped and counted in
     /// [`Scene::degenerate_dropped`].
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
+        if let Some(what) = super::ptracer_check::refusal(&desc) {
+            return Err(BuildError::ParticleTracer { file: desc.source.clone(), what });
+        }
         let mut camera = match (&desc.sensor, desc.camera) {
             (Some(s), _) => match desc.crop {
                 Some(c) => Camera::from_sensor(s, c.full_width, c.full_height).cropped(c, desc.width, desc.height),

@@ -23,6 +23,9 @@ pub enum IntegratorKind {
     Direct,
     /// Unidirectional path tracer.
     PathTracer,
+    /// Particle tracer: light paths from the emitters splatted onto the film (Mitsuba's
+    /// `ptracer`).
+    ParticleTracer,
 }
 
 /// `nexteventestimation off|on|mis`.
@@ -63,8 +66,22 @@ macro_rules! spelled {
 spelled!(
     IntegratorKind,
     "integrator",
-    [("raytracer", RayTracer), ("analyticdirect", AnalyticDirect), ("direct", Direct), ("pathtracer", PathTracer)]
+    [
+        ("raytracer", RayTracer),
+        ("analyticdirect", AnalyticDirect),
+        ("direct", Direct),
+        ("pathtracer", PathTracer),
+        ("ptracer", ParticleTracer)
+    ]
 );
+impl IntegratorKind {
+    /// Integrators that trace paths of several bounces with the path layouts (`max_depth`,
+    /// roulette): the path tracer and the particle tracer.
+    pub fn traces_paths(self) -> bool {
+        matches!(self, Self::PathTracer | Self::ParticleTracer)
+    }
+}
+
 spelled!(Nee, "next event estimation mode", [("off", Off), ("on", On), ("mis", Mis)]);
 spelled!(
     ImportanceSampling,

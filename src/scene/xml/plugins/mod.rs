@@ -24,6 +24,7 @@ mod plastic;
 mod ply;
 mod point;
 mod projector;
+mod ptracer;
 mod rectangle;
 mod rfilter_box;
 mod rfilter_gaussian;
@@ -101,7 +102,7 @@ pub const PLUGINS: &[Plugin] = &[
     path::PLUGIN,
     direct::PLUGIN,
     integrator_moment::PLUGIN,
-    refused("integrator", "ptracer", "needs the particle tracer of issue 29"),
+    ptracer::PLUGIN,
     obj::PLUGIN,
     ply::PLUGIN,
     serialized::PLUGIN,
