@@ -24,9 +24,10 @@
 //! sample, each splat is `alpha f cos / d^2 |p|^3 / (4 |det M|)`.
 //!
 //! Shading normals: a BSDF evaluated for light flowing from the light towards the sensor is
-//! corrected as Veach's adjoint BSDF (`|n_s . w_l| |n_g . w_o| / (|n_g . w_l| |n_s . w_o|)`);
-//! lights' geometry absorbs light paths (strata's path tracer does not shade light geometry
-//! either).
+//! corrected as Veach's adjoint BSDF (`|n_s . w_l| |n_g . w_o| / (|n_g . w_l| |n_s . w_o|)`).
+//! Lights' geometry reflects with its shape's material, as Mitsuba's area lights do (the `.test`
+//! quad lights are black). Emitters with a bitmap `radiance` (their texture at the sampled
+//! point's uv) are rendered by this integrator only.
 //!
 //! Sampler dimensions of a light path (light layout for the emitter, path layout after): the
 //! emitter choice and point (2D, the choice reusing u as `--light-choice reuse` does), the
@@ -259,7 +260,9 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
                 let es: Option<EmissionSample> = match src {
                     Source0::Area(e) => {
                         let em = &scene.emitters.list[e as usize];
+                        let tex = emitted_texture(scene, e, (u, u1[i]));
                         let es = em.sample_emission((u, u1[i]), (v0[i], v1[i]));
+                        let es = es.map(|es| EmissionSample { weight: es.weight * tex, ..es });
                         // Vertex 0: the emitter point seen by the sensor.
                         if let (Some(es), false) = (es, scene.desc.hide_emitters) {
                             if let Some((px, w)) = sensor.project(es.p) {
@@ -268,7 +271,7 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
                                 let cos = es.n.dot(to) / d2.sqrt();
                                 if cos > 0.0 && d2 > 0.0 {
                                     let (_, pdf_a) = em.sample_position((u, u1[i]));
-                                    let rgb = em.radiance * (cos / (d2 * pdf_a * pmf) * w);
+                                    let rgb = em.radiance * tex * (cos / (d2 * pdf_a * pmf) * w);
                                     conn.push((i, es.p, es.n, 0.0, px, rgb));
                                 }
                             }
@@ -297,8 +300,9 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
                 tracer.intersect(&mut rh, RayKind::Bounce, active)
             };
             scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(&rh, traced), &mut sh);
-            let is_light = F8::from_bits(!sh.light.simd_eq(U8::splat(u32::MAX)));
-            let shade = sh.valid & !is_light;
+            // Lights' geometry reflects with its material too (Mitsuba's area lights; black for
+            // the `.test` quad lights, which end the path).
+            let shade = sh.valid;
             let shade_b = mask_to_bools(shade);
             for i in 0..8 {
                 if !shade_b[i] {
@@ -406,6 +410,16 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
             k += 1;
         }
     }
+}
+
+/// The radiance texture of emitter `e` at the point placed by the unit-square sample `u` (as
+/// `Emitter::point` places it: a triangle folds `u + v > 1`), or 1 for an untextured emitter.
+fn emitted_texture(scene: &Scene, e: u32, u: (f32, f32)) -> Vec3 {
+    let Some(Some((image, uv))) = scene.emitter_textures.get(e as usize) else { return Vec3::ONE };
+    let Some(im) = scene.desc.emission_images.get(*image as usize) else { return Vec3::ONE };
+    let (a, b) = if u.0 + u.1 > 1.0 { (1.0 - u.0, 1.0 - u.1) } else { u };
+    let t = uv[0] * (1.0 - a - b) + uv[1] * a + uv[2] * b;
+    im.eval(t.x, t.y)
 }
 
 /// [`Scene::offset_eps`] at one point.

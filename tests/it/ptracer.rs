@@ -30,6 +30,7 @@ const SCENE: &str = r#"<scene version="3.0.0">
     </shape>
     <shape type="rectangle">
         <transform name="to_world"><scale value="0.5"/><rotate x="1" angle="90"/><translate y="3" x="1"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
         <emitter type="area"><rgb name="radiance" value="10, 8, 6"/></emitter>
     </shape>
     <emitter type="point">

@@ -8,7 +8,7 @@ use crate::scene::desc::{EmissiveTriangleDesc, SceneDesc, SphereDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
 use crate::scene::mesh::{Mesh, MeshError};
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 
 /// A shape's geometry.
 pub enum ShapeOut {
@@ -47,7 +47,7 @@ pub fn place(
     limits: &Limits,
     out: ShapeOut,
     material: u32,
-    emitter: Option<(Vec3, Loc)>,
+    emitter: Option<(super::plugins::AreaEmission, Loc)>,
     at: &Loc,
 ) -> Result<(), SceneError> {
     match out {
@@ -71,11 +71,27 @@ pub fn place(
                 None => {
                     desc.add_mesh(&mesh, material);
                 }
-                Some((radiance, _)) => {
+                Some((em, eat)) => {
+                    let radiance = em.radiance;
+                    let image = match em.texture {
+                        Some(_) if mesh.uvs.is_empty() => {
+                            return Err(eat.err("a textured area emitter needs a shape with uvs"));
+                        }
+                        Some(t) => {
+                            desc.emission_images.push(t);
+                            Some(desc.emission_images.len() as u32 - 1)
+                        }
+                        None => None,
+                    };
                     for f in &mesh.indices {
                         let v = f.map(|i| mesh.positions[i as usize]);
                         desc.emissive_materials.resize(desc.emissive_triangles.len(), u32::MAX);
                         desc.emissive_materials.push(material);
+                        if let Some(i) = image {
+                            let no = (u32::MAX, [glam::Vec2::ZERO; 3]);
+                            desc.emissive_textures.resize(desc.emissive_triangles.len(), no);
+                            desc.emissive_textures.push((i, f.map(|k| mesh.uvs[k as usize])));
+                        }
                         desc.emissive_triangles.push(EmissiveTriangleDesc { v, radiance });
                     }
                 }

@@ -66,7 +66,7 @@ pub enum Run {
     /// a texture (of a material's reflectance)
     Texture(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<crate::texture::Texture, SceneError>),
     /// an area emitter's radiance
-    Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Vec3, SceneError>),
+    Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<AreaEmission, SceneError>),
     /// known to Mitsuba, not rendered yet: the missing feature
     Refused(&'static str),
 }
@@ -161,7 +161,16 @@ pub fn lookup(e: &Elem) -> Result<&'static Plugin, SceneError> {
 }
 
 /// A shape's geometry, its material index and its area emitter (radiance, where declared).
-pub type ShapeParts = (ShapeOut, u32, Option<(Vec3, Loc)>);
+pub type ShapeParts = (ShapeOut, u32, Option<(AreaEmission, Loc)>);
+
+/// What an area emitter emits: `radiance`, times `texture` at the shape's uvs where it has one.
+#[derive(Clone, Debug)]
+pub struct AreaEmission {
+    /// the radiance (a bitmap radiance: 1, the image carries it)
+    pub radiance: Vec3,
+    /// the bitmap `radiance`, if any
+    pub texture: Option<std::sync::Arc<crate::scene::desc::RgbImage>>,
+}
 
 /// The state of one scene's conversion: the scene being filled, warnings, the ids.
 pub struct Build<'e> {
@@ -272,7 +281,7 @@ impl<'e> Build<'e> {
     }
 
     /// The radiance of an `<emitter>` nested in a shape.
-    pub fn area(&mut self, e: &'e Elem) -> Result<Vec3, SceneError> {
+    pub fn area(&mut self, e: &'e Elem) -> Result<AreaEmission, SceneError> {
         let p = lookup(e)?;
         let props = Props::new(e, self.ids)?;
         let r = match p.run {
