@@ -210,22 +210,31 @@ fn render_light(
         let t0 = Instant::now();
         let blocks: Vec<(u32, u32, u32)> =
             part.clone().flat_map(|s| tiles.iter().map(move |&(tx, ty)| (s, tx, ty))).collect();
-        let traced: Vec<(Vec<crate::integrator::Splat>, Counters, f64)> = pool.install(|| {
+        type Traced = (Vec<crate::integrator::Splat>, Counters, f64, [u64; crate::profile::N_PHASES], u64);
+        let traced: Vec<Traced> = pool.install(|| {
             blocks
                 .par_iter()
                 .map(|&(s, tx, ty)| {
                     let c0 = cpu_time::ThreadTime::now();
+                    let w0 = crate::profile::enabled().then(Instant::now);
+                    crate::profile::tile_begin();
                     let (x0, y0) = (tx * TILE, ty * TILE);
                     let pks = tile_packets(x0, y0, TILE.min(w - x0), TILE.min(h - y0), w, h);
                     let (mut splats, mut counters) = (Vec::new(), Counters::default());
                     integrator.splat_tile(scene, &paths, &pks, s, &mut splats, &mut counters);
-                    (splats, counters, c0.elapsed().as_secs_f64())
+                    let phases = crate::profile::tile_end();
+                    let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
+                    (splats, counters, c0.elapsed().as_secs_f64(), phases, wall)
                 })
                 .collect()
         });
         let mut images =
             SplatImages { start: part.start, width: w, data: vec![vec![[0.0; 3]; pixels as usize]; part.len()] };
-        for (&(s, _, _), (splats, c, busy)) in blocks.iter().zip(&traced) {
+        for (&(s, _, _), (splats, c, busy, phases, wall)) in blocks.iter().zip(&traced) {
+            for (a, b) in stats.phase_ns.iter_mut().zip(phases) {
+                *a += b;
+            }
+            stats.profiled_ns += wall;
             let im = &mut images.data[(s - part.start) as usize];
             for sp in splats {
                 let px = &mut im[sp.pixel as usize];

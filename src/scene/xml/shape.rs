@@ -8,7 +8,7 @@ use crate::scene::desc::{EmissiveTriangleDesc, SceneDesc, SphereDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
 use crate::scene::mesh::{Mesh, MeshError};
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 
 /// A shape's geometry.
 pub enum ShapeOut {
@@ -39,6 +39,15 @@ pub fn load_error(p: &Props, e: MeshError) -> SceneError {
     p.elem.at.err(format!("{}: {e}", p.elem.what()))
 }
 
+/// What an area emitter emits: `radiance`, times `texture` at the shape's uvs where it has one.
+#[derive(Clone, Debug)]
+pub struct AreaEmission {
+    /// the radiance (a bitmap radiance: 1, the image carries it)
+    pub radiance: Vec3,
+    /// the bitmap `radiance`, if any
+    pub texture: Option<std::sync::Arc<crate::scene::desc::RgbImage>>,
+}
+
 /// Places a shape into `desc` (within `limits`): its triangles with `material` (a material
 /// index), or emissive triangles (that also reflect with `material`) when it carries an area
 /// emitter of `radiance`; a sphere as an ellipsoid.
@@ -47,7 +56,7 @@ pub fn place(
     limits: &Limits,
     out: ShapeOut,
     material: u32,
-    emitter: Option<(super::plugins::AreaEmission, Loc)>,
+    emitter: Option<(AreaEmission, Loc)>,
     at: &Loc,
 ) -> Result<(), SceneError> {
     match out {

@@ -160,17 +160,10 @@ pub fn lookup(e: &Elem) -> Result<&'static Plugin, SceneError> {
     Err(e.at.err(format!("unknown {} type \"{kind}\" (supported: {})", e.tag, known.join(", "))))
 }
 
+pub use super::shape::AreaEmission;
+
 /// A shape's geometry, its material index and its area emitter (radiance, where declared).
 pub type ShapeParts = (ShapeOut, u32, Option<(AreaEmission, Loc)>);
-
-/// What an area emitter emits: `radiance`, times `texture` at the shape's uvs where it has one.
-#[derive(Clone, Debug)]
-pub struct AreaEmission {
-    /// the radiance (a bitmap radiance: 1, the image carries it)
-    pub radiance: Vec3,
-    /// the bitmap `radiance`, if any
-    pub texture: Option<std::sync::Arc<crate::scene::desc::RgbImage>>,
-}
 
 /// The state of one scene's conversion: the scene being filled, warnings, the ids.
 pub struct Build<'e> {
