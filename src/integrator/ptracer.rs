@@ -304,10 +304,8 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
             // the `.test` quad lights, which end the path).
             let shade = sh.valid;
             let shade_b = mask_to_bools(shade);
-            for i in 0..8 {
-                if !shade_b[i] {
-                    st.alive[i] = false;
-                }
+            for (a, &hit) in st.alive.iter_mut().zip(&shade_b) {
+                *a &= hit;
             }
             if shade.none() {
                 break;
