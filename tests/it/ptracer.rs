@@ -159,3 +159,18 @@ fn what_it_cannot_render_is_refused_by_name() {
     let e = strata::session::render_to_film(&o).err().expect("gaussian").to_string();
     assert!(e.contains("particle tracer") && e.contains("box"), "{e}");
 }
+
+/// Area emitters with a bitmap `radiance` (Mitsuba's various_emitters scene) are the particle
+/// tracer's; the other integrators refuse them by name rather than render them untextured.
+#[test]
+fn textured_area_emitters_are_the_particle_tracers_only() {
+    let scene =
+        strata::lab::mitsuba::corpus_dir().join("tests/scenes/various_emitters/test_various_emitters_ptracer.xml");
+    assert!(scene.is_file(), "{}: the Mitsuba corpus is missing (it comes with ../shared)", scene.display());
+    let o = RenderOptions { size: Some((32, 4)), ..opts(&scene, "path", 1, 0, 1) };
+    let e = strata::session::render_to_film(&o).err().expect("path on a textured emitter").to_string();
+    assert!(e.contains("textured area emitter") && e.contains("ptracer"), "{e}");
+    let o = RenderOptions { size: Some((32, 4)), ..opts(&scene, "ptracer", 1, 0, 1) };
+    let out = strata::session::render_to_film(&o).unwrap();
+    assert!(out.film.mean().iter().any(|p| p[0] > 0.0));
+}
