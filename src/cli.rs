@@ -379,7 +379,7 @@ pub(crate) struct RenderArgs {
     /// behind the camera, or under the ceiling when the camera is inside; announced on stderr).
     #[arg(long, help_heading = LIGHTS)]
     pub(crate) no_default_light: bool,
-    /// Integrator override: raytracer, analyticdirect, direct, pathtracer.
+    /// Integrator override: raytracer, analyticdirect, direct, pathtracer, ptracer.
     #[arg(long, help_heading = INTEGRATOR, value_parser = parse_integrator)]
     pub(crate) integrator: Option<IntegratorKind>,
     /// Path tracer direction sampling: hemisphere, cosine, brdf (default: the scene's importancesampling).
@@ -610,7 +610,8 @@ pub(crate) fn parse_sampler(s: &str) -> Result<SamplerKind, ValueError> {
 }
 
 pub(crate) fn parse_integrator(s: &str) -> Result<IntegratorKind, ValueError> {
-    IntegratorKind::parse(s).ok_or_else(|| unknown("integrator", s, "raytracer, analyticdirect, direct, pathtracer"))
+    IntegratorKind::parse(s)
+        .ok_or_else(|| unknown("integrator", s, "raytracer, analyticdirect, direct, pathtracer, ptracer"))
 }
 
 pub(crate) fn parse_nee(s: &str) -> Result<Nee, ValueError> {

@@ -98,6 +98,24 @@ pub fn render_counted(
         have.is_empty() || have.end == samples.start,
         "render: samples {samples:?} do not continue the film's {have:?}"
     );
+    if integrator.kind == crate::scene::desc::IntegratorKind::ParticleTracer {
+        return render_light(scene, integrator, film, samples, pool, tiles_done);
+    }
+    render_source(scene, integrator, film, samples, pool, tiles_done, None)
+}
+
+/// [`render_counted`] with the pixel samples taken from `images` (the particle tracer's splat
+/// images, one per sample of `samples`) instead of the integrator's tiles.
+pub(crate) fn render_source(
+    scene: &Scene,
+    integrator: &Integrator,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+    pool: &rayon::ThreadPool,
+    tiles_done: &AtomicU64,
+    images: Option<&SplatImages>,
+) -> RenderStats {
+    let have = film.samples();
     let (w, h) = (film.width, film.height);
     let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
     if samples.is_empty() {
@@ -123,7 +141,7 @@ pub fn render_counted(
                     let _f = crate::profile::scope(crate::profile::Phase::Film);
                     TileResult::from_film(film_in, tx * TILE, ty * TILE)
                 };
-                render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters);
+                render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters, images);
                 crate::sampler::replay::tile_end();
                 let phases = crate::profile::tile_end();
                 let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
@@ -161,6 +179,106 @@ pub fn render_counted(
         stats.profiled_ns += ns;
     }
     stats
+}
+
+/// Bytes of splat images the particle tracer holds at once (a pass with more samples is cut
+/// into chunks of samples).
+const SPLAT_IMAGE_BYTES: u64 = 256 << 20;
+
+/// The particle tracer's pass (see `integrator/ptracer.rs`): for every sample, each tile's light
+/// paths traced as one block (in parallel), their splats summed into the sample's image in block
+/// order, then the images accumulated as the pixels' samples. Bit-identical whatever the thread
+/// count, and whatever the split of samples into passes.
+fn render_light(
+    scene: &Scene,
+    integrator: &Integrator,
+    film: &mut Film,
+    samples: std::ops::Range<u32>,
+    pool: &rayon::ThreadPool,
+    tiles_done: &AtomicU64,
+) -> RenderStats {
+    let (w, h) = (film.width, film.height);
+    let pixels = u64::from(w) * u64::from(h);
+    let chunk = (SPLAT_IMAGE_BYTES / (pixels * 12).max(1)).clamp(1, u64::from(u32::MAX)) as u32;
+    let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
+    let paths = crate::integrator::LightPaths::new(scene);
+    let tiles_x = w.div_ceil(TILE);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let mut start = samples.start;
+    while start < samples.end {
+        let part = start..samples.end.min(start.saturating_add(chunk));
+        let t0 = Instant::now();
+        let blocks: Vec<(u32, u32, u32)> =
+            part.clone().flat_map(|s| tiles.iter().map(move |&(tx, ty)| (s, tx, ty))).collect();
+        type Traced = (Vec<crate::integrator::Splat>, Counters, f64, [u64; crate::profile::N_PHASES], u64);
+        let traced: Vec<Traced> = pool.install(|| {
+            blocks
+                .par_iter()
+                .map(|&(s, tx, ty)| {
+                    let c0 = cpu_time::ThreadTime::now();
+                    let w0 = crate::profile::enabled().then(Instant::now);
+                    crate::profile::tile_begin();
+                    let (x0, y0) = (tx * TILE, ty * TILE);
+                    let pks = tile_packets(x0, y0, TILE.min(w - x0), TILE.min(h - y0), w, h);
+                    let (mut splats, mut counters) = (Vec::new(), Counters::default());
+                    integrator.splat_tile(scene, &paths, &pks, s, &mut splats, &mut counters);
+                    let phases = crate::profile::tile_end();
+                    let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
+                    (splats, counters, c0.elapsed().as_secs_f64(), phases, wall)
+                })
+                .collect()
+        });
+        let mut images =
+            SplatImages { start: part.start, width: w, data: vec![vec![[0.0; 3]; pixels as usize]; part.len()] };
+        for (&(s, _, _), (splats, c, busy, phases, wall)) in blocks.iter().zip(&traced) {
+            for (a, b) in stats.phase_ns.iter_mut().zip(phases) {
+                *a += b;
+            }
+            stats.profiled_ns += wall;
+            let im = &mut images.data[(s - part.start) as usize];
+            for sp in splats {
+                let px = &mut im[sp.pixel as usize];
+                for (a, b) in px.iter_mut().zip(sp.rgb) {
+                    *a += b;
+                }
+            }
+            stats.counters.merge(c);
+            stats.cpu_seconds += busy;
+        }
+        let traced_secs = t0.elapsed().as_secs_f64();
+        let st = render_source(scene, integrator, film, part.clone(), pool, tiles_done, Some(&images));
+        stats.merge(&st);
+        stats.seconds += traced_secs;
+        start = part.end;
+    }
+    stats
+}
+
+/// The particle tracer's images of samples `start..start + data.len()`: `data[s - start][pixel]`.
+pub(crate) struct SplatImages {
+    start: u32,
+    width: u32,
+    data: Vec<Vec<[f32; 3]>>,
+}
+
+impl SplatImages {
+    /// The samples `batch` of the packets `pks`, sample-major as `Integrator::radiance_tile`
+    /// writes them (lanes outside the image zero).
+    fn fill(&self, pks: &[PixelPacket], batch: std::ops::Range<u32>, out: &mut Vec<Vec3x8>) {
+        let _ = self.width;
+        out.clear();
+        for s in batch {
+            let im = &self.data[(s - self.start) as usize];
+            for pk in pks {
+                let (pix, on) = (pk.pixel.to_array(), crate::simd::mask_to_bools(pk.active));
+                let lanes: [glam::Vec3; 8] =
+                    std::array::from_fn(
+                        |i| if on[i] { glam::Vec3::from(im[pix[i] as usize]) } else { glam::Vec3::ZERO },
+                    );
+                out.push(Vec3x8::from_lanes(lanes));
+            }
+        }
+    }
 }
 
 /// Accumulated samples of one tile: the film's dyadic blocks continued (moments level-major,
@@ -212,6 +330,7 @@ fn render_tile(
     samples: std::ops::Range<u32>,
     scratch: &mut Scratch,
     counters: &mut Counters,
+    images: Option<&SplatImages>,
 ) {
     let (x0, y0, tw, th) = (tile.x0, tile.y0, tile.tw, tile.th);
     let (w, h) = (scene.desc.width, scene.desc.height);
@@ -225,7 +344,10 @@ fn render_tile(
         // A batch of samples is one wavefront (full packets for the path tracer); samples are
         // still accumulated in increasing order.
         let batch = start..samples.end.min(start + SAMPLE_BATCH);
-        integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None);
+        match images {
+            None => integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None),
+            Some(im) => im.fill(&packets, batch.clone(), &mut radiance),
+        }
         let _acc = crate::profile::scope(crate::profile::Phase::Accumulate);
         // The block structure is the same for every pixel: one binary-counter step per sample.
         let depth = tile.blocks.len();

@@ -30,6 +30,7 @@ pub mod estimator;
 pub mod kernel;
 pub mod path;
 mod primary;
+pub mod ptracer;
 pub mod samples;
 pub mod settings;
 pub mod stats;
@@ -42,6 +43,7 @@ pub use context::{TileCtx, Tracer};
 pub use direct::DIM_LIGHT_BASE;
 pub use estimator::Estimator;
 pub use path::{PathScratch, DIM_PATH_BASE};
+pub use ptracer::{LightPaths, Splat};
 pub use samples::{Dim, Samples, Source};
 pub use settings::{progressive_names, Integrator, NotProgressive, SamplerChoice};
 pub use stats::{Counters, RayKind, RayLog};
@@ -86,6 +88,7 @@ pub static INTEGRATORS: &[Entry] = &[
     entry::<analytic::Analytic>(),
     entry::<direct::Direct>(),
     entry::<path::PathTracer>(),
+    entry::<ptracer::ParticleTracer>(),
 ];
 
 /// The registry position of `kind` (every kind is registered: tested).

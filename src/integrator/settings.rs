@@ -195,7 +195,7 @@ impl Sets {
     /// samples per pixel sample.
     fn resolve(d: &crate::scene::desc::SceneDesc, samplers: SamplerChoice, spp: u32, n_light: u32) -> Self {
         let base = samplers.sampler.unwrap_or(SamplerKind::STRATIFIED);
-        let light_default = if d.integrator == IntegratorKind::PathTracer || d.light_stratify {
+        let light_default = if d.integrator.traces_paths() || d.light_stratify {
             base
         } else {
             samplers.sampler.unwrap_or(SamplerKind::INDEPENDENT)
@@ -209,7 +209,7 @@ impl Sets {
     fn build(kind: IntegratorKind, [pixel, light, path]: [SamplerKind; 3], spp: u32, n_light: u32, width: u32) -> Self {
         // The light table spans all of a pixel's light samples: spp x N for `direct`, spp for
         // the path tracer (one light sample per vertex).
-        let per_pixel = if kind == IntegratorKind::PathTracer { spp } else { spp.saturating_mul(n_light) };
+        let per_pixel = if kind.traces_paths() { spp } else { spp.saturating_mul(n_light) };
         Self {
             pixel: PointSet::for_image(pixel, spp, width),
             light: PointSet::for_image(light, n_light, width),

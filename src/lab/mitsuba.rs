@@ -57,7 +57,7 @@ pub const CORPUS: &[(&str, Expect)] = &[
     ("projector/test_projector_textured_direct.xml", Expect::Pass),
     ("spot_light/test_spot_direct.xml", Expect::Pass),
     ("texture_interp/test_texture_interp_direct.xml", Expect::Pass),
-    ("various_emitters/test_various_emitters_ptracer.xml", Expect::Refused("particle tracer")),
+    ("various_emitters/test_various_emitters_ptracer.xml", Expect::Pass),
     (
         "various_shapes/test_various_shapes_path.xml",
         Expect::Fails("98.3 % of pixel channels accepted at 8 spp: a difference not found yet (suspects: the back faces of mirrored shapes, which strata's diffuse shades and Mitsuba's does not; the sdfgrid mesh)"),

@@ -261,6 +261,9 @@ impl DeltaLight {
     }
 }
 
+#[path = "delta_emission.rs"]
+mod emission;
+
 #[cfg(test)]
 #[path = "delta_tests.rs"]
 mod tests;

@@ -3,6 +3,7 @@
 //! ([`envmap`]) and Mitsuba's delta lights ([`delta`]: point, directional, spot, projector).
 pub mod delta;
 pub mod desc;
+pub mod emission;
 pub mod emitters;
 pub mod envmap;
 pub mod polygonal;

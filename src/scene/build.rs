@@ -225,6 +225,10 @@ pub struct Scene {
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
+    /// per emitter (index into `emitters.list`; the table may be shorter): its radiance texture,
+    /// the image (index into `desc.emission_images`) and corner uvs; empty without textured
+    /// emitters (the particle tracer's only)
+    pub emitter_textures: Vec<Option<(u32, [glam::Vec2; 3])>>,
     /// the constant environment light (`--sky`, Mitsuba's `constant`), if any
     pub sky: Option<crate::light::sky::Sky>,
     /// the image environment light (Mitsuba's `envmap`), if any
@@ -327,6 +331,22 @@ pub enum BuildError {
         /// The names the meshes have.
         have: String,
     },
+    /// A scene feature the particle tracer does not support.
+    #[error("{}: the particle tracer (`ptracer`) does not support {what}; use `path`", file.display())]
+    ParticleTracer {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// the feature
+        what: &'static str,
+    },
+    /// An area emitter with a bitmap `radiance` under an integrator other than `ptracer`.
+    #[error("{}: a textured area emitter is rendered by the particle tracer (`ptracer`) only, not by `{integrator}`", file.display())]
+    TexturedEmitter {
+        /// the scene file
+        file: std::path::PathBuf,
+        /// the integrator asked for
+        integrator: &'static str,
+    },
     /// The scene has no `camera` command (the scene file).
     #[error("{}: no camera command", .0.display())]
     NoCamera(std::path::PathBuf),
@@ -427,6 +447,13 @@ impl Scene {
     /// edges vanishes or is not finite) of either kind are dropped and counted in
     /// [`Scene::degenerate_dropped`].
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
+        if let Some(what) = super::ptracer_check::refusal(&desc) {
+            return Err(BuildError::ParticleTracer { file: desc.source.clone(), what });
+        }
+        let textured = desc.emissive_textures.iter().any(|t| t.0 != u32::MAX);
+        if textured && desc.integrator != crate::scene::desc::IntegratorKind::ParticleTracer {
+            return Err(BuildError::TexturedEmitter { file: desc.source.clone(), integrator: desc.integrator.name() });
+        }
         let mut camera = match (&desc.sensor, desc.camera) {
             (Some(s), _) => match desc.crop {
                 Some(c) => Camera::from_sensor(s, c.full_width, c.full_height).cropped(c, desc.width, desc.height),
@@ -483,6 +510,7 @@ impl Scene {
             lights.push(light);
         }
         let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
+        let mut emitter_textures = Vec::new();
         for (k, t) in desc.emissive_triangles.iter().enumerate() {
             let e = Emitter::triangle(t.v, t.radiance);
             if !(e.area > 0.0 && e.area.is_finite()) || is_degenerate(&t.v) {
@@ -497,6 +525,10 @@ impl Scene {
             let reflects = desc.emissive_materials.get(k).copied().filter(|&m| (m as usize) < materials.len());
             tri_material.push(reflects.unwrap_or(black));
             tri_light.push((lights.len() + tri_emitters.len()) as u32);
+            if textured {
+                emitter_textures.resize(lights.len() + tri_emitters.len(), None);
+                emitter_textures.push(desc.emissive_textures.get(k).copied().filter(|t| t.0 != u32::MAX));
+            }
             tri_emitters.push(e);
         }
         let emitters = Emitters::new(lights.iter().copied(), tri_emitters);
@@ -603,6 +635,7 @@ impl Scene {
             camera,
             lights,
             emitters,
+            emitter_textures,
             sky,
             envmap,
             delta,

@@ -23,6 +23,9 @@ pub enum IntegratorKind {
     Direct,
     /// Unidirectional path tracer.
     PathTracer,
+    /// Particle tracer: light paths from the emitters splatted onto the film (Mitsuba's
+    /// `ptracer`).
+    ParticleTracer,
 }
 
 /// `nexteventestimation off|on|mis`.
@@ -63,8 +66,22 @@ macro_rules! spelled {
 spelled!(
     IntegratorKind,
     "integrator",
-    [("raytracer", RayTracer), ("analyticdirect", AnalyticDirect), ("direct", Direct), ("pathtracer", PathTracer)]
+    [
+        ("raytracer", RayTracer),
+        ("analyticdirect", AnalyticDirect),
+        ("direct", Direct),
+        ("pathtracer", PathTracer),
+        ("ptracer", ParticleTracer)
+    ]
 );
+impl IntegratorKind {
+    /// Integrators that trace paths of several bounces with the path layouts (`max_depth`,
+    /// roulette): the path tracer and the particle tracer.
+    pub fn traces_paths(self) -> bool {
+        matches!(self, Self::PathTracer | Self::ParticleTracer)
+    }
+}
+
 spelled!(Nee, "next event estimation mode", [("off", Off), ("on", On), ("mis", Mis)]);
 spelled!(
     ImportanceSampling,
@@ -255,6 +272,13 @@ pub struct SceneDesc {
     /// index; `u32::MAX` or a missing entry (the table may be shorter, and is empty for `.test`
     /// and OBJ scenes): black, emitting only
     pub emissive_materials: Vec<u32>,
+    /// the texture of each emissive triangle's radiance (a Mitsuba area emitter with a bitmap
+    /// `radiance`), by index: the image (index into `emission_images`) and the triangle's corner
+    /// uvs; `u32::MAX` or a missing entry: untextured. Only the particle tracer renders them
+    /// (`Scene::build` refuses them for the other integrators)
+    pub emissive_textures: Vec<(u32, [glam::Vec2; 3])>,
+    /// the images of textured area emitters (linear RGB, Mitsuba's bitmap addressing)
+    pub emission_images: Vec<std::sync::Arc<RgbImage>>,
     /// the scene's sampler (a Mitsuba `<sampler>`); None: the session's default. `--sampler`
     /// overrides it
     pub sampler: Option<crate::sampler::SamplerKind>,
@@ -378,6 +402,18 @@ impl SceneDesc {
             h.word(0x656d_6d00);
             self.emissive_materials.iter().for_each(|&m| h.word(m));
         }
+        if !self.emissive_textures.is_empty() {
+            h.word(0x656d_7400);
+            for (i, uv) in &self.emissive_textures {
+                h.word(*i);
+                uv.iter().for_each(|c| h.vec3(c.extend(0.0)));
+            }
+            for im in &self.emission_images {
+                h.word(im.width);
+                h.word(im.height);
+                im.texels.iter().for_each(|&t| h.vec3(t));
+            }
+        }
         if let Some(s) = self.sampler {
             h.word(0x736d_7000);
             let _ = std::fmt::Write::write_str(&mut h, s.name());
@@ -446,6 +482,8 @@ impl Default for SceneDesc {
             filter: PixelFilter::Box,
             delta_lights: Vec::new(),
             emissive_materials: Vec::new(),
+            emissive_textures: Vec::new(),
+            emission_images: Vec::new(),
             sampler: None,
         }
     }

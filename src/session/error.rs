@@ -59,6 +59,12 @@ pub enum SessionError {
         /// the integrator's name
         integrator: &'static str,
     },
+    /// `strata rays` with an integrator whose rays it cannot log (the particle tracer).
+    #[error("strata rays: the {integrator} integrator's light paths are not logged for the replay; measure another integrator")]
+    RaysNotLogged {
+        /// the integrator's name
+        integrator: &'static str,
+    },
     #[error("--max-depth {depth} is outside -1..={max} ({hint})")]
     MaxDepth {
         /// depth asked

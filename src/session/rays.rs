@@ -7,6 +7,10 @@ use crate::measure::{self, RayRates};
 /// rates and the scene's name.
 pub fn run_rays(opts: &RenderOptions) -> Result<(RayRates, String), SessionError> {
     let (scene, integrator) = prepare(opts)?;
+    if integrator.kind == crate::scene::desc::IntegratorKind::ParticleTracer {
+        // Its light paths are traced outside the per-tile calls `strata rays` logs and replays.
+        return Err(SessionError::RaysNotLogged { integrator: integrator.kind.name() });
+    }
     let rates = measure::ray_rates(&scene, &integrator, integrator.spp);
     Ok((rates, scene.desc.source.display().to_string()))
 }

@@ -89,7 +89,12 @@ pub fn load_scene(opts: &RenderOptions) -> Result<SceneDesc, SessionError> {
     }
     use crate::scene::desc::IntegratorKind;
     let outside = desc.environment.is_some() || !desc.delta_lights.is_empty();
-    if outside && !matches!(desc.integrator, IntegratorKind::PathTracer | IntegratorKind::Direct) {
+    if outside
+        && !matches!(
+            desc.integrator,
+            IntegratorKind::PathTracer | IntegratorKind::Direct | IntegratorKind::ParticleTracer
+        )
+    {
         return Err(SessionError::SkyNeedsPathTracer { integrator: desc.integrator.name() });
     }
     Ok(desc)

@@ -26,6 +26,7 @@ mod obj_wild;
 mod path_tracing;
 mod pointset_files;
 mod profile;
+mod ptracer;
 mod report_html;
 mod sky;
 mod stability;

@@ -39,6 +39,15 @@ pub fn load_error(p: &Props, e: MeshError) -> SceneError {
     p.elem.at.err(format!("{}: {e}", p.elem.what()))
 }
 
+/// What an area emitter emits: `radiance`, times `texture` at the shape's uvs where it has one.
+#[derive(Clone, Debug)]
+pub struct AreaEmission {
+    /// the radiance (a bitmap radiance: 1, the image carries it)
+    pub radiance: Vec3,
+    /// the bitmap `radiance`, if any
+    pub texture: Option<std::sync::Arc<crate::scene::desc::RgbImage>>,
+}
+
 /// Places a shape into `desc` (within `limits`): its triangles with `material` (a material
 /// index), or emissive triangles (that also reflect with `material`) when it carries an area
 /// emitter of `radiance`; a sphere as an ellipsoid.
@@ -47,7 +56,7 @@ pub fn place(
     limits: &Limits,
     out: ShapeOut,
     material: u32,
-    emitter: Option<(Vec3, Loc)>,
+    emitter: Option<(AreaEmission, Loc)>,
     at: &Loc,
 ) -> Result<(), SceneError> {
     match out {
@@ -71,11 +80,27 @@ pub fn place(
                 None => {
                     desc.add_mesh(&mesh, material);
                 }
-                Some((radiance, _)) => {
+                Some((em, eat)) => {
+                    let radiance = em.radiance;
+                    let image = match em.texture {
+                        Some(_) if mesh.uvs.is_empty() => {
+                            return Err(eat.err("a textured area emitter needs a shape with uvs"));
+                        }
+                        Some(t) => {
+                            desc.emission_images.push(t);
+                            Some(desc.emission_images.len() as u32 - 1)
+                        }
+                        None => None,
+                    };
                     for f in &mesh.indices {
                         let v = f.map(|i| mesh.positions[i as usize]);
                         desc.emissive_materials.resize(desc.emissive_triangles.len(), u32::MAX);
                         desc.emissive_materials.push(material);
+                        if let Some(i) = image {
+                            let no = (u32::MAX, [glam::Vec2::ZERO; 3]);
+                            desc.emissive_textures.resize(desc.emissive_triangles.len(), no);
+                            desc.emissive_textures.push((i, f.map(|k| mesh.uvs[k as usize])));
+                        }
                         desc.emissive_triangles.push(EmissiveTriangleDesc { v, radiance });
                     }
                 }

@@ -24,6 +24,7 @@ mod plastic;
 mod ply;
 mod point;
 mod projector;
+mod ptracer;
 mod rectangle;
 mod rfilter_box;
 mod rfilter_gaussian;
@@ -65,7 +66,7 @@ pub enum Run {
     /// a texture (of a material's reflectance)
     Texture(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<crate::texture::Texture, SceneError>),
     /// an area emitter's radiance
-    Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<Vec3, SceneError>),
+    Area(for<'e> fn(&mut Build<'e>, &Props<'e>) -> Result<AreaEmission, SceneError>),
     /// known to Mitsuba, not rendered yet: the missing feature
     Refused(&'static str),
 }
@@ -101,7 +102,7 @@ pub const PLUGINS: &[Plugin] = &[
     path::PLUGIN,
     direct::PLUGIN,
     integrator_moment::PLUGIN,
-    refused("integrator", "ptracer", "needs the particle tracer of issue 29"),
+    ptracer::PLUGIN,
     obj::PLUGIN,
     ply::PLUGIN,
     serialized::PLUGIN,
@@ -159,8 +160,10 @@ pub fn lookup(e: &Elem) -> Result<&'static Plugin, SceneError> {
     Err(e.at.err(format!("unknown {} type \"{kind}\" (supported: {})", e.tag, known.join(", "))))
 }
 
+pub use super::shape::AreaEmission;
+
 /// A shape's geometry, its material index and its area emitter (radiance, where declared).
-pub type ShapeParts = (ShapeOut, u32, Option<(Vec3, Loc)>);
+pub type ShapeParts = (ShapeOut, u32, Option<(AreaEmission, Loc)>);
 
 /// The state of one scene's conversion: the scene being filled, warnings, the ids.
 pub struct Build<'e> {
@@ -271,7 +274,7 @@ impl<'e> Build<'e> {
     }
 
     /// The radiance of an `<emitter>` nested in a shape.
-    pub fn area(&mut self, e: &'e Elem) -> Result<Vec3, SceneError> {
+    pub fn area(&mut self, e: &'e Elem) -> Result<AreaEmission, SceneError> {
         let p = lookup(e)?;
         let props = Props::new(e, self.ids)?;
         let r = match p.run {
