@@ -56,8 +56,9 @@ pub(crate) enum Cmd {
     /// (--spp-ladder) or equal time (--budget); writes rows.csv/json, runs.csv/json (one row per
     /// run), table.md, error.svg and report.html (flip-book, error maps, plots). The reference must
     /// be of the same scene, size and camera. Variants default to --first-sample jittered.
-    /// Seconds are the worker threads' CPU seconds; the sampler's ns/sample and share of the render
-    /// come from the phase profiler, which every run has on.
+    /// Seconds are the worker threads' CPU seconds of runs timed with the profiler off; the
+    /// sampler's ns/sample and share of the render come from one separate profiled render per
+    /// variant and step (a quarter of the spp its runs reached), whose time is in no row.
     #[command(allow_negative_numbers = true)]
     Compare {
         /// Scene file (.test); omitted: the built-in Cornell box.
@@ -101,8 +102,10 @@ pub(crate) enum Cmd {
         /// Also write the rows (as OUT/rows.json) to this file.
         #[arg(long, value_name = "FILE")]
         json: Option<PathBuf>,
-        /// Write each variant's phase profile over all its runs (the keys of `strata profile
-        /// --json`, plus `variant`) as a JSON list to this file.
+        /// Write each variant's phase profile over its profiled renders, one per step (the keys of
+        /// `strata profile --json`, plus `variant`; `overhead` is the profiler's cost against the
+        /// unprofiled runs, `overhead_share` the runs' CPU share outside samples) as a JSON list to
+        /// this file.
         #[arg(long, value_name = "FILE")]
         profile: Option<PathBuf>,
         /// Write the variants' phase profiles as an SVG stacked bar chart (one bar per variant).
