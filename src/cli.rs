@@ -269,9 +269,11 @@ pub(crate) struct ReferenceCmd {
     pub(crate) render: RenderCmd,
     /// Independent replicas (seeds and scrambles of their own) of spp/replicas samples each: the
     /// variance layer is their variance of the mean, right for every sampler (default: the
-    /// largest divisor of --spp from 2 to 8; 1: one render and the i.i.d. formula, which
-    /// overstates stratified and low-discrepancy samplers' error, but keeps --checkpoint,
-    /// --resume and --samples).
+    /// largest divisor of --spp from 2 to 8, or with --resume the checkpoint's replicas; 1: one
+    /// render and the i.i.d. formula, which overstates stratified and low-discrepancy samplers'
+    /// error, but keeps --samples and periodic checkpoints). With replicas, --checkpoint holds
+    /// every replica's state (written after each replica), and --resume with a larger --spp
+    /// extends each replica: the same bits as rendering that spp at once.
     #[arg(long, help_heading = SAMPLING, value_parser = parse_positive::<u32>)]
     pub(crate) replicas: Option<u32>,
 }

@@ -232,12 +232,19 @@ fn main() -> ExitCode {
     }
 }
 
-/// The replicas of `strata reference`: `--replicas`, else [`session::reference::default_replicas`]
-/// of its spp (1 when there is none: a shard, a resumed or checkpointed reference).
+/// The replicas of `strata reference`: `--replicas`, else the records of the `--resume`
+/// checkpoint (one for a single render's), else [`session::reference::default_replicas`] of its spp
+/// (1 for a shard or a time budget).
 fn resolve_replicas(cmd: &ReferenceCmd) -> u32 {
     let a = &cmd.render.args;
-    let single = a.samples.is_some() || a.resume.is_some() || a.checkpoint.is_some() || a.time_budget.is_some();
-    cmd.replicas.unwrap_or(if single { 1 } else { session::reference::default_replicas(a.spp.unwrap_or(1)) })
+    let single = a.samples.is_some() || a.time_budget.is_some();
+    // An unreadable checkpoint counts as one render's: the render reports why it is unreadable.
+    let resumed = a.resume.as_ref().map(|p| strata::checkpoint::read_replicas(p).map_or(1, |r| r.len() as u32));
+    cmd.replicas.unwrap_or(match resumed {
+        _ if single => 1,
+        Some(n) => n,
+        None => session::reference::default_replicas(a.spp.unwrap_or(1)),
+    })
 }
 
 /// Refuses, as a usage error (exit status 2), what the parsed command line asks for but the

@@ -67,6 +67,19 @@ pub(super) fn write_checkpoint(out: &RenderOutput) -> Result<(), SessionError> {
 /// one staying in place. With `lock`, the output stem's [`crate::files::StemLock`] is taken
 /// before the first pass (a second render to the same stem is refused) and returned held.
 pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOutput, SessionError> {
+    render_passes_from(opts, lock, None)
+}
+
+/// A checkpoint already read: its file (for messages), header and film.
+pub(super) type Resumed = (PathBuf, Header, Film);
+
+/// [`render_passes`], resuming `prior` when given (a replica's record of a reference's
+/// checkpoint) instead of reading `opts.resume`.
+pub(super) fn render_passes_from(
+    opts: &RenderOptions,
+    lock: bool,
+    prior: Option<Resumed>,
+) -> Result<RenderOutput, SessionError> {
     let (scene, mut integrator) = prepare(opts)?;
     let stem = output_stem(opts, &scene.desc);
     let lock = match lock {
@@ -98,21 +111,25 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
     header.target = [target.start, target.end];
     header.options.insert("quantize".into(), serde_json::json!(super::options::default_quantize(opts).name()));
     let mut film = Film::new(scene.desc.width, scene.desc.height);
-    if let Some(path) = &opts.resume {
-        let (h, f) = checkpoint::read(path)?;
+    let prior = match (prior, &opts.resume) {
+        (Some(p), _) => Some(p),
+        (None, Some(path)) => checkpoint::read(path).map(|(h, f)| Some((path.clone(), h, f)))?,
+        (None, None) => None,
+    };
+    if let Some((path, h, f)) = prior {
         // A larger --spp continues the render (the one change a resume may make), if its samples
         // do not depend on the total count: then the result is bit-identical to rendering it at once.
         if let Some((have, asked)) = h.spp_growth(&header, opts.allow_other_build) {
             if let Some(why) = count_bound(&integrator) {
-                return Err(SessionError::ResumeGrow { path: path.clone(), have, asked, why });
+                return Err(SessionError::ResumeGrow { path, have, asked, why });
             }
         } else if let Some(why) = h.mismatch_allowing(&header, "this render", opts.allow_other_build) {
-            return Err(SessionError::ResumeMismatch { path: path.clone(), why });
+            return Err(SessionError::ResumeMismatch { path, why });
         }
         let have = f.samples();
         if !have.is_empty() && (have.start != target.start || have.end > target.end) {
             return Err(SessionError::ResumeRange {
-                path: path.clone(),
+                path,
                 have: [have.start, have.end],
                 target: [target.start, target.end],
             });

@@ -332,22 +332,30 @@ fn resume_with_more_spp_extends_a_finished_render_bit_identically() {
         c.arg(spp.to_string()).arg("-o").arg(d.join(out)).args(extra);
         c
     };
-    for sub in ["render", "reference"] {
-        let ck = d.join(format!("{sub}.ckpt"));
+    // `reference` with its default replicas (8 of 32, then of 64 spp: its checkpoint holds each
+    // replica's state) and with one render (the i.i.d. variance layer from the film's moments).
+    for (sub, extra, tag) in [
+        ("render", &[][..], "render"),
+        ("reference", &[][..], "reference"),
+        ("reference", &["--replicas", "1"][..], "ref1"),
+    ] {
+        let ck = d.join(format!("{tag}.ckpt"));
         let ck = ck.to_str().unwrap();
-        run_ok(cmd(
-            sub,
-            512,
-            &format!("{sub}-once"),
-            &["--sampler", "sobol", "--replicas", "1"][..if sub == "render" { 2 } else { 4 }],
-        ));
-        run_ok(cmd(sub, 256, &format!("{sub}-256"), &["--sampler", "sobol", "--checkpoint", ck]));
-        assert_eq!(held(Path::new(ck)), 0..256);
-        run_ok(cmd(sub, 512, &format!("{sub}-512"), &["--sampler", "sobol", "--resume", ck]));
-        assert_eq!(held(Path::new(ck)), 0..512, "the checkpoint holds the extended render");
-        assert_same_image(&d.join(format!("{sub}-once")), &d.join(format!("{sub}-512")));
-        let (_, _, meta) = image(&d.join(format!("{sub}-512")));
+        let flags = |more: &[&'static str]| [&["--sampler", "sobol"][..], extra, more].concat();
+        run_ok(cmd(sub, 512, &format!("{tag}-once"), &flags(&[])));
+        run_ok(cmd(sub, 256, &format!("{tag}-256"), &[flags(&[]), vec!["--checkpoint", ck]].concat()));
+        run_ok(cmd(sub, 512, &format!("{tag}-512"), &[flags(&[]), vec!["--resume", ck]].concat()));
+        assert_same_image(&d.join(format!("{tag}-once")), &d.join(format!("{tag}-512")));
+        let (_, _, meta) = image(&d.join(format!("{tag}-512")));
         assert_eq!(meta.get("strata.spp").map(String::as_str), Some("512"));
+        if tag == "reference" {
+            assert_eq!(meta.get("strata.replicas").map(String::as_str), Some("8"), "{meta:?}");
+            let recs = strata::checkpoint::read_replicas(Path::new(ck)).unwrap();
+            assert_eq!(recs.len(), 8);
+            assert!(recs.iter().all(|(_, f)| f.samples() == (0..64)), "every replica extended to 64 spp");
+        } else {
+            assert_eq!(held(Path::new(ck)), 0..512, "the checkpoint holds the extended render");
+        }
     }
     // Every progressive sampler, by a count that is no power of two, twice.
     for sampler in ["independent", "halton", "pmj02"] {
@@ -367,6 +375,15 @@ fn resume_with_more_spp_extends_a_finished_render_bit_identically() {
     let e = run_err(cmd("render", 1024, "x", &["--sampler", "sobol", "--light-sampler", "halton", "--resume", ck]));
     assert!(e.contains(r#"light_sampler "sobol" (this render: "halton")"#), "{e}");
     assert!(e.contains("spp 512 (this render: 1024)"), "{e}");
+    // A reference's checkpoint keeps its replicas: fewer is refused, naming them.
+    let ck = d.join("reference.ckpt");
+    let e = run_err(cmd(
+        "reference",
+        512,
+        "x",
+        &["--sampler", "sobol", "--replicas", "4", "--resume", ck.to_str().unwrap()],
+    ));
+    assert!(e.contains("holds 8 replicas, more than --replicas 4"), "{e}");
     // Count-bound layouts refuse, naming the layout and why.
     for (flags, name) in [
         (&["--sampler", "stratified"][..], "`stratified`"),
