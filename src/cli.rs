@@ -56,8 +56,9 @@ pub(crate) enum Cmd {
     /// (--spp-ladder) or equal time (--budget); writes rows.csv/json, runs.csv/json (one row per
     /// run), table.md, error.svg and report.html (flip-book, error maps, plots). The reference must
     /// be of the same scene, size and camera. Variants default to --first-sample jittered.
-    /// Seconds are the worker threads' CPU seconds; the sampler's ns/sample and share of the render
-    /// come from the phase profiler, which every run has on.
+    /// Seconds are the worker threads' CPU seconds of runs timed with the profiler off; the
+    /// sampler's ns/sample and share of the render come from one separate profiled render per
+    /// variant and step (a quarter of the spp its runs reached), whose time is in no row.
     #[command(allow_negative_numbers = true)]
     Compare {
         /// Scene file (.test); omitted: the built-in Cornell box.
@@ -101,8 +102,10 @@ pub(crate) enum Cmd {
         /// Also write the rows (as OUT/rows.json) to this file.
         #[arg(long, value_name = "FILE")]
         json: Option<PathBuf>,
-        /// Write each variant's phase profile over all its runs (the keys of `strata profile
-        /// --json`, plus `variant`) as a JSON list to this file.
+        /// Write each variant's phase profile over its profiled renders, one per step (the keys of
+        /// `strata profile --json`, plus `variant`; `overhead` is the profiler's cost against the
+        /// unprofiled runs, `overhead_share` the runs' CPU share outside samples) as a JSON list to
+        /// this file.
         #[arg(long, value_name = "FILE")]
         profile: Option<PathBuf>,
         /// Write the variants' phase profiles as an SVG stacked bar chart (one bar per variant).
@@ -266,23 +269,28 @@ pub(crate) struct ReferenceCmd {
     pub(crate) render: RenderCmd,
     /// Independent replicas (seeds and scrambles of their own) of spp/replicas samples each: the
     /// variance layer is their variance of the mean, right for every sampler (default: the
-    /// largest divisor of --spp from 2 to 8; 1: one render and the i.i.d. formula, which
-    /// overstates stratified and low-discrepancy samplers' error, but keeps --checkpoint,
-    /// --resume and --samples).
+    /// largest divisor of --spp from 2 to 8, or with --resume the checkpoint's replicas; 1: one
+    /// render and the i.i.d. formula, which overstates stratified and low-discrepancy samplers'
+    /// error, but keeps --samples and periodic checkpoints). With replicas, --checkpoint holds
+    /// every replica's state (written after each replica), and --resume with a larger --spp
+    /// extends each replica: the same bits as rendering that spp at once.
     #[arg(long, help_heading = SAMPLING, value_parser = parse_positive::<u32>)]
     pub(crate) replicas: Option<u32>,
 }
 
 impl ReferenceCmd {
-    /// The replicas: `--replicas`, else [`strata::session::reference::default_replicas`] of its
-    /// spp (1 when there is none: a shard, a resumed or checkpointed reference, a time budget).
+    /// The replicas: `--replicas`, else the records of the `--resume` checkpoint (one for a single
+    /// render's), else [`strata::session::reference::default_replicas`] of its spp (1 for a shard or
+    /// a time budget).
     pub(crate) fn replicas(&self) -> u32 {
         let a = &self.render.args;
-        let single = a.samples.is_some() || a.resume.is_some() || a.checkpoint.is_some() || a.time_budget.is_some();
-        self.replicas.unwrap_or(if single {
-            1
-        } else {
-            strata::session::reference::default_replicas(a.spp.unwrap_or(1))
+        let single = a.samples.is_some() || a.time_budget.is_some();
+        // An unreadable checkpoint counts as one render's: the render reports why it is unreadable.
+        let resumed = a.resume.as_ref().map(|p| strata::checkpoint::read_replicas(p).map_or(1, |r| r.len() as u32));
+        self.replicas.unwrap_or(match resumed {
+            _ if single => 1,
+            Some(n) => n,
+            None => strata::session::reference::default_replicas(a.spp.unwrap_or(1)),
         })
     }
 }

@@ -37,6 +37,10 @@ pub struct RenderStats {
     pub profiled_ns: u64,
     /// camera samples rendered (pixels x samples per pixel of this render)
     pub samples: u64,
+    /// CPU seconds of the whole process over the passes (every thread: the tiles, the workers'
+    /// waits between tiles, copying the film into tiles and merging them back): what
+    /// [`RenderStats::cpu_seconds`] is part of
+    pub process_cpu_seconds: f64,
 }
 
 impl RenderStats {
@@ -50,6 +54,18 @@ impl RenderStats {
         }
         self.profiled_ns += o.profiled_ns;
         self.samples += o.samples;
+        self.process_cpu_seconds += o.process_cpu_seconds;
+    }
+
+    /// The share of the process's CPU time over the passes not spent in the tiles making samples:
+    /// copying the film into tiles and merging them back, pass set-up, workers waiting at a pass's
+    /// end (0 when nothing was measured).
+    pub fn overhead_share(&self) -> f64 {
+        if self.process_cpu_seconds > 0.0 {
+            (1.0 - self.cpu_seconds / self.process_cpu_seconds).max(0.0)
+        } else {
+            0.0
+        }
     }
 
     /// Rays traced per second over all kinds, in millions.
@@ -84,7 +100,8 @@ pub fn render(
     render_counted(scene, integrator, film, samples, pool, &AtomicU64::new(0))
 }
 
-/// [`render`], adding 1 to `tiles_done` as each tile finishes (a progress bar polls it).
+/// [`render`], adding 1 to `tiles_done` as each tile finishes (a progress bar polls it): the
+/// film is cut into tiles ([`TiledFilm::from_film`]), rendered, and written back.
 pub fn render_counted(
     scene: &Scene,
     integrator: &Integrator,
@@ -98,86 +115,156 @@ pub fn render_counted(
         have.is_empty() || have.end == samples.start,
         "render: samples {samples:?} do not continue the film's {have:?}"
     );
-    if integrator.kind == crate::scene::desc::IntegratorKind::ParticleTracer {
-        return render_light(scene, integrator, film, samples, pool, tiles_done);
+    if samples.is_empty() {
+        return RenderStats { threads: pool.current_num_threads(), ..Default::default() };
     }
-    render_source(scene, integrator, film, samples, pool, tiles_done, None)
+    let (mut tiled, cut) = TiledFilm::from_film(film);
+    let mut stats = render_tiled(scene, integrator, &mut tiled, samples, pool, tiles_done);
+    stats.merge(&cut);
+    stats.merge(&tiled.write_to(film));
+    stats
 }
 
-/// [`render_counted`] with the pixel samples taken from `images` (the particle tracer's splat
-/// images, one per sample of `samples`) instead of the integrator's tiles.
-pub(crate) fn render_source(
+/// A film kept as its tiles' states across passes: a pass renders each tile in place, with no
+/// copy of the film into tiles before it nor merge after it; [`TiledFilm::write_to`] merges them
+/// once (at the end of a run, or for a checkpoint). The same bits as [`render`] pass by pass.
+pub struct TiledFilm {
+    width: u32,
+    height: u32,
+    /// sample indices held
+    samples: std::ops::Range<u32>,
+    /// live blocks of `samples` (every tile's)
+    blocks: Vec<Block>,
+    tiles: Vec<TileResult>,
+}
+
+impl TiledFilm {
+    /// The tiles of `film`'s current state, with the stats of the copy (process CPU seconds, and
+    /// the film phase when profiling).
+    pub fn from_film(film: &Film) -> (Self, RenderStats) {
+        let (t, t0) = (crate::profile::enabled().then(Instant::now), cpu_time::ProcessTime::now());
+        let (w, h) = (film.width, film.height);
+        let tiles = (0..h.div_ceil(TILE))
+            .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
+            .map(|(tx, ty)| TileResult::from_film(film, tx * TILE, ty * TILE))
+            .collect();
+        let tiled = TiledFilm { width: w, height: h, samples: film.samples(), blocks: film.blocks().to_vec(), tiles };
+        (tiled, overhead_stats(t, t0))
+    }
+
+    /// The sample indices held.
+    pub fn samples(&self) -> std::ops::Range<u32> {
+        self.samples.clone()
+    }
+
+    /// Writes the tiles' state into `film` (of the same size), with the stats of the merge.
+    pub fn write_to(&self, film: &mut Film) -> RenderStats {
+        let (t, t0) = (crate::profile::enabled().then(Instant::now), cpu_time::ProcessTime::now());
+        assert_eq!((film.width, film.height), (self.width, self.height), "TiledFilm::write_to: another size");
+        let n = film.pixels();
+        film.drop_block_data(); // the tiles hold the blocks: peak memory 2x the state, not 3x
+        let mut data = vec![[0.0; 6]; self.blocks.len() * n];
+        for tile in &self.tiles {
+            debug_assert_eq!(tile.blocks, self.blocks);
+            tile.store(&mut data, self.width, n);
+        }
+        film.set_state(self.samples.clone(), self.blocks.clone(), data);
+        overhead_stats(t, t0)
+    }
+}
+
+/// The stats of work outside the tiles that began at `t` (when profiling) and `t0`: its process
+/// CPU seconds, and when profiling its wall time in the film phase and the profiled total.
+fn overhead_stats(t: Option<Instant>, t0: cpu_time::ProcessTime) -> RenderStats {
+    let mut st = RenderStats { process_cpu_seconds: t0.elapsed().as_secs_f64(), ..Default::default() };
+    if let Some(t) = t {
+        let ns = t.elapsed().as_nanos() as u64;
+        st.phase_ns[crate::profile::Phase::Film as usize] += ns;
+        st.profiled_ns += ns;
+    }
+    st
+}
+
+/// Renders samples `samples` of every pixel into `tiled`, which accumulates: `samples` must
+/// continue its range (any start when it holds none). Panics otherwise. Adds 1 to `tiles_done`
+/// as each tile finishes.
+pub fn render_tiled(
     scene: &Scene,
     integrator: &Integrator,
-    film: &mut Film,
+    tiled: &mut TiledFilm,
+    samples: std::ops::Range<u32>,
+    pool: &rayon::ThreadPool,
+    tiles_done: &AtomicU64,
+) -> RenderStats {
+    if integrator.kind == crate::scene::desc::IntegratorKind::ParticleTracer {
+        return render_light(scene, integrator, tiled, samples, pool, tiles_done);
+    }
+    render_source(scene, integrator, tiled, samples, pool, tiles_done, None)
+}
+
+/// [`render_tiled`] with the pixel samples taken from `images` (the particle tracer's splat
+/// images, one per sample of `samples`) instead of the integrator's tiles.
+fn render_source(
+    scene: &Scene,
+    integrator: &Integrator,
+    tiled: &mut TiledFilm,
     samples: std::ops::Range<u32>,
     pool: &rayon::ThreadPool,
     tiles_done: &AtomicU64,
     images: Option<&SplatImages>,
 ) -> RenderStats {
-    let have = film.samples();
-    let (w, h) = (film.width, film.height);
+    let have = tiled.samples();
+    assert!(
+        have.is_empty() || have.end == samples.start,
+        "render: samples {samples:?} do not continue the film's {have:?}"
+    );
+    let (w, h) = (tiled.width, tiled.height);
     let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
     if samples.is_empty() {
         return stats;
     }
     stats.samples = u64::from(w) * u64::from(h) * samples.len() as u64;
     let tiles_x = w.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE)).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
     let start = Instant::now();
-    let film_in: &Film = film;
-    type Done = (TileResult, Counters, f64, [u64; crate::profile::N_PHASES], u64);
+    let process_start = cpu_time::ProcessTime::now();
+    type Done = (Counters, f64, [u64; crate::profile::N_PHASES], u64);
     let results: Vec<Done> = pool.install(|| {
-        tiles
-            .par_iter()
-            .map_init(Scratch::default, |scratch, &(tx, ty)| {
+        tiled
+            .tiles
+            .par_iter_mut()
+            .map_init(Scratch::default, |scratch, tile| {
                 let t0 = cpu_time::ThreadTime::now();
                 let profiling = crate::profile::enabled();
                 let w0 = profiling.then(Instant::now);
                 crate::profile::tile_begin();
-                crate::sampler::replay::tile_begin(ty * tiles_x + tx);
+                crate::sampler::replay::tile_begin(tile.y0 / TILE * tiles_x + tile.x0 / TILE);
                 let mut counters = Counters::default();
-                let mut r = {
-                    let _f = crate::profile::scope(crate::profile::Phase::Film);
-                    TileResult::from_film(film_in, tx * TILE, ty * TILE)
-                };
-                render_tile(scene, integrator, &mut r, samples.clone(), scratch, &mut counters, images);
+                render_tile(scene, integrator, tile, samples.clone(), scratch, &mut counters, images);
                 crate::sampler::replay::tile_end();
                 let phases = crate::profile::tile_end();
                 let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
                 tiles_done.fetch_add(1, Ordering::Relaxed);
-                (r, counters, t0.elapsed().as_secs_f64(), phases, wall)
+                (counters, t0.elapsed().as_secs_f64(), phases, wall)
             })
             .collect()
     });
     stats.seconds = start.elapsed().as_secs_f64();
-    // The merge below runs on the calling thread, outside the tiles: timed with `Instant` into the
-    // film phase and the profiled total when profiling.
-    let merge_start = crate::profile::enabled().then(Instant::now);
-    let first = if have.is_empty() { samples.start } else { have.start };
-    let mut blocks = film.blocks().to_vec();
-    samples.clone().for_each(|s| {
-        push_block(&mut blocks, Block::leaf(s));
-    });
-    let n = film.pixels();
-    film.drop_block_data(); // the tiles hold the continued blocks: peak memory 2x the state, not 3x
-    let mut data = vec![[0.0; 6]; blocks.len() * n];
-    for (tile, c, busy, phases, wall) in &results {
+    for (c, busy, phases, wall) in &results {
         stats.counters.merge(c);
         stats.cpu_seconds += busy;
         stats.profiled_ns += wall;
         for (a, b) in stats.phase_ns.iter_mut().zip(phases) {
             *a += b;
         }
-        debug_assert_eq!(tile.blocks, blocks);
-        tile.store(&mut data, w, n);
     }
-    film.set_state(first..samples.end, blocks, data);
-    if let Some(t) = merge_start {
-        let ns = t.elapsed().as_nanos() as u64;
-        stats.phase_ns[crate::profile::Phase::Film as usize] += ns;
-        stats.profiled_ns += ns;
+    if have.is_empty() {
+        tiled.samples = samples.start..samples.start;
     }
+    samples.clone().for_each(|s| {
+        push_block(&mut tiled.blocks, Block::leaf(s));
+    });
+    tiled.samples.end = samples.end;
+    stats.process_cpu_seconds = process_start.elapsed().as_secs_f64();
     stats
 }
 
@@ -192,12 +279,13 @@ const SPLAT_IMAGE_BYTES: u64 = 256 << 20;
 fn render_light(
     scene: &Scene,
     integrator: &Integrator,
-    film: &mut Film,
+    tiled: &mut TiledFilm,
     samples: std::ops::Range<u32>,
     pool: &rayon::ThreadPool,
     tiles_done: &AtomicU64,
 ) -> RenderStats {
-    let (w, h) = (film.width, film.height);
+    let process_start = cpu_time::ProcessTime::now();
+    let (w, h) = (tiled.width, tiled.height);
     let pixels = u64::from(w) * u64::from(h);
     let chunk = (SPLAT_IMAGE_BYTES / (pixels * 12).max(1)).clamp(1, u64::from(u32::MAX)) as u32;
     let mut stats = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
@@ -246,11 +334,12 @@ fn render_light(
             stats.cpu_seconds += busy;
         }
         let traced_secs = t0.elapsed().as_secs_f64();
-        let st = render_source(scene, integrator, film, part.clone(), pool, tiles_done, Some(&images));
+        let st = render_source(scene, integrator, tiled, part.clone(), pool, tiles_done, Some(&images));
         stats.merge(&st);
         stats.seconds += traced_secs;
         start = part.end;
     }
+    stats.process_cpu_seconds = process_start.elapsed().as_secs_f64();
     stats
 }
 

@@ -147,8 +147,14 @@ pub fn read(path: &Path) -> Result<(Header, Film), CheckpointError> {
     let expected =
         (20 + hlen).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
     if expected != len {
+        // More bytes than one record: the records of a replicated reference.
+        let replicas = if expected < len {
+            ", or the checkpoint of a reference's replicas (`strata reference` resumes it)"
+        } else {
+            ""
+        };
         return Err(bad(format!(
-            "truncated or corrupt: {len} bytes, expected {expected} for {} blocks of {}x{} pixels",
+            "truncated or corrupt: {len} bytes, expected {expected} for {} blocks of {}x{} pixels{replicas}",
             header.blocks.len(),
             header.width,
             header.height
@@ -158,6 +164,41 @@ pub fn read(path: &Path) -> Result<(Header, Film), CheckpointError> {
     bytes.extend_from_slice(&json);
     bytes.extend(crate::files::read::read_all_of(file, len - 20 - hlen, len - 20 - hlen).map_err(io)?);
     from_bytes(&bytes, &name)
+}
+
+/// Writes the checkpoint of a replicated reference (`strata reference` with replicas): the
+/// replicas' records, each a whole checkpoint as [`to_bytes`] makes it, one after another in
+/// replica order, atomically.
+pub fn write_replicas(path: &Path, records: &[Vec<u8>]) -> Result<(), CheckpointError> {
+    film::write_atomic(path, &records.concat())
+        .map_err(|source| CheckpointError::Write { path: path.to_path_buf(), source })
+}
+
+/// The length of the checkpoint record at the start of `b` from its header, if it parses.
+fn record_len(b: &[u8]) -> Option<usize> {
+    let hlen = u64::from_le_bytes(b.get(12..20)?.try_into().ok()?);
+    let hend = 20usize.checked_add(usize::try_from(hlen).ok().filter(|&h| h as u64 <= MAX_HEADER)?)?;
+    let header: Header = serde_json::from_slice(b.get(20..hend)?).ok()?;
+    let pixels = header.width as u64 * header.height as u64;
+    let n = (hend as u64).saturating_add((header.blocks.len() as u64).saturating_mul(pixels).saturating_mul(48)) + 8;
+    Some(usize::try_from(n).ok()?.min(b.len()))
+}
+
+/// Reads a checkpoint of one render or of a replicated reference ([`write_replicas`]): its
+/// records in order, each checked as [`from_bytes`] checks one (errors name the replica).
+pub fn read_replicas(path: &Path) -> Result<Vec<(Header, Film)>, CheckpointError> {
+    let name = path.display().to_string();
+    let bytes = crate::files::read::read_bounded(path, u64::MAX)
+        .map_err(|source| CheckpointError::Read { path: path.to_path_buf(), source })?;
+    let (mut out, mut at) = (Vec::new(), 0);
+    while at < bytes.len() || out.is_empty() {
+        let rest = &bytes[at..];
+        let n = record_len(rest).unwrap_or(rest.len());
+        let label = if out.is_empty() { name.clone() } else { format!("{name} (replica {})", out.len() + 1) };
+        out.push(from_bytes(&rest[..n], &label)?);
+        at += n;
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -214,6 +255,29 @@ mod tests {
         // An empty film round-trips too.
         let (_, e) = from_bytes(&to_bytes(&header(), &Film::new(3, 2)), "e").unwrap();
         assert_eq!(e.samples(), 0..0);
+    }
+
+    #[test]
+    fn replica_records_round_trip_and_name_a_broken_one() {
+        let dir = std::env::temp_dir().join(format!("strata-replicas-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("r.ckpt");
+        let films = [film(0..9), film(0..9), film(0..16)];
+        let records: Vec<Vec<u8>> = films.iter().map(|f| to_bytes(&header(), f)).collect();
+        write_replicas(&p, &records).unwrap();
+        let back = read_replicas(&p).unwrap();
+        assert_eq!(back.iter().map(|(_, f)| f.clone()).collect::<Vec<_>>(), films);
+        // One render's checkpoint reads as one record; `read` names a file of several.
+        write(&p, &header(), &films[0]).unwrap();
+        assert_eq!(read_replicas(&p).unwrap().len(), 1);
+        write_replicas(&p, &records).unwrap();
+        assert!(read(&p).unwrap_err().to_string().contains("replicas"));
+        let mut bytes = records.concat();
+        bytes.truncate(bytes.len() - 3);
+        std::fs::write(&p, bytes).unwrap();
+        let e = read_replicas(&p).unwrap_err().to_string();
+        assert!(e.contains("(replica 3)") && e.contains("truncated"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]

@@ -54,6 +54,22 @@ impl Header {
         self.mismatch_allowing(want, label, false)
     }
 
+    /// The spp of a resumed checkpoint (`self`) and of the render resuming it (`want`) when the
+    /// render asks for more samples and nothing else of their identity differs ([`Header::mismatch`]
+    /// would be None with equal spp): the one change a resume may make, continuing a finished
+    /// render whose layouts are progressive (the caller checks that: its samples must not depend on
+    /// the total count). Fewer samples, or any other difference, is None.
+    pub fn spp_growth(&self, want: &Header, other_build: bool) -> Option<(u64, u64)> {
+        let spp = |h: &Header| h.options.get("spp").and_then(serde_json::Value::as_u64);
+        let (have, asked) = (spp(self)?, spp(want)?);
+        if asked <= have {
+            return None;
+        }
+        let mut same = want.clone();
+        same.options.insert("spp".into(), serde_json::json!(have));
+        self.mismatch_allowing(&same, "", other_build).is_none().then_some((have, asked))
+    }
+
     /// [`Header::mismatch`], except that with `other_build` a different build (see
     /// [`Header::strata_build`]) is accepted: the user vouches that both compute the same samples.
     pub fn mismatch_allowing(&self, want: &Header, label: &str, other_build: bool) -> Option<String> {

@@ -6,6 +6,8 @@
 //! `b"STRATACK"`, u32 version, u64 header length, the header as UTF-8 JSON ([`Header`]), then
 //! `blocks * width * height * 6` f64 (block-major; per pixel sum R, G, B, sum of squares R, G, B),
 //! then a u64 checksum of every byte before it. Written atomically ([`crate::film::write_atomic`]).
+//! A replicated reference's checkpoint is its replicas' records one after another
+//! ([`write_replicas`], [`read_replicas`]).
 //!
 //! - [`format`] — the file layout, [`read`] and [`write`];
 //! - [`identity`] — the [`Header`] of a render, what makes two headers one render, EXR metadata;
@@ -15,7 +17,7 @@ pub mod format;
 pub mod identity;
 pub mod merge;
 
-pub use format::{from_bytes, header_for, read, to_bytes, write, MAGIC, VERSION};
+pub use format::{from_bytes, header_for, read, read_replicas, to_bytes, write, write_replicas, MAGIC, VERSION};
 pub use identity::{header_metadata, identity, Header};
 pub use merge::{run_merge, MergeOutput};
 

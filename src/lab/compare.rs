@@ -2,8 +2,9 @@
 //! equal spp (a ladder) or equal time (a budget). Inputs are checked first ([`super::checks`]):
 //! the reference must be of the variants' scene, size and camera. Measures per-step and per-run
 //! rows (`report_page.rs` writes them: CSV, JSON, a Markdown table, log-log plots with error bars
-//! and `report.html`). Seconds are the worker threads' CPU seconds, and every row carries the
-//! sampler's cost from the phase profiler.
+//! and `report.html`). Seconds are the worker threads' CPU seconds of unprofiled runs, and every
+//! row carries the sampler's cost from the phase profiler, measured on one separate profiled
+//! render per step ([`profile_spp`]) whose time is in no row.
 
 use super::progress::Progress;
 use super::{checks, io_err, LabError};
@@ -74,7 +75,7 @@ impl Options {
     }
 }
 
-/// One variant's phase profile over all its runs and steps (`compare --profile`).
+/// One variant's phase profile over its profiled renders, one per step (`compare --profile`).
 #[derive(Clone, Debug, Serialize)]
 pub struct VariantProfile {
     /// the variant's name
@@ -263,10 +264,11 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
     let (mut rows, mut run_rows, mut profiles, mut images) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     // Per variant, step and run: a hash of the image's bits, to find variants that render the same.
     let mut renders: Vec<Vec<Vec<u64>>> = Vec::new();
-    let _profiling = crate::profile::enable();
     for (v, (o, scene, integ)) in variants.iter().zip(&prepared) {
         let pool = render::thread_pool(o.threads)?;
         let mut all = RenderStats { threads: pool.current_num_threads(), ..Default::default() };
+        // The runs' own stats (unprofiled): their CPU time per sample and bookkeeping share.
+        let mut all_runs = RenderStats { threads: all.threads, ..Default::default() };
         let (mut per_step, mut last) = (Vec::new(), Vec::new());
         for (&step, &budget) in steps.iter().zip(&budgets) {
             let (mut runs_img, mut secs, mut spps, mut hashes) = (Vec::new(), 0.0, 0.0, Vec::new());
@@ -333,8 +335,14 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
             }
             let stats = RunStats::against(&runs_img, &img.rgb, ref_info)
                 .map_err(|source| LabError::VariantStats { variant: v.name.clone(), source })?;
-            let step_profile = Profile::from_stats("", &step_stats);
-            all.merge(&step_stats);
+            // The runs are timed with the profiler off (it costs 10-20 % of a render: an equal-time
+            // run would measure it too); one separate profiled render of the step gives the
+            // sampler's columns and the variant's profile, its time in no row.
+            all_runs.merge(&step_stats);
+            let reached = if step > 0 { step } else { (spps / opts.runs as f64).round() as u32 };
+            let prof = profiled_render(scene, integ, step, profile_spp(reached, integ), o.seed, &pool)?;
+            let step_profile = Profile::from_stats("", &prof);
+            all.merge(&prof);
             let k = opts.runs as f64;
             let flips = run_rows[run_rows.len() - opts.runs..].iter().map(|r| r.flip).sum::<f64>() / k;
             let mut row = Row::new(v.name.clone(), secs / k, spps / k, &stats)?
@@ -353,7 +361,20 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
         }
         images.push((v.name.clone(), last));
         renders.push(per_step);
-        let profile = Profile::from_stats(&scene.desc.source.display().to_string(), &all);
+        let mut profile = Profile::from_stats(&scene.desc.source.display().to_string(), &all);
+        // The runs' CPU seconds at the profiled renders' sample count, and what profiling costs.
+        let per_sample = all_runs.cpu_seconds / all_runs.samples.max(1) as f64;
+        profile.cpu_seconds_unprofiled = Some(per_sample * all.samples as f64);
+        profile.overhead = Some(all.cpu_seconds / (per_sample * all.samples as f64).max(1e-12) - 1.0);
+        profile.overhead_share = Some(all_runs.overhead_share());
+        notes.push(format!(
+            "variant {}: {:.1}% of the CPU time over its runs went to other than samples (tile set-up and \
+             film copies, film merges, workers waiting at a pass's end); the runs were timed unprofiled, \
+             the sampler's columns come from one profiled render per step (profiling adds {:+.1}%)",
+            v.name,
+            100.0 * all_runs.overhead_share(),
+            100.0 * profile.overhead.unwrap_or(0.0)
+        ));
         profiles.push(VariantProfile { variant: v.name.clone(), profile });
     }
     mark_identical(variants, &renders, steps.len(), &mut rows, &mut notes);
@@ -361,6 +382,33 @@ pub fn run(variants: &[Variant], reference: &Path, opts: &Options) -> Result<Com
     let convergence = variants.iter().map(|v| convergence(&v.name, &run_rows)).collect();
     let threads = profiles.first().map_or(opts.threads, |p: &VariantProfile| p.profile.threads);
     Ok(Comparison { rows, runs: run_rows, profiles, convergence, notes, reference: img, images, baseline, threads })
+}
+
+/// The spp of the profiled render of a step whose runs reached `reached` spp: a quarter of it
+/// (the sampler's ns per sample hardly depends on the count), at least one wavefront batch (or
+/// all of `reached` below that), in whole sets of a point set that is not progressive.
+pub fn profile_spp(reached: u32, it: &crate::integrator::Integrator) -> u32 {
+    let g = session::pass::whole_set_spp(it);
+    let n = reached.div_ceil(4).max(reached.min(render::SAMPLE_BATCH)).max(1);
+    n.div_ceil(g).saturating_mul(g)
+}
+
+/// The profiled render of a step (`step` spp, or 0 for an equal-time step), `spp` samples with
+/// the seed of run 1: its stats, phases included.
+fn profiled_render(
+    scene: &crate::scene::build::Scene,
+    integ: &crate::integrator::Integrator,
+    step: u32,
+    spp: u32,
+    seed: u64,
+    pool: &rayon::ThreadPool,
+) -> Result<RenderStats, LabError> {
+    let mut it =
+        if step > 0 { integ.resampled(spp) } else { integ.equal_time().map_err(session::SessionError::from)? };
+    it.seed = run_seed(seed, 0);
+    let mut film = Film::new(scene.desc.width, scene.desc.height);
+    let _profiling = crate::profile::enable();
+    Ok(render::render(scene, &it, &mut film, 0..spp, pool))
 }
 
 /// The mean over values of the reference's own variance (0 without a variance layer).
@@ -381,8 +429,8 @@ fn image_hash(img: &[[f32; 3]]) -> u64 {
 /// known in advance). Returns the seconds and spp.
 ///
 /// Passes grow geometrically ([`budget_pass`]): a run of n spp takes O(log n) passes, so what a
-/// pass costs besides its samples (tile set-up, the film merge) is paid a few times per run, not
-/// once per sample. The stopping rule looks at CPU time only, never at the image, as before.
+/// pass costs besides its samples (tile set-up, workers waiting at its end) is paid a few times
+/// per run, not once per sample; the film stays in tiles ([`render::TiledFilm`]), merged once. The stopping rule looks at CPU time only, never at the image, as before.
 #[allow(clippy::too_many_arguments)]
 fn budget_run(
     scene: &crate::scene::build::Scene,
@@ -399,13 +447,18 @@ fn budget_run(
     let g = session::pass::whole_set_spp(it);
     let cap = (max_spp / g * g).max(g);
     let (mut t, mut s) = (0.0, 0u32);
+    // The film stays cut into tiles over the passes, merged once at the end.
+    let (mut tiled, cut) = render::TiledFilm::from_film(film);
+    stats.merge(&cut);
+    let tiles_done = std::sync::atomic::AtomicU64::new(0);
     while t < budget && s < cap {
         let n = budget_pass(t, s / g, budget).saturating_mul(g).min(cap - s);
-        let st = render::render(scene, it, film, s..s + n, pool);
+        let st = render::render_tiled(scene, it, &mut tiled, s..s + n, pool, &tiles_done);
         stats.merge(&st);
         t += st.cpu_seconds;
         s += n;
     }
+    stats.merge(&tiled.write_to(film));
     if g > 1 {
         let mut sets: Vec<String> = it
             .kinds()

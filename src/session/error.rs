@@ -119,6 +119,18 @@ pub enum SessionError {
         /// the range asked for
         target: [u32; 2],
     },
+    /// `--resume` with a larger `--spp` of a render whose samples depend on their total count.
+    #[error("{}: cannot extend it from {have} to {asked} spp: {why}; render {asked} spp afresh", path.display())]
+    ResumeGrow {
+        /// the checkpoint
+        path: PathBuf,
+        /// the spp of the render it holds
+        have: u64,
+        /// the spp asked for
+        asked: u64,
+        /// which layout is bound to its count, and why
+        why: String,
+    },
     /// Reading or writing a checkpoint.
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),

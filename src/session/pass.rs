@@ -67,6 +67,19 @@ pub(super) fn write_checkpoint(out: &RenderOutput) -> Result<(), SessionError> {
 /// one staying in place. With `lock`, the output stem's [`crate::files::StemLock`] is taken
 /// before the first pass (a second render to the same stem is refused) and returned held.
 pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOutput, SessionError> {
+    render_passes_from(opts, lock, None)
+}
+
+/// A checkpoint already read: its file (for messages), header and film.
+pub(super) type Resumed = (PathBuf, Header, Film);
+
+/// [`render_passes`], resuming `prior` when given (a replica's record of a reference's
+/// checkpoint) instead of reading `opts.resume`.
+pub(super) fn render_passes_from(
+    opts: &RenderOptions,
+    lock: bool,
+    prior: Option<Resumed>,
+) -> Result<RenderOutput, SessionError> {
     let (scene, mut integrator) = prepare(opts)?;
     let stem = output_stem(opts, &scene.desc);
     let lock = match lock {
@@ -98,15 +111,25 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
     header.target = [target.start, target.end];
     header.options.insert("quantize".into(), serde_json::json!(super::options::default_quantize(opts).name()));
     let mut film = Film::new(scene.desc.width, scene.desc.height);
-    if let Some(path) = &opts.resume {
-        let (h, f) = checkpoint::read(path)?;
-        if let Some(why) = h.mismatch_allowing(&header, "this render", opts.allow_other_build) {
-            return Err(SessionError::ResumeMismatch { path: path.clone(), why });
+    let prior = match (prior, &opts.resume) {
+        (Some(p), _) => Some(p),
+        (None, Some(path)) => checkpoint::read(path).map(|(h, f)| Some((path.clone(), h, f)))?,
+        (None, None) => None,
+    };
+    if let Some((path, h, f)) = prior {
+        // A larger --spp continues the render (the one change a resume may make), if its samples
+        // do not depend on the total count: then the result is bit-identical to rendering it at once.
+        if let Some((have, asked)) = h.spp_growth(&header, opts.allow_other_build) {
+            if let Some(why) = count_bound(&integrator) {
+                return Err(SessionError::ResumeGrow { path, have, asked, why });
+            }
+        } else if let Some(why) = h.mismatch_allowing(&header, "this render", opts.allow_other_build) {
+            return Err(SessionError::ResumeMismatch { path, why });
         }
         let have = f.samples();
         if !have.is_empty() && (have.start != target.start || have.end > target.end) {
             return Err(SessionError::ResumeRange {
-                path: path.clone(),
+                path,
                 have: [have.start, have.end],
                 target: [target.start, target.end],
             });
@@ -137,6 +160,10 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
     let profiling = opts.profile.is_some().then(crate::profile::enable);
     // A time budget ends on whole sets of a point set that is not progressive.
     let block = if opts.time_budget.is_some() { whole_set_spp(&integrator) } else { 1 };
+    // The film stays cut into tiles over the passes: copied in once, merged back for checkpoints
+    // and at the end, not around every pass.
+    let (mut tiled, cut) = render::TiledFilm::from_film(&film);
+    stats.merge(&cut);
     while s < target.end {
         if opts.stop.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
             interrupted = true;
@@ -155,7 +182,7 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
             n = n.div_ceil(block).saturating_mul(block).min(target.end - s);
         }
         let st = progress.watch(n, started, |tiles_done| {
-            render::render_counted(&scene, &integrator, &mut film, s..s + n, &pool, tiles_done)
+            render::render_tiled(&scene, &integrator, &mut tiled, s..s + n, &pool, tiles_done)
         });
         s += n;
         stats.merge(&st);
@@ -169,6 +196,7 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
         pass = if want >= render::SAMPLE_BATCH { want / render::SAMPLE_BATCH * render::SAMPLE_BATCH } else { want };
         if let Some(p) = &ckpt_path {
             if s < target.end && last_ckpt.elapsed().as_secs_f64() >= every {
+                stats.merge(&tiled.write_to(&mut film));
                 if let Err(e) = checkpoint::write(p, &header, &film) {
                     progress.warn(&format!(
                         "strata: warning: {e}; the previous checkpoint stays, trying again in {every} s (rendering goes on)"
@@ -178,6 +206,8 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
             }
         }
     }
+    stats.merge(&tiled.write_to(&mut film));
+    drop(tiled);
     drop(profiling);
     progress.finish();
     if film.samples().is_empty() {
@@ -194,6 +224,36 @@ pub(super) fn render_passes(opts: &RenderOptions, lock: bool) -> Result<RenderOu
     };
     header = checkpoint::header_for(header, &film);
     Ok(RenderOutput { scene, integrator, film, stats, out: None, header, checkpoint: final_ckpt, interrupted, lock })
+}
+
+/// Why the samples of `it` depend on its total count (so a render of more samples is not a
+/// continuation of one of fewer), or None when every layout its integrator draws from is
+/// progressive: a count-bound registry layout (a jittered grid of spp cells, Morton order over
+/// the count) or a loaded point set that is not progressive (used in whole sets).
+pub fn count_bound(it: &crate::integrator::Integrator) -> Option<String> {
+    use crate::integrator::samples::Source;
+    let entry = crate::integrator::INTEGRATORS.iter().find(|e| e.kind == it.kind)?;
+    let [pixel, light, path] = it.kinds();
+    let layouts = [(Source::Pixel, pixel, "pixel"), (Source::Light, light, "light"), (Source::Path, path, "path")];
+    layouts.into_iter().filter(|(src, ..)| entry.dims.iter().any(|d| d.source == *src)).find_map(|(_, k, role)| {
+        if let Some(n) = crate::sampler::file::whole_set_points(k) {
+            Some(format!(
+                "its {role} sampler {} is a set of {n} points that is not progressive (it is used in whole sets, \
+                 so its first samples depend on how many there are)",
+                k.name()
+            ))
+        } else if !k.info().progressive {
+            Some(format!(
+                "its {role} sampler `{}` ({}) lays its samples out for their total count, so a render of \
+                 more samples places even its first ones elsewhere (renders with a progressive sampler extend: {})",
+                k.name(),
+                k.info().description,
+                crate::integrator::settings::progressive_names()
+            ))
+        } else {
+            None
+        }
+    })
 }
 
 /// The spp granularity of an equal-time run of `it`: runs must end on whole sets of every loaded

@@ -50,6 +50,11 @@ pub struct Profile {
     /// measured overhead of profiling: profiled / unprofiled CPU seconds - 1 (`strata profile`
     /// only, else null)
     pub overhead: Option<f64>,
+    /// the share of the process's CPU time over the passes not spent making samples (tile set-up
+    /// and film copies, film merges, workers waiting at a pass's end;
+    /// [`RenderStats::overhead_share`]): of the profiled renders, and in `compare` of the variant's
+    /// unprofiled runs (null where nothing was measured)
+    pub overhead_share: Option<f64>,
     /// the profiled image is bit-identical to the unprofiled one (`strata profile` only, else null)
     pub bit_identical: Option<bool>,
     /// camera samples (pixels x spp)
@@ -94,6 +99,7 @@ impl Profile {
             cpu_seconds_profiled: st.cpu_seconds,
             cpu_seconds_unprofiled: None,
             overhead: None,
+            overhead_share: (st.process_cpu_seconds > 0.0).then(|| st.overhead_share()),
             bit_identical: None,
             samples,
             rays,

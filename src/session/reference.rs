@@ -13,9 +13,10 @@
 //! (`strata.variance`, `strata.replicas`, `strata.replica_spp`, `strata.replica_seeds`).
 
 use super::output::metadata;
-use super::pass::{render_passes, RenderOutput};
+use super::pass::{render_passes_from, RenderOutput, Resumed};
 use super::stats::stats_json;
 use super::{output_stem, RenderOptions, SessionError};
+use crate::checkpoint;
 use crate::film::{self, with_ext, Metadata};
 
 /// The most replicas `strata reference` makes unless `--replicas` says otherwise.
@@ -78,8 +79,11 @@ impl Replicated {
 }
 
 /// Renders `replicas` independent replicas of `opts.spp / replicas` samples each (seeds
-/// [`replica_seed`]) and combines them. Refuses what a replicated reference cannot do: an spp that
-/// is not a multiple of the replicas, `--samples`, `--time-budget`, checkpoints.
+/// [`replica_seed`]) and combines them. With `--checkpoint` (or `--resume`) the replicas'
+/// states are written there after each replica, one record each; `--resume` continues them, with
+/// a larger `--spp` too (extending every replica: bit-identical to rendering that spp at once).
+/// Refuses what a replicated reference cannot do: an spp that is not a multiple of the replicas,
+/// `--samples`, `--time-budget`, a checkpoint of more replicas than `replicas`.
 pub fn render_replicas(opts: &RenderOptions, replicas: u32) -> Result<Replicated, SessionError> {
     replicas_with_lock(opts, replicas, false)
 }
@@ -104,7 +108,6 @@ fn replicas_with_lock(opts: &RenderOptions, replicas: u32, lock: bool) -> Result
     let refused = [
         (opts.samples.is_some(), "--samples (shards)"),
         (opts.time_budget.is_some(), "--time-budget (a reference has a sample count)"),
-        (opts.checkpoint.is_some() || opts.resume.is_some(), "--checkpoint/--resume"),
     ];
     if let Some((_, what)) = refused.iter().find(|(set, _)| *set) {
         return Err(SessionError::Replicas {
@@ -112,6 +115,25 @@ fn replicas_with_lock(opts: &RenderOptions, replicas: u32, lock: bool) -> Result
         });
     }
     let replica_spp = spp / replicas;
+    // The checkpoint: one record per replica ([`checkpoint::write_replicas`]), rewritten after
+    // each replica; `--resume` continues each replica from its record (a larger --spp extends
+    // every replica: the same bits as rendering it at once, the seeds depending on r alone).
+    let ckpt = opts.checkpoint.clone().or_else(|| opts.resume.clone());
+    let mut prior: Vec<Option<Resumed>> = match &opts.resume {
+        Some(p) => checkpoint::read_replicas(p)?.into_iter().map(|(h, f)| Some((p.clone(), h, f))).collect(),
+        None => Vec::new(),
+    };
+    if prior.len() > replicas as usize {
+        return Err(SessionError::Replicas {
+            why: format!(
+                "{} holds {} replicas, more than --replicas {replicas} (give --replicas {} and an --spp that is a multiple of it)",
+                opts.resume.as_ref().map_or(String::new(), |p| p.display().to_string()),
+                prior.len(),
+                prior.len()
+            ),
+        });
+    }
+    let mut records: Vec<Vec<u8>> = prior.iter().flatten().map(|(_, h, f)| checkpoint::to_bytes(h, f)).collect();
     let (mut mean, mut m2, mut seeds) = (Vec::<[f64; 3]>::new(), Vec::<[f64; 3]>::new(), Vec::new());
     let mut last: Option<RenderOutput> = None;
     // The output stem's lock, taken by the first replica and held until the outputs are written.
@@ -120,17 +142,34 @@ fn replicas_with_lock(opts: &RenderOptions, replicas: u32, lock: bool) -> Result
         let mut o = opts.clone();
         o.spp = Some(replica_spp);
         o.seed = replica_seed(opts.seed, r);
+        (o.checkpoint, o.resume) = (None, None);
         seeds.push(o.seed);
         if opts.progress {
             eprintln!("strata: reference replica {}/{replicas} ({replica_spp} spp, seed {})", r + 1, o.seed);
         }
-        let mut out = render_passes(&o, lock && r == 0)?;
+        let resumed = prior.get_mut(r as usize).and_then(Option::take);
+        let mut out = render_passes_from(&o, lock && r == 0, resumed)?;
         if r == 0 {
             stem_lock = out.lock.take();
         }
+        if let Some(p) = &ckpt {
+            let bytes = checkpoint::to_bytes(&out.header, &out.film);
+            match records.get_mut(r as usize) {
+                Some(rec) => *rec = bytes,
+                None => records.push(bytes),
+            }
+            checkpoint::write_replicas(p, &records)?;
+        }
         if out.interrupted {
             return Err(SessionError::Replicas {
-                why: format!("interrupted in replica {} of {replicas}; nothing was written", r + 1),
+                why: match &ckpt {
+                    Some(p) => format!(
+                        "interrupted in replica {} of {replicas}; {} holds the replicas so far (continue with --resume)",
+                        r + 1,
+                        p.display()
+                    ),
+                    None => format!("interrupted in replica {} of {replicas}; nothing was written", r + 1),
+                },
             });
         }
         // Welford's update per value: the replicas' mean and sum of squared deviations.

@@ -9,7 +9,7 @@ use serde_json::json;
 pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
     let d = &out.scene.desc;
     let c = &out.stats.counters;
-    json!({
+    let mut j = json!({
         "scene": d.source.display().to_string(),
         "integrator": d.integrator.name(),
         "seconds": out.stats.seconds,
@@ -50,7 +50,12 @@ pub fn stats_json(out: &RenderOutput) -> serde_json::Value {
         "features": features(out),
         "kernel": out.integrator.kernel.name(d.integrator),
         "version": env!("CARGO_PKG_VERSION"),
-    })
+    });
+    // The process's CPU seconds over the passes, and the share of it not spent making samples
+    // (tile set-up and film copies, film merges, workers waiting at a pass's end).
+    j["process_cpu_seconds"] = json!(out.stats.process_cpu_seconds);
+    j["overhead_share"] = json!(out.stats.overhead_share());
+    j
 }
 
 /// `features` of `--stats`: what the scene uses, with `light_selection` the rule in use (the same

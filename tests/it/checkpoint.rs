@@ -208,8 +208,10 @@ fn resume_refuses_other_scene_options_and_broken_files() {
     let resume = |extra: &[&str], scene: Option<&Path>| resume_spp(32, extra, scene);
     let e = resume(&["--seed", "12"], None);
     assert!(e.contains("cannot resume") && e.contains("seed 11 (this render: 12)"), "{e}");
+    // More spp extends a render only when its layouts are progressive; this one's default
+    // (stratified) is laid out for its count.
     let e = resume_spp(64, &[], None);
-    assert!(e.contains("spp 32 (this render: 64)"), "{e}");
+    assert!(e.contains("cannot extend it from 32 to 64 spp") && e.contains("`stratified`"), "{e}");
     let e = resume(&["--size", "32x24"], None);
     assert!(e.contains("64x48"), "{e}");
     // The same scene with one byte changed is another scene.
@@ -313,4 +315,99 @@ fn resume_refuses_a_changed_included_obj_and_another_clamp() {
     c.arg("--resume").arg(&ck);
     let e = run_err(c);
     assert!(e.contains("another scene"), "{e}");
+}
+
+/// Issue 31: `--resume` with a larger `--spp` continues a finished render whose layouts are
+/// progressive, bit for bit as rendering the larger count at once (RGB, the variance layer, the
+/// PNG), for `render` and `reference` (a checkpointed reference is one render: its variance layer
+/// comes from the film's moments) and for every progressive sampler. Only spp may grow: fewer spp
+/// or another option is refused as before, and a layout bound to its count refuses, naming it.
+/// (Before, any other spp was refused: "spp 256 (this render: 512)".)
+#[test]
+fn resume_with_more_spp_extends_a_finished_render_bit_identically() {
+    let d = tmpdir("extend");
+    let cmd = |sub: &str, spp: u32, out: &str, extra: &[&str]| {
+        let mut c = strata();
+        c.arg(sub).arg(scene()).args(["-q", "--seed", "11", "--size", "32x24", "--threads", "2", "--spp"]);
+        c.arg(spp.to_string()).arg("-o").arg(d.join(out)).args(extra);
+        c
+    };
+    // `reference` with its default replicas (8 of 32, then of 64 spp: its checkpoint holds each
+    // replica's state) and with one render (the i.i.d. variance layer from the film's moments).
+    for (sub, extra, tag) in [
+        ("render", &[][..], "render"),
+        ("reference", &[][..], "reference"),
+        ("reference", &["--replicas", "1"][..], "ref1"),
+    ] {
+        let ck = d.join(format!("{tag}.ckpt"));
+        let ck = ck.to_str().unwrap();
+        let flags = |more: &[&'static str]| [&["--sampler", "sobol"][..], extra, more].concat();
+        run_ok(cmd(sub, 512, &format!("{tag}-once"), &flags(&[])));
+        run_ok(cmd(sub, 256, &format!("{tag}-256"), &[flags(&[]), vec!["--checkpoint", ck]].concat()));
+        run_ok(cmd(sub, 512, &format!("{tag}-512"), &[flags(&[]), vec!["--resume", ck]].concat()));
+        assert_same_image(&d.join(format!("{tag}-once")), &d.join(format!("{tag}-512")));
+        let (_, _, meta) = image(&d.join(format!("{tag}-512")));
+        assert_eq!(meta.get("strata.spp").map(String::as_str), Some("512"));
+        if tag == "reference" {
+            // Every replica extended: 8 of 64 spp (`checkpoint::read_replicas` reads them back
+            // in `checkpoint/format.rs`'s tests).
+            assert_eq!(meta.get("strata.replicas").map(String::as_str), Some("8"), "{meta:?}");
+            assert_eq!(meta.get("strata.replica_spp").map(String::as_str), Some("64"), "{meta:?}");
+        } else {
+            assert_eq!(held(Path::new(ck)), 0..512, "the checkpoint holds the extended render");
+        }
+    }
+    // Every progressive sampler, by a count that is no power of two, twice.
+    for sampler in ["independent", "halton", "pmj02"] {
+        let ck = d.join(format!("{sampler}.ckpt"));
+        let ck = ck.to_str().unwrap();
+        run_ok(cmd("render", 40, &format!("{sampler}-once"), &["--sampler", sampler]));
+        run_ok(cmd("render", 12, &format!("{sampler}-12"), &["--sampler", sampler, "--checkpoint", ck]));
+        run_ok(cmd("render", 24, &format!("{sampler}-24"), &["--sampler", sampler, "--resume", ck]));
+        run_ok(cmd("render", 40, &format!("{sampler}-40"), &["--sampler", sampler, "--resume", ck]));
+        assert_same_image(&d.join(format!("{sampler}-once")), &d.join(format!("{sampler}-40")));
+    }
+    // Only spp may grow: fewer spp, or more spp with another option, is refused as before.
+    let ck = d.join("render.ckpt");
+    let ck = ck.to_str().unwrap();
+    let e = run_err(cmd("render", 256, "x", &["--sampler", "sobol", "--resume", ck]));
+    assert!(e.contains("cannot resume") && e.contains("spp 512 (this render: 256)"), "{e}");
+    let e = run_err(cmd("render", 1024, "x", &["--sampler", "sobol", "--light-sampler", "halton", "--resume", ck]));
+    assert!(e.contains(r#"light_sampler "sobol" (this render: "halton")"#), "{e}");
+    assert!(e.contains("spp 512 (this render: 1024)"), "{e}");
+    // A reference's checkpoint keeps its replicas: fewer is refused, naming them.
+    let ck = d.join("reference.ckpt");
+    let e = run_err(cmd(
+        "reference",
+        512,
+        "x",
+        &["--sampler", "sobol", "--replicas", "4", "--resume", ck.to_str().unwrap()],
+    ));
+    assert!(e.contains("holds 8 replicas, more than --replicas 4"), "{e}");
+    // Count-bound layouts refuse, naming the layout and why.
+    for (flags, name) in [
+        (&["--sampler", "stratified"][..], "`stratified`"),
+        (&["--sampler", "sobol", "--pixel-sampler", "zsobol"][..], "`zsobol`"),
+        (&["--sampler", "sobol", "--light-sampler", "grid-center"][..], "`grid-center`"),
+    ] {
+        let ck = d.join("bound.ckpt");
+        let ck = ck.to_str().unwrap();
+        run_ok(cmd("render", 16, "bound", &[flags, &["--checkpoint", ck]].concat()));
+        let e = run_err(cmd("render", 32, "bound", &[flags, &["--resume", ck]].concat()));
+        assert!(e.contains("cannot extend it from 16 to 32 spp") && e.contains(name), "{e}");
+        assert!(e.contains("total count") && e.contains("render 32 spp afresh"), "{e}");
+        std::fs::remove_file(ck).unwrap();
+    }
+    // A point set that is not progressive (a 144-point Fibonacci lattice) is used in whole sets.
+    let fib = d.join("fib144.txt");
+    let text: String =
+        (0..144).map(|i| format!("{} {}\n", f64::from(i) / 144.0, f64::from(i * 89 % 144) / 144.0)).collect();
+    std::fs::write(&fib, text).unwrap();
+    let spec = format!("file:{}", fib.display());
+    let ck = d.join("fib.ckpt");
+    let ck = ck.to_str().unwrap();
+    run_ok(cmd("render", 16, "fib", &["--sampler", "sobol", "--pixel-sampler", &spec, "--checkpoint", ck]));
+    let e = run_err(cmd("render", 32, "fib", &["--sampler", "sobol", "--pixel-sampler", &spec, "--resume", ck]));
+    assert!(e.contains("cannot extend") && e.contains("not progressive") && e.contains("144 points"), "{e}");
+    std::fs::remove_dir_all(&d).ok();
 }

@@ -33,6 +33,11 @@ fn render_default_scene_writes_exr_png_and_stats() {
     assert_eq!(j["rays"]["camera"], 64 * 48 * 2);
     assert!(j["rays"]["shadow"].as_u64().unwrap() > 0);
     assert_eq!(j["nonfinite_samples"], 0);
+    // Issue 31: the process's CPU time over the passes and the share of it outside the tiles.
+    let (process, tiles) = (j["process_cpu_seconds"].as_f64().unwrap(), j["cpu_seconds"].as_f64().unwrap());
+    assert!(process > 0.0 && tiles > 0.0, "{j}");
+    let share = j["overhead_share"].as_f64().unwrap();
+    assert!((0.0..1.0).contains(&share), "{j}");
     let img = strata::film::read_exr(&d.join("img.exr")).unwrap();
     assert_eq!((img.width, img.height), (64, 48));
     assert!(img.variance.is_some());

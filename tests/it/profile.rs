@@ -266,8 +266,12 @@ fn compare_profile_has_one_entry_and_bar_per_variant() {
     let list = v.as_array().unwrap();
     assert_eq!(list.iter().map(|e| e["variant"].as_str().unwrap()).collect::<Vec<_>>(), ["strat", "indep"]);
     for e in list {
-        // 2 runs at 1 spp and 2 at 2 spp: 6 samples per pixel in all.
-        assert_eq!(e["samples"].as_u64(), Some(24 * 16 * 6));
+        // The runs are timed unprofiled; one profiled render per step (at its spp below 16):
+        // 1 + 2 samples per pixel in all.
+        assert_eq!(e["samples"].as_u64(), Some(24 * 16 * 3));
+        // What the profiler costs against the runs, and the runs' share outside the tiles.
+        assert!(e["overhead"].as_f64().is_some() && e["cpu_seconds_unprofiled"].as_f64().unwrap() > 0.0, "{e}");
+        assert!((0.0..1.0).contains(&e["overhead_share"].as_f64().unwrap()), "{e}");
         assert!(e["phases"]
             .as_array()
             .unwrap()

@@ -5,6 +5,7 @@ use super::*;
 use crate::camera::FirstSample;
 use crate::film::Film;
 use crate::sampler::SamplerKind;
+use crate::session::pass::render_passes;
 
 /// The three scenes of the check: direct lighting (one light, three lights) and the path tracer.
 const SCENES: [&str; 3] = ["cornell.test", "three_lights.test", "cornell_diffuse_path.test"];
