@@ -67,6 +67,7 @@ registry! {
     roughconductor: RoughConductor,
     roughdielectric: RoughDielectric,
     roughplastic: RoughPlastic,
+    mask: Mask,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

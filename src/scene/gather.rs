@@ -51,6 +51,9 @@ pub struct SurfaceHit8 {
     /// hit lanes that hit the back of the surface (the normals were flipped to face the ray);
     /// filled only in scenes with registry BSDFs
     pub back: Mask8,
+    /// where textures are evaluated at the hit (uv, triangle, barycentrics); filled only in
+    /// scenes with textured BSDF parameters (`Scene::param_textures`)
+    pub tex: crate::texture::TexQuery8,
 }
 
 impl SurfaceHit8 {
@@ -73,6 +76,7 @@ impl SurfaceHit8 {
         light: U8::MAX,
         material: U8::ZERO,
         back: F8::ZERO,
+        tex: crate::texture::TexQuery8 { u: F8::ZERO, v: F8::ZERO, tri: U8::MAX, b1: F8::ZERO, b2: F8::ZERO },
     };
 }
 

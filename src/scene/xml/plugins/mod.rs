@@ -16,6 +16,7 @@ mod envmap;
 mod hdrfilm;
 mod instance;
 mod integrator_moment;
+mod mask;
 mod obj;
 mod orthographic;
 mod path;
@@ -129,10 +130,10 @@ pub const PLUGINS: &[Plugin] = &[
     thindielectric::PLUGIN,
     plastic::PLUGIN,
     roughplastic::PLUGIN,
+    mask::PLUGIN,
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
     refused("bsdf", "blendbsdf", BSDFS),
-    refused("bsdf", "mask", BSDFS),
     refused("bsdf", "bumpmap", BSDFS),
     refused("bsdf", "normalmap", BSDFS),
     refused("bsdf", "null", BSDFS),
@@ -180,6 +181,8 @@ pub struct Build<'e> {
     textures: HashMap<usize, u32>,
     /// the reflectance texture of the material the last BSDF plugin made, if textured
     pub pending_texture: Option<u32>,
+    /// the textured BSDF parameters of the material the last BSDF plugin made
+    pub pending_params: Vec<(crate::bsdf::interface::Slot, u32)>,
 }
 
 impl<'e> Build<'e> {
@@ -201,6 +204,7 @@ impl<'e> Build<'e> {
             materials: HashMap::new(),
             textures: HashMap::new(),
             pending_texture: None,
+            pending_params: Vec::new(),
         }
     }
 
@@ -211,8 +215,13 @@ impl<'e> Build<'e> {
 
     /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
     /// once; `SceneDesc::diffuse_textures` stays empty until a material is textured).
-    pub fn intern(&mut self, m: Material, texture: Option<u32>) -> u32 {
-        let key = format!("{m:?}|{texture:?}");
+    pub fn intern(
+        &mut self,
+        m: Material,
+        texture: Option<u32>,
+        params: Vec<(crate::bsdf::interface::Slot, u32)>,
+    ) -> u32 {
+        let key = format!("{m:?}|{texture:?}|{params:?}");
         let n = self.desc.materials.len() as u32;
         let i = *self.materials.entry(key).or_insert_with(|| {
             self.desc.materials.push(m);
@@ -223,7 +232,21 @@ impl<'e> Build<'e> {
             slots.resize(slots.len().max(i as usize + 1), None);
             slots[i as usize] = Some(t);
         }
+        if !params.is_empty() {
+            let slots = &mut self.desc.param_textures;
+            slots.resize(slots.len().max(i as usize + 1), Vec::new());
+            slots[i as usize] = params;
+        }
         i
+    }
+
+    /// A BSDF parameter `slot` given per hit by the texture `t` (a `<texture>` element) of the
+    /// material being made; returns the texture's index.
+    pub fn texture_param(&mut self, slot: crate::bsdf::interface::Slot, t: &'e Elem) -> Result<u32, SceneError> {
+        let i = self.texture(t)?;
+        self.pending_params.retain(|(s, _)| *s != slot);
+        self.pending_params.push((slot, i));
+        Ok(i)
     }
 
     /// The index in `SceneDesc::textures` of the `<texture>` element `e` (built once per element).
@@ -298,18 +321,20 @@ impl<'e> Build<'e> {
             _ => return Err(e.at.err(format!("{} is not a shape", e.what()))),
         };
         self.pending_texture = None;
+        self.pending_params.clear();
         let material = match props.object("bsdf")? {
             Some(b) => self.bsdf(b)?,
             None => diffuse::default_material(),
         };
         let texture = self.pending_texture.take();
+        let params = std::mem::take(&mut self.pending_params);
         let emitter = match props.object("emitter")? {
             Some(em) => Some((self.area(em)?, em.at.clone())),
             None => None,
         };
         props.ignore("id");
         self.warnings.extend(props.unused());
-        Ok((out, self.intern(material, texture), emitter))
+        Ok((out, self.intern(material, texture, params), emitter))
     }
 
     /// The file named by the plugin's `filename` string, resolved.
