@@ -86,3 +86,7 @@ pub fn sample_x8(opacity: F8, null: Mask8, wo: Vec3x8, s: Sample8) -> Sample8 {
 
 /// Largest f32 below 1.
 const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
+
+#[cfg(test)]
+#[path = "mask_tests.rs"]
+mod tests;

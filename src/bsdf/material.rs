@@ -195,7 +195,7 @@ impl Material8 {
     }
 
     /// [`Material8::eval_pdf_k`] without the mask: the nested BSDF of every lane.
-    #[inline]
+    #[inline(always)]
     fn eval_pdf_nested_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,
@@ -279,7 +279,7 @@ impl Material8 {
     }
 
     /// [`Material8::sample_bsdf_k`] without the mask: the nested BSDF of every lane.
-    #[inline]
+    #[inline(always)]
     fn sample_nested_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,
@@ -331,7 +331,7 @@ impl Material8 {
     /// [`Material8::sample`] compiled for the lobe set `L` a scene has: bit-identical to it on lanes
     /// that satisfy the [`super::Lobes`] promise of `L`. The course lanes' nested material: a mask
     /// is applied by [`Material8::sample_bsdf_k`].
-    #[inline]
+    #[inline(always)]
     pub fn sample_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,

@@ -68,6 +68,7 @@ registry! {
     roughdielectric: RoughDielectric,
     roughplastic: RoughPlastic,
     mask: Mask,
+    blendbsdf: BlendBsdf,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

@@ -12,11 +12,6 @@ use crate::scene::xml::props::{Color, Props};
 /// Registry entry.
 pub const PLUGIN: Plugin = Plugin { tag: "bsdf", kind: "mask", run: Run::Bsdf(run) };
 
-/// Mitsuba's luminance of a linear RGB value (what a scalar texture reads from a colour).
-pub fn luminance(c: glam::Vec3) -> f32 {
-    c.x * 0.212_671 + c.y * 0.715_160 + c.z * 0.072_169
-}
-
 /// Largest f32 below 1.
 const ONE_MINUS: f32 = 1.0 - f32::EPSILON / 2.0;
 
@@ -29,7 +24,7 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     let opacity = match p.color("opacity", false)? {
         None => 0.5,
         Some(Color::Rgb(c)) => {
-            let o = if c.x == c.y && c.y == c.z { c.x } else { luminance(c) };
+            let o = if c.x == c.y && c.y == c.z { c.x } else { crate::texture::luminance(c) };
             if !o.is_finite() {
                 let at = p.get("opacity").map_or(&p.elem.at, |e| &e.at);
                 return Err(at.err(format!("{}: \"opacity\" must be finite, not {o}", p.elem.what())));
@@ -39,7 +34,7 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
         Some(Color::Texture(t)) => {
             let i = b.texture_param(Slot::Opacity, t)?;
             let mean = b.desc.textures[i as usize].mean();
-            luminance(mean).clamp(0.0, ONE_MINUS)
+            crate::texture::luminance(mean).clamp(0.0, ONE_MINUS)
         }
     };
     let mut m = b.bsdf(one)?;

@@ -3,6 +3,7 @@
 //! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
 
 mod area;
+mod blendbsdf;
 mod conductor;
 mod constant;
 mod cube;
@@ -47,6 +48,7 @@ mod twosided;
 use super::doc::{Elem, Loc};
 use super::props::{Color, Props};
 use super::shape::ShapeOut;
+use crate::bsdf::interface::Slot;
 use crate::scene::desc::{EnvironmentDesc, Material, RgbImage, SceneDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
@@ -131,9 +133,9 @@ pub const PLUGINS: &[Plugin] = &[
     plastic::PLUGIN,
     roughplastic::PLUGIN,
     mask::PLUGIN,
+    blendbsdf::PLUGIN,
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
-    refused("bsdf", "blendbsdf", BSDFS),
     refused("bsdf", "bumpmap", BSDFS),
     refused("bsdf", "normalmap", BSDFS),
     refused("bsdf", "null", BSDFS),
@@ -182,7 +184,7 @@ pub struct Build<'e> {
     /// the reflectance texture of the material the last BSDF plugin made, if textured
     pub pending_texture: Option<u32>,
     /// the textured BSDF parameters of the material the last BSDF plugin made
-    pub pending_params: Vec<(crate::bsdf::interface::Slot, u32)>,
+    pub pending_params: Vec<(Slot, u32)>,
 }
 
 impl<'e> Build<'e> {
@@ -215,12 +217,7 @@ impl<'e> Build<'e> {
 
     /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
     /// once; `SceneDesc::diffuse_textures` stays empty until a material is textured).
-    pub fn intern(
-        &mut self,
-        m: Material,
-        texture: Option<u32>,
-        params: Vec<(crate::bsdf::interface::Slot, u32)>,
-    ) -> u32 {
+    pub fn intern(&mut self, m: Material, texture: Option<u32>, params: Vec<(Slot, u32)>) -> u32 {
         let key = format!("{m:?}|{texture:?}|{params:?}");
         let n = self.desc.materials.len() as u32;
         let i = *self.materials.entry(key).or_insert_with(|| {
@@ -242,11 +239,46 @@ impl<'e> Build<'e> {
 
     /// A BSDF parameter `slot` given per hit by the texture `t` (a `<texture>` element) of the
     /// material being made; returns the texture's index.
-    pub fn texture_param(&mut self, slot: crate::bsdf::interface::Slot, t: &'e Elem) -> Result<u32, SceneError> {
+    pub fn texture_param(&mut self, slot: Slot, t: &'e Elem) -> Result<u32, SceneError> {
         let i = self.texture(t)?;
         self.pending_params.retain(|(s, _)| *s != slot);
         self.pending_params.push((slot, i));
         Ok(i)
+    }
+
+    /// Colour property `name` of a BSDF where Mitsuba allows a texture: the constant (`default`
+    /// when absent), or the mean of a texture that gives the row's `slot` per hit.
+    pub fn color_param(&mut self, p: &Props<'e>, name: &str, default: Vec3, slot: Slot) -> Result<Vec3, SceneError> {
+        match p.color(name, false)? {
+            None => Ok(default),
+            Some(Color::Rgb(c)) => Ok(c),
+            Some(Color::Texture(t)) => {
+                let i = self.texture_param(slot, t)?;
+                Ok(self.desc.textures[i as usize].mean())
+            }
+        }
+    }
+
+    /// Float property `name` of a BSDF where Mitsuba allows a texture: the float (`default` when
+    /// absent), or the mean luminance of a texture that gives the row's `slot` per hit
+    /// (`slot` None: a texture is refused, naming the property).
+    pub fn float_param(
+        &mut self,
+        p: &Props<'e>,
+        name: &str,
+        default: f32,
+        slot: Option<Slot>,
+    ) -> Result<f32, SceneError> {
+        match p.get(name) {
+            Some(t) if t.tag == "texture" => match slot {
+                Some(slot) => {
+                    let i = self.texture_param(slot, t)?;
+                    Ok(crate::texture::luminance(self.desc.textures[i as usize].mean()))
+                }
+                None => Err(t.at.err(format!("{}: a texture for \"{name}\" is not supported", p.elem.what()))),
+            },
+            _ => p.float(name, default),
+        }
     }
 
     /// The index in `SceneDesc::textures` of the `<texture>` element `e` (built once per element).
