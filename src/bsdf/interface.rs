@@ -55,6 +55,24 @@ pub mod flags {
     pub const GLOSSY_REFLECTION: u32 = REFLECTION | GLOSSY;
     /// glossy transmission
     pub const GLOSSY_TRANSMISSION: u32 = TRANSMISSION | GLOSSY;
+    /// Mitsuba's null lobe: the ray continues unchanged (`wi = -wo`, weight 1); sampled with
+    /// [`DELTA`] and [`TRANSMISSION`], so integrators treat it as a delta transmission (it is a
+    /// vertex of the path: it counts towards the depth, as in Mitsuba's path tracer)
+    pub const NULL: u32 = 32;
+    /// a null sample's flags
+    pub const NULL_TRANSMISSION: u32 = NULL | DELTA | TRANSMISSION;
+}
+
+/// A parameter of a BSDF row that a texture can give per hit (the scene evaluates the texture
+/// at the hit and writes the lane's slot, `scene/texturing.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Slot {
+    /// [`BsdfParams::color`]`[i]`
+    Color(u8),
+    /// [`BsdfParams::scalar`]`[i]` (a colour texture's luminance)
+    Scalar(u8),
+    /// [`BsdfParams::opacity`] (luminance, clamped to [0, 1])
+    Opacity,
 }
 
 /// Colour parameter slots of a BSDF row.
@@ -78,11 +96,20 @@ pub struct BsdfParams {
     pub color: [Vec3; COLORS],
     /// scalar slots
     pub scalar: [f32; SCALARS],
+    /// Mitsuba's `mask` around the BSDF: the probability in [0, 1] that a hit scatters (1:
+    /// opaque, the BSDF alone); with 1 - opacity the ray passes unchanged (`bsdf::mask`)
+    pub opacity: f32,
 }
 
 impl BsdfParams {
     /// The course's material (two-sided, slots unused).
-    pub const COURSE: Self = Self { kind: COURSE, twosided: true, color: [Vec3::ZERO; COLORS], scalar: [0.0; SCALARS] };
+    pub const COURSE: Self =
+        Self { kind: COURSE, twosided: true, color: [Vec3::ZERO; COLORS], scalar: [0.0; SCALARS], opacity: 1.0 };
+
+    /// A one-sided, opaque row of BSDF `kind` with the given slots.
+    pub const fn new(kind: u32, color: [Vec3; COLORS], scalar: [f32; SCALARS]) -> Self {
+        Self { kind, twosided: false, color, scalar, opacity: 1.0 }
+    }
 }
 
 impl Default for BsdfParams {
@@ -103,12 +130,19 @@ pub struct Params8 {
     pub color: [Vec3x8; COLORS],
     /// scalar slots
     pub scalar: [F8; SCALARS],
+    /// [`BsdfParams::opacity`] per lane
+    pub opacity: F8,
 }
 
 impl Params8 {
     /// The course's material in every lane.
-    pub const COURSE: Self =
-        Self { kind: U8::ZERO, twosided: F8::ZERO, color: [Vec3x8::ZERO; COLORS], scalar: [F8::ZERO; SCALARS] };
+    pub const COURSE: Self = Self {
+        kind: U8::ZERO,
+        twosided: F8::ZERO,
+        color: [Vec3x8::ZERO; COLORS],
+        scalar: [F8::ZERO; SCALARS],
+        opacity: F8::ONE,
+    };
 
     /// One row in every lane.
     #[inline]
@@ -118,6 +152,7 @@ impl Params8 {
             twosided: crate::simd::mask_from_bools([p.twosided; 8]),
             color: p.color.map(Vec3x8::splat),
             scalar: p.scalar.map(F8::splat),
+            opacity: F8::splat(p.opacity),
         }
     }
 
@@ -128,6 +163,7 @@ impl Params8 {
             twosided: crate::simd::mask_from_bools(p.map(|p| p.twosided)),
             color: std::array::from_fn(|c| Vec3x8::from_lanes(p.map(|p| p.color[c]))),
             scalar: std::array::from_fn(|c| F8::new(p.map(|p| p.scalar[c]))),
+            opacity: F8::new(p.map(|p| p.opacity)),
         }
     }
 

@@ -165,7 +165,8 @@ impl<B: BsdfSet> LobeSet for WithBsdfs<B> {
         wi
     }
     fn used_by(m: &crate::bsdf::desc::Material) -> u32 {
-        B::bit_of(m.bsdf.kind)
+        let mask = if super::mask::masked(&m.bsdf) { B::bit_of(<super::Mask as super::Bsdf>::ID) } else { 0 };
+        B::bit_of(m.bsdf.kind) | mask
     }
     fn names(bits: u32, out: &mut Vec<&'static str>) {
         B::names(bits, out)

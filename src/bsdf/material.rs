@@ -5,6 +5,8 @@
 
 use super::interface::{self, BsdfSet, Params8, Sample8, COURSE};
 use super::lobe::{AllLobes, LobeSet};
+use super::mask::{self, Mask};
+use super::Bsdf as _;
 use super::{diffuse, BrdfKind, ImportanceSampling};
 use crate::sampling::{fmadd, sample_uniform_hemisphere, sample_uniform_hemisphere_x8};
 use crate::sampling::{uniform_hemisphere_pdf, uniform_hemisphere_pdf_x8};
@@ -160,9 +162,41 @@ impl Material8 {
 
     /// [`Material8::eval_pdf`] compiled for the lobe set `L` a scene has: bit-identical to it on
     /// lanes that satisfy the [`super::Lobes`] promise of `L`. Only the lobes present among the active
-    /// lanes are evaluated.
+    /// lanes are evaluated. Masked lanes (opacity below 1, kernels with [`Mask`] only) scale both
+    /// by their opacity (`bsdf::mask`).
     #[inline]
     pub fn eval_pdf_k<L: LobeSet>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        wi: Vec3x8,
+        active: Mask8,
+    ) -> (Vec3x8, F8) {
+        let r = self.eval_pdf_nested_k::<L>(strategy, wo, wi, active);
+        if Self::masks::<L>() {
+            let masked = self.masked(active);
+            if masked.any() {
+                return mask::eval_pdf_x8(self.bsdf.opacity, masked, r);
+            }
+        }
+        r
+    }
+
+    /// Whether kernels of `L` compile masks in.
+    #[inline(always)]
+    fn masks<L: LobeSet>() -> bool {
+        <L::Bsdfs as BsdfSet>::BITS & interface::bit(Mask::ID) != 0
+    }
+
+    /// The `active` lanes whose opacity is below 1.
+    #[inline]
+    fn masked(&self, active: Mask8) -> Mask8 {
+        active & self.bsdf.opacity.simd_lt(F8::ONE)
+    }
+
+    /// [`Material8::eval_pdf_k`] without the mask: the nested BSDF of every lane.
+    #[inline(always)]
+    fn eval_pdf_nested_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,
         wo: Vec3x8,
@@ -198,9 +232,55 @@ impl Material8 {
 
     /// [`Material8::sample_k`] with the registry BSDFs of `L`: course lanes as `sample_k` (under
     /// `strategy`), the others through the BSDF interface (their own sampling, `u_lobe` picking the
-    /// lobe; `strategy` does not apply).
+    /// lobe; `strategy` does not apply). Masked lanes (kernels with [`Mask`] only) first choose
+    /// between the nested BSDF and the null lobe by `u_lobe` (`bsdf::mask`: the null lanes come
+    /// back as `general` lanes with the null sample; the nested ones with the nested sample, its
+    /// pdf not scaled by the opacity, as Mitsuba's).
     #[inline]
     pub fn sample_bsdf_k<L: LobeSet>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        u: [F8; 2],
+        u_lobe: F8,
+        active: Mask8,
+    ) -> Sampled8 {
+        if Self::masks::<L>() {
+            let masked = self.masked(active);
+            if masked.any() {
+                return self.sample_masked_k::<L>(strategy, wo, u, u_lobe, active, masked);
+            }
+        }
+        self.sample_nested_k::<L>(strategy, wo, u, u_lobe, active)
+    }
+
+    /// [`Material8::sample_bsdf_k`] on a packet with `masked` lanes (out of line: scenes with
+    /// masks only).
+    #[inline(never)]
+    fn sample_masked_k<L: LobeSet>(
+        &self,
+        strategy: ImportanceSampling,
+        wo: Vec3x8,
+        u: [F8; 2],
+        u_lobe: F8,
+        active: Mask8,
+        masked: Mask8,
+    ) -> Sampled8 {
+        let opacity = self.bsdf.opacity;
+        let (nested, u_lobe) = mask::choose_x8(opacity, masked, u_lobe);
+        let mut s = self.sample_nested_k::<L>(strategy, wo, u, u_lobe, active & nested);
+        let null = active & !nested;
+        s.bsdf = mask::sample_x8(opacity, null, wo, s.bsdf);
+        s.wi = Vec3x8::select(null, s.bsdf.wi, s.wi);
+        s.pdf = null.select(s.bsdf.pdf, s.pdf);
+        s.f = Vec3x8::select(null, Vec3x8::ZERO, s.f);
+        s.general |= null;
+        s
+    }
+
+    /// [`Material8::sample_bsdf_k`] without the mask: the nested BSDF of every lane.
+    #[inline(always)]
+    fn sample_nested_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,
         wo: Vec3x8,
@@ -249,8 +329,9 @@ impl Material8 {
     }
 
     /// [`Material8::sample`] compiled for the lobe set `L` a scene has: bit-identical to it on lanes
-    /// that satisfy the [`super::Lobes`] promise of `L`.
-    #[inline]
+    /// that satisfy the [`super::Lobes`] promise of `L`. The course lanes' nested material: a mask
+    /// is applied by [`Material8::sample_bsdf_k`].
+    #[inline(always)]
     pub fn sample_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,
@@ -267,7 +348,7 @@ impl Material8 {
                 L::sample_x8(self, wo, u, spec, diffuse::sample_x8(u, active & !spec))
             }
         };
-        let (f, pdf) = self.eval_pdf_k::<L>(strategy, wo, wi, active);
+        let (f, pdf) = self.eval_pdf_nested_k::<L>(strategy, wo, wi, active);
         (wi, pdf, f)
     }
 }

@@ -67,6 +67,8 @@ registry! {
     roughconductor: RoughConductor,
     roughdielectric: RoughDielectric,
     roughplastic: RoughPlastic,
+    mask: Mask,
+    blendbsdf: BlendBsdf,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

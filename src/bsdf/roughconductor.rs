@@ -113,5 +113,6 @@ pub fn params(
         twosided: false,
         color: [eta, k, specular],
         scalar: [alpha_u, alpha_v, kind.code(sample_visible), 0.0],
+        opacity: 1.0,
     }
 }

@@ -143,6 +143,7 @@ pub fn params(
         twosided: false,
         color: [reflectance, transmittance, Vec3::ZERO],
         scalar: [eta, alpha_u, alpha_v, kind.code(sample_visible)],
+        opacity: 1.0,
     }
 }
 

@@ -217,6 +217,7 @@ pub fn params(
         twosided: false,
         color: [diff, specular, Vec3::new(id as f32, 0.0, 0.0)],
         scalar: [eta, alpha, kind.code(sample_visible), w],
+        opacity: 1.0,
     }
 }
 

@@ -107,7 +107,11 @@ pub(super) fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
 #[inline]
 pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8 {
     let bsdf = if <L::Bsdfs as BsdfSet>::BITS != 0 {
-        scene.bsdf_params(sh.material, sh.valid)
+        let mut p = scene.bsdf_params(sh.material, sh.valid);
+        if !scene.param_textures.is_empty() {
+            scene.texture_params(sh, sh.valid, &mut p);
+        }
+        p
     } else {
         crate::bsdf::Params8::COURSE
     };

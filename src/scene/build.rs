@@ -251,6 +251,10 @@ pub struct Scene {
     /// [`super::texturing::NO_TEXTURE`]; empty when no material is textured (then gather reads
     /// no texture and builds no uv)
     pub material_texture: Vec<u32>,
+    /// per material: its textured BSDF parameters (`SceneDesc::param_textures`); empty when no
+    /// material has one (then no hit evaluates them); `material_texture` is filled whenever this
+    /// is (hits then carry their texture query, [`SurfaceHit8::tex`])
+    pub param_textures: Vec<Vec<(crate::bsdf::interface::Slot, u32)>>,
     /// some material is a registry BSDF (not the course's): hits then carry material ids and
     /// sides ([`SurfaceHit8::material`], [`SurfaceHit8::back`]), which only such BSDFs read
     pub registry_bsdfs: bool,
@@ -392,7 +396,8 @@ type TexturingTables = (Vec<crate::texture::Texture>, Vec<u32>);
 /// `n_materials` scene materials, or `None` when no material is textured.
 fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<TexturingTables>, BuildError> {
     use crate::texture::{AttrRun, Texture};
-    if desc.diffuse_textures.iter().all(Option::is_none) {
+    let params = desc.param_textures.iter().any(|p| !p.is_empty());
+    if desc.diffuse_textures.iter().all(Option::is_none) && !params {
         return Ok(None);
     }
     let mut material_texture = vec![super::texturing::NO_TEXTURE; n_materials];
@@ -403,6 +408,12 @@ fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<Textu
             return Err(BuildError::TextureIndex { path, material: m, texture: t, count });
         }
         material_texture[m] = t;
+    }
+    for (m, p) in desc.param_textures.iter().enumerate() {
+        if let Some(&(_, t)) = p.iter().find(|(_, t)| *t as usize >= desc.textures.len()) {
+            let (path, count) = (desc.source.clone(), desc.textures.len());
+            return Err(BuildError::TextureIndex { path, material: m, texture: t, count });
+        }
     }
     let runs = || {
         desc.triangle_attrs.iter().map(|a| {
@@ -629,7 +640,16 @@ impl Scene {
             tri_source.resize(indices.len(), crate::texture::NO_TRIANGLE);
         }
         let (textures, material_texture) = texturing.unwrap_or_default();
-        let registry_bsdfs = materials.iter().any(|m| m.bsdf.kind != crate::bsdf::interface::COURSE);
+        let param_textures = if desc.param_textures.iter().any(|p| !p.is_empty()) {
+            let mut t = desc.param_textures.clone();
+            t.resize(materials.len(), Vec::new());
+            t
+        } else {
+            Vec::new()
+        };
+        let registry_bsdfs = materials
+            .iter()
+            .any(|m| m.bsdf.kind != crate::bsdf::interface::COURSE || crate::bsdf::mask::masked(&m.bsdf));
         Ok(Self {
             desc,
             camera,
@@ -645,6 +665,7 @@ impl Scene {
             tri_corner_normals,
             textures,
             material_texture,
+            param_textures,
             registry_bsdfs,
             tri_uv,
             tri_source,

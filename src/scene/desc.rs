@@ -248,6 +248,10 @@ pub struct SceneDesc {
     /// own `diffuse` should still be a representative nonzero value (e.g. the texture's mean):
     /// only hits read the texture
     pub diffuse_textures: Vec<Option<u32>>,
+    /// per material index: the textures that give BSDF parameters at hits (a slot of the
+    /// material's `bsdf` row and the texture's index; the row keeps a representative value). The
+    /// table may be shorter than `materials`; empty: none
+    pub param_textures: Vec<Vec<(crate::bsdf::interface::Slot, u32)>>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -439,6 +443,14 @@ impl SceneDesc {
             self.textures.iter().for_each(|t| t.digest(&mut |w| h.word(w)));
             self.diffuse_textures.iter().for_each(|t| h.word(t.unwrap_or(u32::MAX)));
         }
+        if self.param_textures.iter().any(|p| !p.is_empty()) {
+            h.word(0x7061_7200);
+            for (m, params) in self.param_textures.iter().enumerate() {
+                for (slot, t) in params {
+                    let _ = std::fmt::Write::write_str(&mut h, &format!("{m}:{slot:?}:{t};"));
+                }
+            }
+        }
         h.0
     }
 }
@@ -474,6 +486,7 @@ impl Default for SceneDesc {
             triangle_attrs: Vec::new(),
             textures: Vec::new(),
             diffuse_textures: Vec::new(),
+            param_textures: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
             environment: None,

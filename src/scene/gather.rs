@@ -51,6 +51,9 @@ pub struct SurfaceHit8 {
     /// hit lanes that hit the back of the surface (the normals were flipped to face the ray);
     /// filled only in scenes with registry BSDFs
     pub back: Mask8,
+    /// where textures are evaluated at the hit (uv, triangle, barycentrics); filled only in
+    /// scenes with textured BSDF parameters (`Scene::param_textures`)
+    pub tex: crate::texture::TexQuery8,
 }
 
 impl SurfaceHit8 {
@@ -73,6 +76,7 @@ impl SurfaceHit8 {
         light: U8::MAX,
         material: U8::ZERO,
         back: F8::ZERO,
+        tex: crate::texture::TexQuery8 { u: F8::ZERO, v: F8::ZERO, tri: U8::MAX, b1: F8::ZERO, b2: F8::ZERO },
     };
 }
 
@@ -102,7 +106,12 @@ impl Scene {
         let bits = valid.to_bitmask();
         if bits == 0 {
             // No lane hit: the miss record (what the lane loop below gives every missed lane).
-            *out = SurfaceHit8 { p, wo: -dir, ..SurfaceHit8::MISS };
+            // (`tex` is left as it is: no lane reads it.)
+            let m = &SurfaceHit8::MISS;
+            (out.valid, out.p, out.n, out.ng, out.smooth, out.wo) = (m.valid, p, m.n, m.ng, m.smooth, -dir);
+            (out.kd, out.ks, out.shininess, out.roughness, out.ggx) = (m.kd, m.ks, m.shininess, m.roughness, m.ggx);
+            (out.emitted, out.ambient, out.le, out.light) = (m.emitted, m.ambient, m.le, m.light);
+            (out.material, out.back) = (m.material, m.back);
             return;
         }
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());

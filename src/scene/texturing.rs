@@ -70,14 +70,18 @@ impl Scene {
                 }
                 _ => continue,
             };
+            (u[i], v[i], tri[i]) = (uv.x, uv.y, t);
             let Some(t_idx) = self.texture_of(m) else { continue };
-            (tex[i], u[i], v[i], tri[i]) = (t_idx, uv.x, uv.y, t);
+            tex[i] = t_idx;
+        }
+        let q = TexQuery8 { u: F8::new(u), v: F8::new(v), tri: U8::new(tri), b1: hits.u, b2: hits.v };
+        if !self.param_textures.is_empty() {
+            out.tex = q;
         }
         let mut todo: u32 = (0..8).filter(|&i| tex[i] != NO_TEXTURE).map(|i| 1u32 << i).sum();
         if todo == 0 {
             return;
         }
-        let q = TexQuery8 { u: F8::new(u), v: F8::new(v), tri: U8::new(tri), b1: hits.u, b2: hits.v };
         let mut kd = out.kd;
         while todo != 0 {
             let t = tex[todo.trailing_zeros() as usize];
@@ -87,6 +91,46 @@ impl Scene {
             todo &= !(0..8).filter(|&i| lanes[i]).map(|i| 1u32 << i).sum::<u32>();
         }
         out.kd = kd;
+    }
+
+    /// Writes the textured BSDF parameters (`Scene::param_textures`) of the `valid` lanes of
+    /// the hit record `sh` into their rows `p`: one texture evaluation, 8 lanes wide, per
+    /// distinct (slot, texture) of the packet. Colour slots take the texture's RGB, scalar slots
+    /// its luminance (grey: its value), the opacity that clamped to [0, 1]. Scenes without
+    /// textured parameters never call it.
+    #[cold]
+    #[inline(never)]
+    pub fn texture_params(&self, sh: &SurfaceHit8, valid: crate::simd::Mask8, p: &mut crate::bsdf::Params8) {
+        use crate::bsdf::interface::Slot;
+        let (ids, bits) = (sh.material.to_array(), valid.to_bitmask());
+        let mut done: Vec<(Slot, u32)> = Vec::new();
+        for i in super::gather::lanes_of(bits) {
+            let Some(params) = self.param_textures.get(ids[i] as usize) else { continue };
+            for &(slot, t) in params {
+                if done.contains(&(slot, t)) {
+                    continue;
+                }
+                done.push((slot, t));
+                let lanes: [bool; 8] = std::array::from_fn(|j| {
+                    bits & (1 << j) != 0
+                        && self.param_textures.get(ids[j] as usize).is_some_and(|q| q.contains(&(slot, t)))
+                });
+                let m = crate::simd::mask_from_bools(lanes);
+                let value = self.textures[t as usize].eval_x8(&sh.tex);
+                let grey = value.x.simd_eq(value.y) & value.y.simd_eq(value.z);
+                let lum = || {
+                    let l = value.x * F8::splat(0.212_671)
+                        + value.y * F8::splat(0.715_160)
+                        + value.z * F8::splat(0.072_169);
+                    grey.select(value.x, l)
+                };
+                match slot {
+                    Slot::Color(c) => p.color[c as usize] = Vec3x8::select(m, value, p.color[c as usize]),
+                    Slot::Scalar(c) => p.scalar[c as usize] = m.select(lum(), p.scalar[c as usize]),
+                    Slot::Opacity => p.opacity = m.select(lum().max(F8::ZERO).min(F8::ONE), p.opacity),
+                }
+            }
+        }
     }
 }
 

@@ -68,6 +68,12 @@ macro_rules! textures {
     };
 }
 
+/// Mitsuba's luminance of a linear sRGB value (what a scalar parameter reads from a colour
+/// texture: `eval_1`).
+pub fn luminance(c: Vec3) -> f32 {
+    c.x * 0.212_671 + c.y * 0.715_160 + c.z * 0.072_169
+}
+
 impl Texture {
     /// A representative value: a bitmap's texel mean, a checkerboard's two colours averaged, a
     /// constant's value, a mesh attribute's mean over its bound values (times `scale`; 0 before

@@ -3,6 +3,7 @@
 //! `specular_reflectance` (default 1). One-sided (black from the back) unless in a `twosided`.
 
 use super::{Build, Plugin, Run};
+use crate::bsdf::interface::Slot;
 use crate::scene::desc::Material;
 use crate::scene::error::SceneError;
 use crate::scene::xml::props::Props;
@@ -31,9 +32,9 @@ pub fn eta_k(p: &Props) -> Result<(Vec3, Vec3), SceneError> {
     }
 }
 
-fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
     let (eta, k) = eta_k(p)?;
-    let specular = p.rgb_only("specular_reflectance", Vec3::ONE)?;
+    let specular = b.color_param(p, "specular_reflectance", Vec3::ONE, Slot::Color(2))?;
     Ok(super::diffuse::registry_material(crate::bsdf::conductor::params(eta, k, specular)))
 }

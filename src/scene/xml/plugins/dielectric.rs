@@ -3,6 +3,7 @@
 //! `specular_reflectance` and `specular_transmittance` (default 1).
 
 use super::{Build, Plugin, Run};
+use crate::bsdf::interface::Slot;
 use crate::scene::desc::Material;
 use crate::scene::error::SceneError;
 use crate::scene::xml::props::Props;
@@ -16,10 +17,10 @@ pub fn relative_ior(p: &Props) -> Result<f32, SceneError> {
     Ok(p.ior("int_ior", "bk7")? / p.ior("ext_ior", "air")?)
 }
 
-fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
     let eta = relative_ior(p)?;
-    let r = p.rgb_only("specular_reflectance", Vec3::ONE)?;
-    let t = p.rgb_only("specular_transmittance", Vec3::ONE)?;
+    let r = b.color_param(p, "specular_reflectance", Vec3::ONE, Slot::Color(0))?;
+    let t = b.color_param(p, "specular_transmittance", Vec3::ONE, Slot::Color(1))?;
     Ok(super::diffuse::registry_material(crate::bsdf::dielectric::params(eta, r, t)))
 }

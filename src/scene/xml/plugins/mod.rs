@@ -3,6 +3,7 @@
 //! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
 
 mod area;
+mod blendbsdf;
 mod conductor;
 mod constant;
 mod cube;
@@ -16,6 +17,7 @@ mod envmap;
 mod hdrfilm;
 mod instance;
 mod integrator_moment;
+mod mask;
 mod obj;
 mod orthographic;
 mod path;
@@ -47,6 +49,7 @@ mod twosided;
 use super::doc::{Elem, Loc};
 use super::props::{Color, Props};
 use super::shape::ShapeOut;
+use crate::bsdf::interface::Slot;
 use crate::scene::desc::{EnvironmentDesc, Material, RgbImage, SceneDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
@@ -130,10 +133,10 @@ pub const PLUGINS: &[Plugin] = &[
     thindielectric::PLUGIN,
     plastic::PLUGIN,
     roughplastic::PLUGIN,
+    mask::PLUGIN,
+    blendbsdf::PLUGIN,
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
-    refused("bsdf", "blendbsdf", BSDFS),
-    refused("bsdf", "mask", BSDFS),
     refused("bsdf", "bumpmap", BSDFS),
     refused("bsdf", "normalmap", BSDFS),
     refused("bsdf", "null", BSDFS),
@@ -183,6 +186,8 @@ pub struct Build<'e> {
     textures: HashMap<usize, u32>,
     /// the reflectance texture of the material the last BSDF plugin made, if textured
     pub pending_texture: Option<u32>,
+    /// the textured BSDF parameters of the material the last BSDF plugin made
+    pub pending_params: Vec<(Slot, u32)>,
 }
 
 impl<'e> Build<'e> {
@@ -204,6 +209,7 @@ impl<'e> Build<'e> {
             materials: HashMap::new(),
             textures: HashMap::new(),
             pending_texture: None,
+            pending_params: Vec::new(),
         }
     }
 
@@ -214,8 +220,8 @@ impl<'e> Build<'e> {
 
     /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
     /// once; `SceneDesc::diffuse_textures` stays empty until a material is textured).
-    pub fn intern(&mut self, m: Material, texture: Option<u32>) -> u32 {
-        let key = format!("{m:?}|{texture:?}");
+    pub fn intern(&mut self, m: Material, texture: Option<u32>, params: Vec<(Slot, u32)>) -> u32 {
+        let key = format!("{m:?}|{texture:?}|{params:?}");
         let n = self.desc.materials.len() as u32;
         let i = *self.materials.entry(key).or_insert_with(|| {
             self.desc.materials.push(m);
@@ -226,7 +232,56 @@ impl<'e> Build<'e> {
             slots.resize(slots.len().max(i as usize + 1), None);
             slots[i as usize] = Some(t);
         }
+        if !params.is_empty() {
+            let slots = &mut self.desc.param_textures;
+            slots.resize(slots.len().max(i as usize + 1), Vec::new());
+            slots[i as usize] = params;
+        }
         i
+    }
+
+    /// A BSDF parameter `slot` given per hit by the texture `t` (a `<texture>` element) of the
+    /// material being made; returns the texture's index.
+    pub fn texture_param(&mut self, slot: Slot, t: &'e Elem) -> Result<u32, SceneError> {
+        let i = self.texture(t)?;
+        self.pending_params.retain(|(s, _)| *s != slot);
+        self.pending_params.push((slot, i));
+        Ok(i)
+    }
+
+    /// Colour property `name` of a BSDF where Mitsuba allows a texture: the constant (`default`
+    /// when absent), or the mean of a texture that gives the row's `slot` per hit.
+    pub fn color_param(&mut self, p: &Props<'e>, name: &str, default: Vec3, slot: Slot) -> Result<Vec3, SceneError> {
+        match p.color(name, false)? {
+            None => Ok(default),
+            Some(Color::Rgb(c)) => Ok(c),
+            Some(Color::Texture(t)) => {
+                let i = self.texture_param(slot, t)?;
+                Ok(self.desc.textures[i as usize].mean())
+            }
+        }
+    }
+
+    /// Float property `name` of a BSDF where Mitsuba allows a texture: the float (`default` when
+    /// absent), or the mean luminance of a texture that gives the row's `slot` per hit
+    /// (`slot` None: a texture is refused, naming the property).
+    pub fn float_param(
+        &mut self,
+        p: &Props<'e>,
+        name: &str,
+        default: f32,
+        slot: Option<Slot>,
+    ) -> Result<f32, SceneError> {
+        match p.get(name) {
+            Some(t) if t.tag == "texture" => match slot {
+                Some(slot) => {
+                    let i = self.texture_param(slot, t)?;
+                    Ok(crate::texture::luminance(self.desc.textures[i as usize].mean()))
+                }
+                None => Err(t.at.err(format!("{}: a texture for \"{name}\" is not supported", p.elem.what()))),
+            },
+            _ => p.float(name, default),
+        }
     }
 
     /// The index in `SceneDesc::textures` of the `<texture>` element `e` (built once per element).
@@ -301,18 +356,20 @@ impl<'e> Build<'e> {
             _ => return Err(e.at.err(format!("{} is not a shape", e.what()))),
         };
         self.pending_texture = None;
+        self.pending_params.clear();
         let material = match props.object("bsdf")? {
             Some(b) => self.bsdf(b)?,
             None => diffuse::default_material(),
         };
         let texture = self.pending_texture.take();
+        let params = std::mem::take(&mut self.pending_params);
         let emitter = match props.object("emitter")? {
             Some(em) => Some((self.area(em)?, em.at.clone())),
             None => None,
         };
         props.ignore("id");
         self.warnings.extend(props.unused());
-        Ok((out, self.intern(material, texture), emitter))
+        Ok((out, self.intern(material, texture, params), emitter))
     }
 
     /// The file named by the plugin's `filename` string, resolved.

@@ -3,6 +3,7 @@
 //! (false). One-sided unless in a `twosided`.
 
 use super::{Build, Plugin, Run};
+use crate::bsdf::interface::Slot;
 use crate::scene::desc::Material;
 use crate::scene::error::SceneError;
 use crate::scene::xml::props::Props;
@@ -11,10 +12,10 @@ use glam::Vec3;
 /// Registry entry.
 pub const PLUGIN: Plugin = Plugin { tag: "bsdf", kind: "plastic", run: Run::Bsdf(run) };
 
-fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
-    let d = p.rgb_only("diffuse_reflectance", Vec3::splat(0.5))?;
-    let s = p.rgb_only("specular_reflectance", Vec3::ONE)?;
+    let d = b.color_param(p, "diffuse_reflectance", Vec3::splat(0.5), Slot::Color(0))?;
+    let s = b.color_param(p, "specular_reflectance", Vec3::ONE, Slot::Color(1))?;
     let eta = p.ior("int_ior", "polypropylene")? / p.ior("ext_ior", "air")?;
     let nonlinear = p.bool("nonlinear", false)?;
     Ok(super::diffuse::registry_material(crate::bsdf::plastic::params(d, s, eta, nonlinear)))

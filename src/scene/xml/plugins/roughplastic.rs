@@ -12,9 +12,9 @@ use glam::Vec3;
 /// Registry entry.
 pub const PLUGIN: Plugin = Plugin { tag: "bsdf", kind: "roughplastic", run: Run::Bsdf(run) };
 
-fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
+fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
-    let (kind, alpha, _, visible) = super::roughconductor::microfacet(p, false)?;
+    let (kind, alpha, _, visible) = super::roughconductor::microfacet(b, p, false, None)?;
     let d = p.rgb_only("diffuse_reflectance", Vec3::splat(0.5))?;
     let s = p.rgb_only("specular_reflectance", Vec3::ONE)?;
     let eta = p.ior("int_ior", "polypropylene")? / p.ior("ext_ior", "air")?;
