@@ -112,6 +112,39 @@ pub struct Material8 {
     /// lanes hit from the back of the surface (the frame faces the viewer; one-sided BSDFs are
     /// evaluated in the surface's own frame, see [`interface::flip_to_surface`])
     pub back: Mask8,
+    /// the terms of a normal or bump map around the lanes' BSDFs (`None`: no lane has one; read
+    /// only by kernels with registry BSDFs, which scenes with such maps run)
+    pub frame_map: Option<FrameMap8>,
+}
+
+/// What Mitsuba 3's `normalmap` and `bumpmap` wrappers add to the BSDF they wrap, whose local
+/// frame is already the perturbed one: a direction must leave on the same side of the
+/// unperturbed shading normal as of the perturbed one (else f = 0, pdf = 0), and f (and a
+/// sample's weight) is scaled by the shadowing term of Estevez et al. 2019 ("A Microfacet-Based
+/// Shadowing Function to Solve the Bump Terminator Problem"), `2 / (1 + sqrt(1 + a2 tan^2))` with
+/// `tan` the tangent of wi's angle to the unperturbed normal and `a2 = min(tan^2(perturbed normal) /
+/// 8, 1)`. Lanes without a map have `base` = +z and `a2` = 0: factor 1.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameMap8 {
+    /// the unperturbed shading normal in the local (perturbed) frame
+    pub base: Vec3x8,
+    /// the shadowing term's alpha^2 (0 on lanes without a map)
+    pub a2: F8,
+}
+
+impl FrameMap8 {
+    /// The factor of f at local direction `wi`: 0 where wi is on different sides of the
+    /// perturbed and the unperturbed normal, else the shadowing term (1 where `a2` = 0).
+    #[inline]
+    pub fn factor(&self, wi: Vec3x8) -> F8 {
+        let c = self.base.dot(wi);
+        let same_side = (c * wi.z).simd_gt(F8::ZERO);
+        let c2 = c * c;
+        let tan2 = (F8::ONE - c2).max(F8::ZERO) / c2;
+        let g = F8::splat(2.0) / (F8::ONE + (F8::ONE + self.a2 * tan2).sqrt());
+        let g = self.a2.simd_gt(F8::ZERO).select(g, F8::ONE);
+        same_side.select(g, F8::ZERO)
+    }
 }
 
 /// [`Material8::sample_bsdf_k`]'s result: the direction, pdf and value of every lane, and on the
@@ -141,6 +174,7 @@ impl Material8 {
             ggx: crate::simd::mask_from_bools(m.map(|m| m.kind == BrdfKind::Ggx)),
             bsdf: Params8::COURSE,
             back: F8::ZERO,
+            frame_map: None,
         }
     }
 
@@ -182,10 +216,17 @@ impl Material8 {
         };
         if <L::Bsdfs as BsdfSet>::BITS != 0 {
             let general = self.general(active);
-            if general.any() {
+            let (f, pdf) = if general.any() {
                 let (fb, pb) = interface::eval_pdf_x8::<L::Bsdfs>(&self.bsdf, self.back, wo, wi, general);
-                return (Vec3x8::select(general, fb, f), general.select(pb, pdf));
+                (Vec3x8::select(general, fb, f), general.select(pb, pdf))
+            } else {
+                (f, pdf)
+            };
+            if let Some(m) = &self.frame_map {
+                let k = m.factor(wi);
+                return (f.scale(k), k.simd_gt(F8::ZERO).select(pdf, F8::ZERO));
             }
+            return (f, pdf);
         }
         (f, pdf)
     }
@@ -213,7 +254,12 @@ impl Material8 {
         if <L::Bsdfs as BsdfSet>::BITS != 0 {
             let general = self.general(active);
             if general.any() {
-                let b = interface::sample_x8::<L::Bsdfs>(&self.bsdf, self.back, wo, u_lobe, u, general);
+                let mut b = interface::sample_x8::<L::Bsdfs>(&self.bsdf, self.back, wo, u_lobe, u, general);
+                if let Some(m) = &self.frame_map {
+                    let k = m.factor(b.wi);
+                    b.weight = b.weight.scale(k);
+                    b.pdf = k.simd_gt(F8::ZERO).select(b.pdf, F8::ZERO);
+                }
                 s.wi = Vec3x8::select(general, b.wi, s.wi);
                 s.pdf = general.select(b.pdf, s.pdf);
                 s.general = general;

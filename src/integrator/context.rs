@@ -9,7 +9,7 @@ use crate::accel::{Ray8, RayHit8};
 use crate::bsdf::{BsdfSet, LobeSet, Material8};
 use crate::camera::PixelPacket;
 use crate::scene::build::{Scene, SurfaceHit8};
-use crate::simd::{Mask8, Vec3x8, F8};
+use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 
 /// Embree calls with their counting and logging, written once.
 pub struct Tracer<'a> {
@@ -111,5 +111,32 @@ pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8
     } else {
         crate::bsdf::Params8::COURSE
     };
-    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx, bsdf, back: sh.back }
+    Material8 {
+        kd: sh.kd,
+        ks: sh.ks,
+        shininess: sh.shininess,
+        alpha: sh.roughness,
+        ggx: sh.ggx,
+        bsdf,
+        back: sh.back,
+        frame_map: None,
+    }
+}
+
+/// The local shading frame and the material of a hit record. Kernels with registry BSDFs (which
+/// every scene with tangents or normal/bump maps runs) build the frame from the hit's tangent
+/// (Mitsuba's: dp/du made orthogonal to the normal) where the scene has tangents, and carry the
+/// maps' terms ([`crate::bsdf::FrameMap8`]); the course's kernels take the frame from the normal
+/// alone.
+#[inline]
+pub(super) fn shading<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> (Frame8, Material8) {
+    let mut mat = material::<L>(scene, sh);
+    if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.tangents {
+        let frame = Frame8::from_normal_tangent(sh.n, sh.s);
+        if scene.frame_maps() {
+            mat.frame_map = Some(crate::bsdf::FrameMap8 { base: frame.to_local(sh.base_n), a2: sh.bump_a2 });
+        }
+        return (frame, mat);
+    }
+    (Frame8::from_normal(sh.n), mat)
 }

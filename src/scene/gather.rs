@@ -51,6 +51,14 @@ pub struct SurfaceHit8 {
     /// hit lanes that hit the back of the surface (the normals were flipped to face the ray);
     /// filled only in scenes with registry BSDFs
     pub back: Mask8,
+    /// unit shading tangent (Mitsuba's: dp/du made orthogonal to `n`; a normal or bump map's
+    /// perturbed one); filled only in scenes with tangents (`Scene::tangents`), zero elsewhere
+    pub s: Vec3x8,
+    /// the shading normal before a normal or bump map perturbed `n` (facing as `n`); `n` on lanes
+    /// without a map; filled only in scenes with such maps
+    pub base_n: Vec3x8,
+    /// the shadowing term's alpha^2 of a normal or bump map (`bsdf::FrameMap8`); 0 without one
+    pub bump_a2: F8,
 }
 
 impl SurfaceHit8 {
@@ -73,6 +81,9 @@ impl SurfaceHit8 {
         light: U8::MAX,
         material: U8::ZERO,
         back: F8::ZERO,
+        s: Vec3x8::ZERO,
+        base_n: Z8,
+        bump_a2: F8::ZERO,
     };
 }
 
@@ -143,8 +154,8 @@ impl Scene {
         out.ambient = m.ambient;
         out.le = le;
         out.light = light;
-        if !self.material_texture.is_empty() {
-            self.texture_hits(bits, hits, out);
+        if self.hit_extras {
+            self.extras(bits, hits, out);
         }
     }
 

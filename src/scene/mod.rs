@@ -7,6 +7,7 @@ pub mod limits;
 pub mod mesh;
 pub mod obj;
 pub mod parse;
+pub mod perturb;
 pub mod sensor;
 pub mod texturing;
 pub mod xml;

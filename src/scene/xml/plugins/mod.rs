@@ -3,6 +3,7 @@
 //! plugin file reads its own Mitsuba properties through [`Props`] and writes the scene.
 
 mod area;
+mod bumpmap;
 mod conductor;
 mod constant;
 mod cube;
@@ -16,6 +17,7 @@ mod envmap;
 mod hdrfilm;
 mod instance;
 mod integrator_moment;
+mod normalmap;
 mod obj;
 mod orthographic;
 mod path;
@@ -46,7 +48,7 @@ mod twosided;
 use super::doc::{Elem, Loc};
 use super::props::{Color, Props};
 use super::shape::ShapeOut;
-use crate::scene::desc::{EnvironmentDesc, Material, RgbImage, SceneDesc};
+use crate::scene::desc::{EnvironmentDesc, FrameMap, Material, RgbImage, SceneDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
 use glam::Vec3;
@@ -133,8 +135,8 @@ pub const PLUGINS: &[Plugin] = &[
     refused("bsdf", "principledthin", BSDFS),
     refused("bsdf", "blendbsdf", BSDFS),
     refused("bsdf", "mask", BSDFS),
-    refused("bsdf", "bumpmap", BSDFS),
-    refused("bsdf", "normalmap", BSDFS),
+    bumpmap::PLUGIN,
+    normalmap::PLUGIN,
     refused("bsdf", "null", BSDFS),
     tex_bitmap::PLUGIN,
     tex_checkerboard::PLUGIN,
@@ -180,6 +182,8 @@ pub struct Build<'e> {
     textures: HashMap<usize, u32>,
     /// the reflectance texture of the material the last BSDF plugin made, if textured
     pub pending_texture: Option<u32>,
+    /// the normal or bump map of the material the last BSDF plugin made, if wrapped in one
+    pub pending_frame: Option<FrameMap>,
 }
 
 impl<'e> Build<'e> {
@@ -201,6 +205,7 @@ impl<'e> Build<'e> {
             materials: HashMap::new(),
             textures: HashMap::new(),
             pending_texture: None,
+            pending_frame: None,
         }
     }
 
@@ -209,10 +214,11 @@ impl<'e> Build<'e> {
         super::doc::resolve_in(&self.search, name)
     }
 
-    /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
-    /// once; `SceneDesc::diffuse_textures` stays empty until a material is textured).
-    pub fn intern(&mut self, m: Material, texture: Option<u32>) -> u32 {
-        let key = format!("{m:?}|{texture:?}");
+    /// The index of `m` with the reflectance texture `texture` and the frame map `frame` in the
+    /// scene's materials (added once; `SceneDesc::diffuse_textures` and
+    /// `SceneDesc::material_frames` stay empty until a material has one).
+    pub fn intern(&mut self, m: Material, texture: Option<u32>, frame: Option<FrameMap>) -> u32 {
+        let key = format!("{m:?}|{texture:?}|{frame:?}");
         let n = self.desc.materials.len() as u32;
         let i = *self.materials.entry(key).or_insert_with(|| {
             self.desc.materials.push(m);
@@ -222,6 +228,11 @@ impl<'e> Build<'e> {
             let slots = &mut self.desc.diffuse_textures;
             slots.resize(slots.len().max(i as usize + 1), None);
             slots[i as usize] = Some(t);
+        }
+        if let Some(f) = frame {
+            let slots = &mut self.desc.material_frames;
+            slots.resize(slots.len().max(i as usize + 1), None);
+            slots[i as usize] = Some(f);
         }
         i
     }
@@ -298,18 +309,20 @@ impl<'e> Build<'e> {
             _ => return Err(e.at.err(format!("{} is not a shape", e.what()))),
         };
         self.pending_texture = None;
+        self.pending_frame = None;
         let material = match props.object("bsdf")? {
             Some(b) => self.bsdf(b)?,
             None => diffuse::default_material(),
         };
         let texture = self.pending_texture.take();
+        let frame = self.pending_frame.take();
         let emitter = match props.object("emitter")? {
             Some(em) => Some((self.area(em)?, em.at.clone())),
             None => None,
         };
         props.ignore("id");
         self.warnings.extend(props.unused());
-        Ok((out, self.intern(material, texture), emitter))
+        Ok((out, self.intern(material, texture, frame), emitter))
     }
 
     /// The file named by the plugin's `filename` string, resolved.
