@@ -104,7 +104,7 @@ pub(super) fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
 
 /// The material of a hit record, with the registry BSDF rows looked up only in a kernel that
 /// compiles registry BSDFs in.
-#[inline]
+#[inline(always)]
 pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8 {
     let bsdf = if <L::Bsdfs as BsdfSet>::BITS != 0 {
         scene.bsdf_params(sh.material, sh.valid)
@@ -123,20 +123,24 @@ pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8
     }
 }
 
-/// The local shading frame and the material of a hit record. Kernels with registry BSDFs (which
-/// every scene with tangents or normal/bump maps runs) build the frame from the hit's tangent
-/// (Mitsuba's: dp/du made orthogonal to the normal) where the scene has tangents, and carry the
-/// maps' terms ([`crate::bsdf::FrameMap8`]); the course's kernels take the frame from the normal
-/// alone.
-#[inline]
-pub(super) fn shading<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> (Frame8, Material8) {
-    let mut mat = material::<L>(scene, sh);
+/// The local shading frame of a hit record: in kernels with registry BSDFs (which every scene
+/// with tangents or normal/bump maps runs) built from the hit's tangent (Mitsuba's: dp/du made
+/// orthogonal to the normal) where the scene has tangents; from the normal alone otherwise.
+#[inline(always)]
+pub(super) fn shading_frame<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Frame8 {
     if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.tangents {
-        let frame = Frame8::from_normal_tangent(sh.n, sh.s);
-        if scene.frame_maps() {
-            mat.frame_map = Some(crate::bsdf::FrameMap8 { base: frame.to_local(sh.base_n), a2: sh.bump_a2 });
-        }
-        return (frame, mat);
+        return Frame8::from_normal_tangent(sh.n, sh.s);
     }
-    (Frame8::from_normal(sh.n), mat)
+    Frame8::from_normal(sh.n)
+}
+
+/// [`material`] with the terms of the hit's normal or bump maps ([`crate::bsdf::FrameMap8`]) in
+/// the local `frame` (from [`shading_frame`]), in kernels with registry BSDFs of scenes with maps.
+#[inline(always)]
+pub(super) fn material_in<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, frame: &Frame8) -> Material8 {
+    let mut mat = material::<L>(scene, sh);
+    if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.frame_maps() {
+        mat.frame_map = Some(crate::bsdf::FrameMap8 { base: frame.to_local(sh.base_n), a2: sh.bump_a2 });
+    }
+    mat
 }

@@ -17,7 +17,7 @@
 //! `direct` does with one emitter sample. `uniform` is then truly 1/#lights (quads and triangles
 //! alike).
 
-use super::context::{masked, shading, TileCtx, Tracer};
+use super::context::{masked, material_in, shading_frame, TileCtx, Tracer};
 use super::estimator::Estimator;
 use super::primary::{self, Wave};
 use super::samples::{Dim, Samples, Source, CAMERA};
@@ -383,7 +383,8 @@ pub(super) fn light_term<L: LobeSet>(
     let f = {
         let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
         // The path tracer's material code, in the local shading frame.
-        let (frame, mat) = shading::<L>(scene, sh);
+        let frame = shading_frame::<L>(scene, sh);
+        let mat = material_in::<L>(scene, sh, &frame);
         let strategy = crate::scene::desc::ImportanceSampling::Cosine;
         mat.eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
     };
@@ -402,7 +403,8 @@ fn light_term_f<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, wi: Vec3x8, active:
         return None;
     }
     let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-    let (frame, mat) = shading::<L>(scene, sh);
+    let frame = shading_frame::<L>(scene, sh);
+    let mat = material_in::<L>(scene, sh, &frame);
     let strategy = crate::scene::desc::ImportanceSampling::Cosine;
     let f = mat.eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
     Some((f, lit.select(cos_i, F8::ZERO), lit))

@@ -112,8 +112,14 @@ impl Scene {
         let valid = hits.hit;
         let bits = valid.to_bitmask();
         if bits == 0 {
-            // No lane hit: the miss record (what the lane loop below gives every missed lane).
-            *out = SurfaceHit8 { p, wo: -dir, ..SurfaceHit8::MISS };
+            // No lane hit: the miss record (what the lane loop below gives every missed lane), but
+            // for the tangent-frame fields, which only shaded lanes read (not writing them keeps
+            // this path as short as before they existed).
+            let m = SurfaceHit8::MISS;
+            (out.valid, out.p, out.n, out.ng, out.smooth, out.wo) = (m.valid, p, m.n, m.ng, m.smooth, -dir);
+            (out.kd, out.ks, out.shininess, out.roughness, out.ggx) = (m.kd, m.ks, m.shininess, m.roughness, m.ggx);
+            (out.emitted, out.ambient, out.le, out.light) = (m.emitted, m.ambient, m.le, m.light);
+            (out.material, out.back) = (m.material, m.back);
             return;
         }
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());

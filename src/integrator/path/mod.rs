@@ -19,7 +19,7 @@
 //! from dim 0's first coordinate); dim 3 only where roulette or the lobe pick needs it. A
 //! dimension not drawn changes no other.
 
-use super::context::{masked, shading, TileCtx};
+use super::context::{masked, material_in, shading_frame, TileCtx};
 use super::estimator::Estimator;
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
@@ -362,8 +362,9 @@ impl Bounce<'_> {
             return;
         }
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
-        let (frame, mat) = shading::<L>(scene, sh);
+        let frame = shading_frame::<L>(scene, sh);
         let wo = frame.to_local(sh.wo);
+        let mat = material_in::<L>(scene, sh, &frame);
         // Registry BSDFs that transmit: directions may cross the surface (compile-time).
         let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;
         let eps = scene.offset_eps(sh.p);
