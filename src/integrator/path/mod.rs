@@ -75,6 +75,7 @@ impl Estimator for PathTracer {
 
     /// All paths of all the samples form one wavefront, so packets stay full even when Russian
     /// roulette thins the paths out.
+    #[inline(never)]
     fn tile<L: LobeSet>(
         it: &Integrator,
         ctx: &mut TileCtx,
