@@ -43,7 +43,7 @@ pub mod desc;
 pub use desc::{BrdfKind, ImportanceSampling};
 pub use ggx::Ggx;
 pub use lobe::{AllLobes, Diffuse, DiffuseGgx, DiffusePhong, Lobe, LobeSet, Lobes};
-pub use material::{Material, Material8, Sampled8};
+pub use material::{FrameMap8, Material, Material8, Sampled8};
 pub use phong::Phong;
 
 /// The BSDF registry: one line per BSDF file (`file: Type,`): declares the module, re-exports the

@@ -15,7 +15,7 @@ use std::f32::consts::PI;
 /// Radiance without emission: kd/pi * sum over area lights of L * max(0, Phi . n) (no visibility;
 /// as for quads, the receiver must see the whole light in its upper hemisphere and on its emitting
 /// side for this to be exact).
-#[inline]
+#[inline(always)]
 pub fn radiance(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
     let mut l_out = Vec3x8::ZERO;
     let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)));

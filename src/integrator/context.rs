@@ -9,7 +9,7 @@ use crate::accel::{Ray8, RayHit8};
 use crate::bsdf::{BsdfSet, LobeSet, Material8};
 use crate::camera::PixelPacket;
 use crate::scene::build::{Scene, SurfaceHit8};
-use crate::simd::{Mask8, Vec3x8, F8};
+use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 
 /// Embree calls with their counting and logging, written once.
 pub struct Tracer<'a> {
@@ -104,7 +104,7 @@ pub(super) fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
 
 /// The material of a hit record, with the registry BSDF rows looked up only in a kernel that
 /// compiles registry BSDFs in.
-#[inline]
+#[inline(always)]
 pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8 {
     let bsdf = if <L::Bsdfs as BsdfSet>::BITS != 0 {
         let mut p = scene.bsdf_params(sh.material, sh.valid);
@@ -115,5 +115,36 @@ pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8
     } else {
         crate::bsdf::Params8::COURSE
     };
-    Material8 { kd: sh.kd, ks: sh.ks, shininess: sh.shininess, alpha: sh.roughness, ggx: sh.ggx, bsdf, back: sh.back }
+    Material8 {
+        kd: sh.kd,
+        ks: sh.ks,
+        shininess: sh.shininess,
+        alpha: sh.roughness,
+        ggx: sh.ggx,
+        bsdf,
+        back: sh.back,
+        frame_map: None,
+    }
+}
+
+/// The local shading frame of a hit record: in kernels with registry BSDFs (which every scene
+/// with tangents or normal/bump maps runs) built from the hit's tangent (Mitsuba's: dp/du made
+/// orthogonal to the normal) where the scene has tangents; from the normal alone otherwise.
+#[inline(always)]
+pub(super) fn shading_frame<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Frame8 {
+    if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.tangents {
+        return Frame8::from_normal_tangent(sh.n, sh.s);
+    }
+    Frame8::from_normal(sh.n)
+}
+
+/// [`material`] with the terms of the hit's normal or bump maps ([`crate::bsdf::FrameMap8`]) in
+/// the local `frame` (from [`shading_frame`]), in kernels with registry BSDFs of scenes with maps.
+#[inline(always)]
+pub(super) fn material_in<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, frame: &Frame8) -> Material8 {
+    let mut mat = material::<L>(scene, sh);
+    if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.frame_maps() {
+        mat.frame_map = Some(crate::bsdf::FrameMap8 { base: frame.to_local(sh.base_n), a2: sh.bump_a2 });
+    }
+    mat
 }

@@ -17,7 +17,7 @@
 //! `direct` does with one emitter sample. `uniform` is then truly 1/#lights (quads and triangles
 //! alike).
 
-use super::context::{masked, material, TileCtx, Tracer};
+use super::context::{masked, material_in, shading_frame, TileCtx, Tracer};
 use super::estimator::Estimator;
 use super::primary::{self, Wave};
 use super::samples::{Dim, Samples, Source, CAMERA};
@@ -31,7 +31,7 @@ use crate::profile::Phase;
 use crate::sampler::{PathDim, Stream};
 use crate::scene::build::{Scene, SurfaceHit8};
 use crate::scene::desc::IntegratorKind;
-use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
+use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 #[path = "direct_env.rs"]
 mod env;
@@ -383,9 +383,10 @@ pub(super) fn light_term<L: LobeSet>(
     let f = {
         let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
         // The path tracer's material code, in the local shading frame.
-        let frame = Frame8::from_normal(sh.n);
+        let frame = shading_frame::<L>(scene, sh);
+        let mat = material_in::<L>(scene, sh, &frame);
         let strategy = crate::scene::desc::ImportanceSampling::Cosine;
-        material::<L>(scene, sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
+        mat.eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
     };
     Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
 }
@@ -402,9 +403,10 @@ fn light_term_f<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, wi: Vec3x8, active:
         return None;
     }
     let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-    let frame = Frame8::from_normal(sh.n);
+    let frame = shading_frame::<L>(scene, sh);
+    let mat = material_in::<L>(scene, sh, &frame);
     let strategy = crate::scene::desc::ImportanceSampling::Cosine;
-    let f = material::<L>(scene, sh).eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
+    let f = mat.eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
     Some((f, lit.select(cos_i, F8::ZERO), lit))
 }
 

@@ -58,6 +58,10 @@ impl Kernel {
 
     /// The kernel specialized for `scene`'s materials.
     pub fn for_scene(scene: &Scene) -> Self {
+        // Normal and bump maps are applied by the kernels with registry BSDFs: the general one.
+        if scene.frame_maps() {
+            return Self::GENERAL;
+        }
         Self { lobes: Lobes::of(&scene.materials) }
     }
 

@@ -259,11 +259,19 @@ pub struct Scene {
     /// sides ([`SurfaceHit8::material`], [`SurfaceHit8::back`]), which only such BSDFs read
     pub registry_bsdfs: bool,
     /// per scene triangle: its corner uvs, `[ZERO; 3]` for none; empty when the scene has no
-    /// uvs or no textured material
+    /// uvs, or neither a textured material nor tangents
     pub tri_uv: Vec<[glam::Vec2; 3]>,
     /// per scene triangle: its index in `desc.triangles` (`NO_TRIANGLE` for lights); empty when
-    /// no material is textured
+    /// the scene has neither a textured material nor tangents
     pub tri_source: Vec<u32>,
+    /// per material: its normal or bump map (`scene/perturb.rs`); empty when no material has one
+    pub material_frame: Vec<Option<crate::scene::desc::FrameMap>>,
+    /// hits carry shading tangents ([`SurfaceHit8::s`], Mitsuba's frame from dp/du): scenes with
+    /// registry BSDFs (anisotropic roughness turns with the frame) or normal/bump maps
+    pub tangents: bool,
+    /// the gather runs `Scene::extras` (textures, tangents, maps): some material is textured or
+    /// the scene has tangents
+    pub hit_extras: bool,
     /// zero-area triangles (scene and emissive) dropped at build: they can be neither hit nor
     /// sampled, and an exact ray through one would get no usable normal
     pub degenerate_dropped: usize,
@@ -396,11 +404,14 @@ type TexturingTables = (Vec<crate::texture::Texture>, Vec<u32>);
 /// `n_materials` scene materials, or `None` when no material is textured.
 fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<TexturingTables>, BuildError> {
     use crate::texture::{AttrRun, Texture};
+    let textured = desc.diffuse_textures.iter().any(Option::is_some);
     let params = desc.param_textures.iter().any(|p| !p.is_empty());
-    if desc.diffuse_textures.iter().all(Option::is_none) && !params {
+    if !textured && !params && desc.material_frames.iter().all(Option::is_none) {
         return Ok(None);
     }
-    let mut material_texture = vec![super::texturing::NO_TEXTURE; n_materials];
+    // Only normal or bump maps: the textures without a diffuse texture table (textured BSDF
+    // parameters are evaluated where the reflectance textures are, so they need one).
+    let mut material_texture = vec![super::texturing::NO_TEXTURE; if textured || params { n_materials } else { 0 }];
     for (m, t) in desc.diffuse_textures.iter().enumerate() {
         let Some(t) = *t else { continue };
         if t as usize >= desc.textures.len() || m >= desc.materials.len() {
@@ -411,6 +422,17 @@ fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<Textu
     }
     for (m, p) in desc.param_textures.iter().enumerate() {
         if let Some(&(_, t)) = p.iter().find(|(_, t)| *t as usize >= desc.textures.len()) {
+            let (path, count) = (desc.source.clone(), desc.textures.len());
+            return Err(BuildError::TextureIndex { path, material: m, texture: t, count });
+        }
+    }
+    for (m, f) in desc.material_frames.iter().enumerate() {
+        use crate::scene::desc::FrameMap;
+        let t = match *f {
+            Some(FrameMap::Normal { texture } | FrameMap::Bump { texture, .. }) => texture,
+            None => continue,
+        };
+        if t as usize >= desc.textures.len() || m >= desc.materials.len() {
             let (path, count) = (desc.source.clone(), desc.textures.len());
             return Err(BuildError::TextureIndex { path, material: m, texture: t, count });
         }
@@ -481,6 +503,17 @@ impl Scene {
         let mut tri_light = Vec::with_capacity(indices.capacity());
         let mut tri_corner_normals = Vec::new();
         let texturing = texturing_tables(&desc, materials.len() + 1)?;
+        let registry_bsdfs = materials
+            .iter()
+            .any(|m| m.bsdf.kind != crate::bsdf::interface::COURSE || crate::bsdf::mask::masked(&m.bsdf));
+        let mut material_frame = desc.material_frames.clone();
+        if material_frame.iter().all(Option::is_none) {
+            material_frame.clear();
+        } else {
+            material_frame.resize(materials.len() + 1, None);
+        }
+        let tangents = registry_bsdfs || !material_frame.is_empty();
+        let uvs = texturing.is_some() || tangents;
         let (mut tri_uv, mut tri_source) = (Vec::new(), Vec::new());
         let (mut degenerate_dropped, mut overflow_dropped) = (0, 0);
         for (k, t) in desc.triangles.iter().enumerate() {
@@ -494,7 +527,7 @@ impl Scene {
                 tri_corner_normals.resize(indices.len(), none);
                 tri_corner_normals.push(desc.triangle_normals.get(k).copied().unwrap_or(none));
             }
-            if texturing.is_some() {
+            if uvs {
                 if !desc.triangle_uvs.is_empty() {
                     tri_uv.resize(indices.len(), [glam::Vec2::ZERO; 3]);
                     tri_uv.push(desc.triangle_uvs.get(k).copied().unwrap_or([glam::Vec2::ZERO; 3]));
@@ -635,7 +668,7 @@ impl Scene {
                     .map_err(|err| BuildError::Delta { file: desc.source.clone(), err })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        if texturing.is_some() {
+        if uvs {
             // Light triangles carry no texture coordinates.
             tri_source.resize(indices.len(), crate::texture::NO_TRIANGLE);
         }
@@ -647,9 +680,7 @@ impl Scene {
         } else {
             Vec::new()
         };
-        let registry_bsdfs = materials
-            .iter()
-            .any(|m| m.bsdf.kind != crate::bsdf::interface::COURSE || crate::bsdf::mask::masked(&m.bsdf));
+        let hit_extras = !material_texture.is_empty() || tangents;
         Ok(Self {
             desc,
             camera,
@@ -669,6 +700,9 @@ impl Scene {
             registry_bsdfs,
             tri_uv,
             tri_source,
+            material_frame,
+            tangents,
+            hit_extras,
             degenerate_dropped,
             overflow_dropped,
             backend,

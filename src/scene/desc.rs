@@ -252,6 +252,9 @@ pub struct SceneDesc {
     /// material's `bsdf` row and the texture's index; the row keeps a representative value). The
     /// table may be shorter than `materials`; empty: none
     pub param_textures: Vec<Vec<(crate::bsdf::interface::Slot, u32)>>,
+    /// per material index: its shading-frame perturbation (Mitsuba's `normalmap` or `bumpmap`
+    /// around it), or None (the table may be shorter than `materials`; empty: none)
+    pub material_frames: Vec<Option<FrameMap>>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -451,8 +454,41 @@ impl SceneDesc {
                 }
             }
         }
+        // Normal and bump maps (Mitsuba scenes only).
+        if !self.material_frames.is_empty() {
+            h.word(0x6e6d_6170);
+            h.word(self.material_frames.len() as u32);
+            for f in &self.material_frames {
+                let (kind, texture, scale) = match *f {
+                    None => (0, u32::MAX, 0.0),
+                    Some(FrameMap::Normal { texture }) => (1, texture, 0.0),
+                    Some(FrameMap::Bump { texture, scale }) => (2, texture, scale),
+                };
+                [kind, texture, f32::to_bits(scale)].into_iter().for_each(|w| h.word(w));
+            }
+        }
         h.0
     }
+}
+
+/// A material's shading-frame perturbation: Mitsuba 3's `normalmap` and `bumpmap` BSDF wrappers
+/// (applied at hits, `scene/perturb.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameMap {
+    /// tangent-space normals: the texture's raw RGB `t` gives the normal `2 t - 1` in the hit's
+    /// shading frame
+    Normal {
+        /// index in `SceneDesc::textures`
+        texture: u32,
+    },
+    /// a height field: the gradient of the texture's luminance in uv, times `scale`, displaces
+    /// the surface along the shading normal
+    Bump {
+        /// index in `SceneDesc::textures`
+        texture: u32,
+        /// Mitsuba's `scale` (default 1)
+        scale: f32,
+    },
 }
 
 impl Default for SceneDesc {
@@ -487,6 +523,7 @@ impl Default for SceneDesc {
             textures: Vec::new(),
             diffuse_textures: Vec::new(),
             param_textures: Vec::new(),
+            material_frames: Vec::new(),
             point_lights: Vec::new(),
             directional_lights: Vec::new(),
             environment: None,

@@ -54,6 +54,14 @@ pub struct SurfaceHit8 {
     /// where textures are evaluated at the hit (uv, triangle, barycentrics); filled only in
     /// scenes with textured BSDF parameters (`Scene::param_textures`)
     pub tex: crate::texture::TexQuery8,
+    /// unit shading tangent (Mitsuba's: dp/du made orthogonal to `n`; a normal or bump map's
+    /// perturbed one); filled only in scenes with tangents (`Scene::tangents`), zero elsewhere
+    pub s: Vec3x8,
+    /// the shading normal before a normal or bump map perturbed `n` (facing as `n`); `n` on lanes
+    /// without a map; filled only in scenes with such maps
+    pub base_n: Vec3x8,
+    /// the shadowing term's alpha^2 of a normal or bump map (`bsdf::FrameMap8`); 0 without one
+    pub bump_a2: F8,
 }
 
 impl SurfaceHit8 {
@@ -77,6 +85,9 @@ impl SurfaceHit8 {
         material: U8::ZERO,
         back: F8::ZERO,
         tex: crate::texture::TexQuery8 { u: F8::ZERO, v: F8::ZERO, tri: U8::MAX, b1: F8::ZERO, b2: F8::ZERO },
+        s: Vec3x8::ZERO,
+        base_n: Z8,
+        bump_a2: F8::ZERO,
     };
 }
 
@@ -105,8 +116,9 @@ impl Scene {
         let valid = hits.hit;
         let bits = valid.to_bitmask();
         if bits == 0 {
-            // No lane hit: the miss record (what the lane loop below gives every missed lane).
-            // (`tex` is left as it is: no lane reads it.)
+            // No lane hit: the miss record (what the lane loop below gives every missed lane), but
+            // for `tex` and the tangent-frame fields, which only shaded lanes read (not writing
+            // them keeps this path as short as before they existed).
             let m = &SurfaceHit8::MISS;
             (out.valid, out.p, out.n, out.ng, out.smooth, out.wo) = (m.valid, p, m.n, m.ng, m.smooth, -dir);
             (out.kd, out.ks, out.shininess, out.roughness, out.ggx) = (m.kd, m.ks, m.shininess, m.roughness, m.ggx);
@@ -152,8 +164,8 @@ impl Scene {
         out.ambient = m.ambient;
         out.le = le;
         out.light = light;
-        if !self.material_texture.is_empty() {
-            self.texture_hits(bits, hits, out);
+        if self.hit_extras {
+            self.extras(bits, hits, out);
         }
     }
 

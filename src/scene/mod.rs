@@ -8,6 +8,7 @@ pub mod mesh;
 pub mod obj;
 pub mod parse;
 pub mod ptracer_check;
+pub mod perturb;
 pub mod sensor;
 pub mod texturing;
 pub mod xml;

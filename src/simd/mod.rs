@@ -244,6 +244,19 @@ impl Frame8 {
         let t = Vec3x8::new(b, sign + n.y * n.y * a, -n.y);
         Self { s, t, n }
     }
+    /// Frame around unit normals `n` with its tangent along `tangent` made orthogonal to `n`
+    /// (Gram-Schmidt, as Mitsuba builds its shading frame from dp/du), `t = n x s`; lanes whose
+    /// tangent is zero or along `n` get [`Frame8::from_normal`]'s.
+    #[inline]
+    pub fn from_normal_tangent(n: Vec3x8, tangent: Vec3x8) -> Self {
+        let d = Self::from_normal(n);
+        let s = tangent - n.scale(n.dot(tangent));
+        let l2 = s.dot(s);
+        let ok = l2.simd_gt(F8::splat(1e-20)) & l2.is_finite();
+        let s = s.scale(F8::ONE / ok.select(l2, F8::ONE).sqrt());
+        let t = n.cross(s);
+        Self { s: Vec3x8::select(ok, s, d.s), t: Vec3x8::select(ok, t, d.t), n }
+    }
     /// Local (s, t, n) coordinates to world, per lane.
     #[inline]
     pub fn to_world(&self, l: Vec3x8) -> Vec3x8 {

@@ -254,6 +254,27 @@ impl Bitmap {
         }
     }
 
+    /// The gradient in uv of the bilinearly filtered luminance (Rec. 709 weights, as Mitsuba's
+    /// `luminance`) at `uv`: the derivative of the interpolation between the four texels around
+    /// the point, in texels times the resolution (Mitsuba's `eval_1_grad`). Zero for a nearest
+    /// lookup (piecewise constant).
+    pub fn grad_luminance(&self, uv: Vec2) -> Vec2 {
+        if self.filter == FilterType::Nearest {
+            return Vec2::ZERO;
+        }
+        let (w, h) = (self.width as f32, self.height as f32);
+        let uv = Vec2::new(sanitize(uv.x), sanitize(uv.y));
+        let (px, py) = (uv.x * w - 0.5, uv.y * h - 0.5);
+        let (fx, fy) = (px.floor(), py.floor());
+        let (ax, ay) = (px - fx, py - fy);
+        let (bx, by) = (1.0 - ax, 1.0 - ay);
+        let (x0, y0) = (fx as i64, fy as i64);
+        let (x1, y1) = (x0.saturating_add(1), y0.saturating_add(1));
+        let lum = |c: [f32; 3]| 0.212_671 * c[0] + 0.715_160 * c[1] + 0.072_169 * c[2];
+        let [f00, f10, f01, f11] = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| lum(self.fetch(x, y)));
+        Vec2::new((by * (f10 - f00) + ay * (f11 - f01)) * w, (bx * (f01 - f00) + ax * (f11 - f10)) * h)
+    }
+
     /// The filtered values at eight uv points (every lane is looked up; mask the result).
     pub fn eval_x8(&self, u: F8, v: F8) -> Vec3x8 {
         let (w, h) = (F8::splat(self.width as f32), F8::splat(self.height as f32));
@@ -309,6 +330,12 @@ impl BitmapTexture {
     /// The value at one point.
     pub fn eval(&self, q: &TexQuery) -> Vec3 {
         self.bitmap.eval(self.to_uv.apply(q.uv))
+    }
+
+    /// The gradient in uv (before `to_uv`) of the luminance at one point
+    /// ([`Bitmap::grad_luminance`] through `to_uv`).
+    pub fn grad_luminance(&self, q: &TexQuery) -> Vec2 {
+        self.to_uv.pull_back(self.bitmap.grad_luminance(self.to_uv.apply(q.uv)))
     }
 
     /// The values at eight points (bit-identical to [`BitmapTexture::eval`] per lane).

@@ -104,6 +104,17 @@ impl Texture {
         }
     }
 
+    /// The gradient in uv of the texture's luminance at `q` (what Mitsuba's `bumpmap` reads):
+    /// a bitmap's ([`Bitmap::grad_luminance`]), zero for a constant; `None` for the plugins
+    /// without one (Mitsuba has none for them either).
+    pub fn grad_luminance(&self, q: &TexQuery) -> Option<glam::Vec2> {
+        match self {
+            Texture::BitmapTexture(t) => Some(t.grad_luminance(q)),
+            Texture::RawConstant(_) => Some(glam::Vec2::ZERO),
+            Texture::Checkerboard(_) | Texture::MeshAttribute(_) => None,
+        }
+    }
+
     /// Feeds everything the texture renders, as 32-bit words, to `word` (for a scene's content
     /// hash): a bitmap's size, settings and texel bits; the other plugins' fields through `Debug`
     /// (f32 `Debug` round-trips, so distinct values print differently).

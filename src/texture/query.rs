@@ -88,6 +88,14 @@ impl UvTransform {
         Vec2::new((a[0] * uv.x + a[1] * uv.y) + a[2], (b[0] * uv.x + b[1] * uv.y) + b[2])
     }
 
+    /// A gradient `g` taken in the mapped coordinates, carried back to the unmapped ones: `A^T g`
+    /// (the chain rule through `uv' = A uv + b`).
+    #[inline]
+    pub fn pull_back(&self, g: Vec2) -> Vec2 {
+        let [a, b] = self.rows;
+        Vec2::new(a[0] * g.x + b[0] * g.y, a[1] * g.x + b[1] * g.y)
+    }
+
     /// Eight uv points mapped (bit-identical to [`UvTransform::apply`] per lane).
     #[inline]
     pub fn apply_x8(&self, u: F8, v: F8) -> (F8, F8) {

@@ -13,6 +13,7 @@ mod docs;
 mod experiments;
 mod fidelity;
 mod flip;
+mod frame_maps;
 mod furnace;
 mod golden;
 mod kernels;

@@ -19,7 +19,7 @@
 //! from dim 0's first coordinate); dim 3 only where roulette or the lobe pick needs it. A
 //! dimension not drawn changes no other.
 
-use super::context::{masked, material, TileCtx};
+use super::context::{masked, material_in, shading_frame, TileCtx};
 use super::estimator::Estimator;
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
@@ -75,6 +75,7 @@ impl Estimator for PathTracer {
 
     /// All paths of all the samples form one wavefront, so packets stay full even when Russian
     /// roulette thins the paths out.
+    #[inline(never)]
     fn tile<L: LobeSet>(
         it: &Integrator,
         ctx: &mut TileCtx,
@@ -362,9 +363,9 @@ impl Bounce<'_> {
             return;
         }
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
-        let frame = Frame8::from_normal(sh.n);
+        let frame = shading_frame::<L>(scene, sh);
         let wo = frame.to_local(sh.wo);
-        let mat = material::<L>(scene, sh);
+        let mat = material_in::<L>(scene, sh, &frame);
         // Registry BSDFs that transmit: directions may cross the surface (compile-time).
         let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;
         let eps = scene.offset_eps(sh.p);

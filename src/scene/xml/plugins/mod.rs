@@ -4,6 +4,7 @@
 
 mod area;
 mod blendbsdf;
+mod bumpmap;
 mod conductor;
 mod constant;
 mod cube;
@@ -18,6 +19,7 @@ mod hdrfilm;
 mod instance;
 mod integrator_moment;
 mod mask;
+mod normalmap;
 mod obj;
 mod orthographic;
 mod path;
@@ -50,7 +52,7 @@ use super::doc::{Elem, Loc};
 use super::props::{Color, Props};
 use super::shape::ShapeOut;
 use crate::bsdf::interface::Slot;
-use crate::scene::desc::{EnvironmentDesc, Material, RgbImage, SceneDesc};
+use crate::scene::desc::{EnvironmentDesc, FrameMap, Material, RgbImage, SceneDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
 use glam::Vec3;
@@ -137,8 +139,8 @@ pub const PLUGINS: &[Plugin] = &[
     blendbsdf::PLUGIN,
     refused("bsdf", "principled", BSDFS),
     refused("bsdf", "principledthin", BSDFS),
-    refused("bsdf", "bumpmap", BSDFS),
-    refused("bsdf", "normalmap", BSDFS),
+    bumpmap::PLUGIN,
+    normalmap::PLUGIN,
     refused("bsdf", "null", BSDFS),
     tex_bitmap::PLUGIN,
     tex_checkerboard::PLUGIN,
@@ -188,6 +190,8 @@ pub struct Build<'e> {
     pub pending_texture: Option<u32>,
     /// the textured BSDF parameters of the material the last BSDF plugin made
     pub pending_params: Vec<(Slot, u32)>,
+    /// the normal or bump map of the material the last BSDF plugin made, if wrapped in one
+    pub pending_frame: Option<FrameMap>,
 }
 
 impl<'e> Build<'e> {
@@ -210,6 +214,7 @@ impl<'e> Build<'e> {
             textures: HashMap::new(),
             pending_texture: None,
             pending_params: Vec::new(),
+            pending_frame: None,
         }
     }
 
@@ -218,10 +223,12 @@ impl<'e> Build<'e> {
         super::doc::resolve_in(&self.search, name)
     }
 
-    /// The index of `m` with the reflectance texture `texture` in the scene's materials (added
-    /// once; `SceneDesc::diffuse_textures` stays empty until a material is textured).
-    pub fn intern(&mut self, m: Material, texture: Option<u32>, params: Vec<(Slot, u32)>) -> u32 {
-        let key = format!("{m:?}|{texture:?}|{params:?}");
+    /// The index of `m` with the reflectance texture `texture`, the textured parameters `params`
+    /// and the frame map `frame` in the scene's materials (added once;
+    /// `SceneDesc::diffuse_textures`, `param_textures` and `material_frames` stay empty until a
+    /// material has one).
+    pub fn intern(&mut self, m: Material, texture: Option<u32>, params: Vec<(Slot, u32)>, frame: Option<FrameMap>) -> u32 {
+        let key = format!("{m:?}|{texture:?}|{params:?}|{frame:?}");
         let n = self.desc.materials.len() as u32;
         let i = *self.materials.entry(key).or_insert_with(|| {
             self.desc.materials.push(m);
@@ -236,6 +243,11 @@ impl<'e> Build<'e> {
             let slots = &mut self.desc.param_textures;
             slots.resize(slots.len().max(i as usize + 1), Vec::new());
             slots[i as usize] = params;
+        }
+        if let Some(f) = frame {
+            let slots = &mut self.desc.material_frames;
+            slots.resize(slots.len().max(i as usize + 1), None);
+            slots[i as usize] = Some(f);
         }
         i
     }
@@ -357,19 +369,21 @@ impl<'e> Build<'e> {
         };
         self.pending_texture = None;
         self.pending_params.clear();
+        self.pending_frame = None;
         let material = match props.object("bsdf")? {
             Some(b) => self.bsdf(b)?,
             None => diffuse::default_material(),
         };
         let texture = self.pending_texture.take();
         let params = std::mem::take(&mut self.pending_params);
+        let frame = self.pending_frame.take();
         let emitter = match props.object("emitter")? {
             Some(em) => Some((self.area(em)?, em.at.clone())),
             None => None,
         };
         props.ignore("id");
         self.warnings.extend(props.unused());
-        Ok((out, self.intern(material, texture, params), emitter))
+        Ok((out, self.intern(material, texture, params, frame), emitter))
     }
 
     /// The file named by the plugin's `filename` string, resolved.

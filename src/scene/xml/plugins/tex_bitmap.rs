@@ -1,5 +1,6 @@
 //! `<texture type="bitmap">`: `filename` (PNG/JPEG/BMP/HDR/EXR), `raw`, `filter_type`
-//! (bilinear, nearest), `wrap_mode` (repeat, mirror, clamp), `to_uv`.
+//! (bilinear, nearest), `wrap_mode` (repeat, mirror, clamp), `to_uv`; `format` (Mitsuba's storage
+//! precision) is read and ignored: texels are f32.
 
 use super::{Build, Plugin, Run};
 use crate::scene::error::SceneError;
@@ -25,6 +26,8 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Texture, SceneError> {
     };
     let to_uv = UvTransform::from_mat4(p.transform("to_uv")?);
     p.ignore("id");
+    // Mitsuba's storage precision (`variant`, `uint8`...): strata keeps texels in f32 either way.
+    p.ignore("format");
     let bitmap = Bitmap::load(&path, &BitmapOptions { raw, filter, wrap }, &BitmapLimits::default())
         .map_err(|e| p.elem.at.err(format!("{}: {e}", p.elem.what())))?;
     Ok(Texture::BitmapTexture(BitmapTexture { bitmap: Arc::new(bitmap), to_uv }))

@@ -1,4 +1,4 @@
-//! `<texture type="rawconstant">`: `value` (rgb or float), used as given.
+//! `<texture type="rawconstant">`: `value` (rgb, float or vector), used as given.
 
 use super::{Build, Plugin, Run};
 use crate::scene::error::SceneError;
@@ -9,6 +9,11 @@ use crate::texture::{RawConstant, Texture};
 pub const PLUGIN: Plugin = Plugin { tag: "texture", kind: "rawconstant", run: Run::Texture(run) };
 
 fn run<'e>(_: &mut Build<'e>, p: &Props<'e>) -> Result<Texture, SceneError> {
+    if p.get("value").is_some_and(|e| e.tag == "vector" || e.tag == "point") {
+        let value = p.vec3("value")?.unwrap_or_default();
+        p.ignore("id");
+        return Ok(Texture::RawConstant(RawConstant { value }));
+    }
     let value = match p.color("value", false)? {
         Some(Color::Rgb(c)) => c,
         Some(Color::Texture(t)) => return Err(t.at.err("rawconstant's `value` must be a constant")),
