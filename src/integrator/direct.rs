@@ -29,8 +29,9 @@ use crate::light::select::LightChoice;
 use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::{PathDim, Stream};
-use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 
 #[path = "direct_env.rs"]

@@ -15,7 +15,7 @@ use crate::bsdf::LobeSet;
 use crate::integrator::context::{masked, TileCtx};
 use crate::integrator::samples::{Dim, Source};
 use crate::integrator::settings::Integrator;
-use crate::scene::build::SurfaceHit8;
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 
 /// The environment direction (2D), with an environment light only.

@@ -33,9 +33,10 @@ use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
-use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
 use crate::scene::desc::{ImportanceSampling, Nee};
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 use wave::{add_lanes, bits, Columns, Pack};
@@ -633,7 +634,7 @@ impl Bounce<'_> {
 fn light_pdf_at_hit_pmf(
     it: &Integrator,
     scene: &Scene,
-    sh: &crate::scene::build::SurfaceHit8,
+    sh: &crate::scene::gather::SurfaceHit8,
     rh: &RayHit8,
     is_light: Mask8,
     pmf: F8,
