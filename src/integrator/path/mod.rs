@@ -220,15 +220,11 @@ fn path_tile<L: LobeSet>(
             scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
             // Under `hide_emitters` camera rays (v = 1) see no emitter.
             let missed = if v == 1 && scene.desc.hide_emitters { Mask8::default() } else { *traced & !sh.valid };
-            if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
-                let (le, p_sky) = (Vec3x8::splat(sky.radiance), F8::splat(Sky::PDF));
-                let le = sky::escaped::<L>(it, v, le, p_sky, paths.get(PDF, ci), missed);
-                add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
-            }
-            if let Some(env) = scene.envmap.as_ref().filter(|_| has_env && missed.any()) {
-                let (le, p_env) = env.radiance_pdf_x8(r.ray.dir(), missed);
-                let le = sky::escaped::<L>(it, v, le, p_env, paths.get(PDF, ci), missed);
-                add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
+            if has_env && missed.any() {
+                let (slot, beta) = (paths.get_u(SLOT, ci), paths.get3(BETA, ci));
+                escaped::<L>(it, scene, v, r.ray.dir(), paths.get(PDF, ci), missed, |le| {
+                    add_lanes(radiance, slot, beta.mul_elem(le), missed)
+                });
             }
             if sh.valid.none() {
                 continue;
@@ -284,6 +280,30 @@ fn path_tile<L: LobeSet>(
         }
     }
     std::mem::swap(out, radiance);
+}
+
+/// The environment's radiance (sky, then envmap), weighted by the next-event mode
+/// ([`sky::escaped`]), that the rays `missed` of vertex `v` leaving along `dir` (sampled with
+/// `pdf`) bring, each handed to `add` (kept out of line: scenes without an environment never run
+/// it).
+#[inline(never)]
+fn escaped<L: LobeSet>(
+    it: &Integrator,
+    scene: &Scene,
+    v: u32,
+    dir: Vec3x8,
+    pdf: F8,
+    missed: Mask8,
+    mut add: impl FnMut(Vec3x8),
+) {
+    if let Some(sky) = scene.sky.as_ref() {
+        let (le, p_sky) = (Vec3x8::splat(sky.radiance), F8::splat(Sky::PDF));
+        add(sky::escaped::<L>(it, v, le, p_sky, pdf, missed));
+    }
+    if let Some(env) = scene.envmap.as_ref() {
+        let (le, p_env) = env.radiance_pdf_x8(dir, missed);
+        add(sky::escaped::<L>(it, v, le, p_env, pdf, missed));
+    }
 }
 
 /// +z in every lane.
