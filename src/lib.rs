@@ -21,6 +21,7 @@ pub mod measure;
 pub mod plan;
 pub mod pointset;
 pub mod profile;
+pub mod registry;
 pub mod render;
 pub mod report;
 pub mod sampler;

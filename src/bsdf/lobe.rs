@@ -15,7 +15,7 @@
 //! [`AllLobes`], its tests (and, for a faster specialized kernel, one line in `with_lobe_set!`).
 
 use super::interface::BsdfSet;
-use super::material::{Material, Material8};
+use super::material_types::{Material, Material8};
 use crate::bsdf::desc::BrdfKind;
 use crate::simd::{Mask8, Vec3x8, F8};
 use glam::Vec3;

@@ -7,8 +7,9 @@ use super::samples::{Dim, CAMERA};
 use super::settings::Integrator;
 use crate::bsdf::LobeSet;
 use crate::light::polygonal::polygon_phi_x8;
-use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Vec3x8, F8, U8};
 use std::f32::consts::PI;
 

@@ -8,7 +8,8 @@ use super::stats::{Counters, RayKind, RayLog};
 use crate::accel::{Ray8, RayHit8};
 use crate::bsdf::{BsdfSet, LobeSet, Material8};
 use crate::camera::PixelPacket;
-use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::build::Scene;
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 
 /// Embree calls with their counting and logging, written once.

@@ -17,8 +17,9 @@
 //! `direct` does with one emitter sample. `uniform` is then truly 1/#lights (quads and triangles
 //! alike).
 
-use super::context::{masked, material_in, shading_frame, TileCtx, Tracer};
+use super::context::{masked, TileCtx, Tracer};
 use super::estimator::Estimator;
+use super::light_term::{area_sample, frame_material, point_shadow, towards, AreaChoice, PointTerm, Shading};
 use super::primary::{self, Wave};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
@@ -29,8 +30,9 @@ use crate::light::select::LightChoice;
 use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::{PathDim, Stream};
-use crate::scene::build::{Scene, SurfaceHit8};
-use crate::scene::desc::IntegratorKind;
+use crate::scene::build::Scene;
+use crate::scene::desc::{ImportanceSampling, IntegratorKind};
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 #[path = "direct_env.rs"]
@@ -59,15 +61,19 @@ pub struct DirectScratch {
 /// Per-thread buffers of `direct`'s light sampling, reused across samples and tiles.
 #[derive(Default)]
 struct Buffers {
-    shade: Vec<Mask8>,
-    eps: Vec<F8>,
+    lanes: Lanes,
     acc: Vec<Vec3x8>,
-    shadow: Vec<(Ray8, Mask8)>,
-    contrib: Vec<Vec3x8>,
-    owner: Vec<u32>,
+    batch: Batch,
     streams: Vec<Stream<U8>>,
     /// one light per sample, `--light-choice dimension`: the light-choice streams
     choice_streams: Vec<Stream<U8>>,
+}
+
+/// Per camera packet of the tile: the lanes to shade and the shadow-ray origin offsets.
+#[derive(Default)]
+pub(super) struct Lanes {
+    shade: Vec<Mask8>,
+    eps: Vec<F8>,
 }
 
 impl Estimator for Direct {
@@ -97,7 +103,7 @@ enum Group<'a> {
 }
 
 impl Group<'_> {
-    /// A point on the group's light(s) for the unit-square sample (u, v) at the hits `sh`, and
+    /// A point on the group's light(s) for the unit-square sample `uv` at the hits `sh`, and
     /// the `active` lanes that got one.
     #[inline]
     fn sample(
@@ -105,20 +111,20 @@ impl Group<'_> {
         it: &Integrator,
         scene: &Scene,
         sh: &SurfaceHit8,
-        u: F8,
-        v: F8,
+        uv: (F8, F8),
         active: Mask8,
     ) -> (LightSample8, Mask8) {
         match self {
             Group::Quad(e) => {
-                let mut ls = e.sample_x8(u, v);
+                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                let mut ls = e.sample_x8(uv.0, uv.1);
                 e.warp_x8(it.light_warp, &mut ls, sh.p, active);
                 (ls, active)
             }
             // The triangle chosen by power from u, u remapped within its interval (`reuse`).
             Group::Triangles => {
-                let (mut ls, ok) =
-                    it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, (u, v));
+                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                let (mut ls, ok) = it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, uv);
                 scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
                 (ls, ok)
             }
@@ -141,16 +147,17 @@ fn shade<L: LobeSet>(
     s: u32,
     out: &mut [Vec3x8],
 ) {
-    if ctx.scene.emitters.is_empty() {
-        // No area light (only lights outside the selection): nothing to choose from.
-        shading_lanes(ctx.scene, hits, sc);
-    } else if it.light_selection.picks_one() {
-        shade_one::<L>(it, ctx, hits, sc, s, out);
-    } else {
-        shade_all::<L>(it, ctx, hits, sc, s, out);
+    shading_lanes(ctx.scene, hits, &mut sc.lanes);
+    // No area light (only lights outside the selection): nothing to choose from.
+    if !ctx.scene.emitters.is_empty() {
+        if it.light_selection.picks_one() {
+            shade_one::<L>(it, ctx, hits, sc, s, out);
+        } else {
+            shade_all::<L>(it, ctx, hits, sc, s, out);
+        }
     }
     if ctx.scene.sky.is_some() || ctx.scene.envmap.is_some() || !ctx.scene.delta.is_empty() {
-        env::shade_outside::<L>(it, ctx, hits, &sc.shade, &sc.eps, s, out);
+        env::shade_outside::<L>(it, ctx, hits, &sc.lanes, s, out);
     }
 }
 
@@ -170,76 +177,55 @@ fn shade_all<L: LobeSet>(
     // Solid-angle points carry their own 1 / pdf_area per sample (`ls.area`); area ones share
     // the quad's area, applied once per group.
     let warped = it.light_warp == LightWarp::SolidAngle;
-    shading_lanes(scene, hits, sc);
+    let Buffers { lanes, batch, acc, streams: st, .. } = sc;
     for (gi, group) in groups(scene).enumerate() {
         let dim = LIGHT_POINT.at(gi as u32);
         let table = LightTable::new(it, smp, dim, s);
-        sc.acc.clear();
-        sc.acc.resize(pks.len(), Vec3x8::ZERO);
-        sc.streams.clear();
+        acc.clear();
+        acc.resize(pks.len(), Vec3x8::ZERO);
+        st.clear();
         if streams {
-            smp.light_streams(pks, &sc.shade, s, dim, true, &mut sc.streams);
+            smp.light_streams(pks, &lanes.shade, s, dim, true, st);
         }
         for k in 0..n_light {
             let point_k = it.light_set.point_k(k);
-            sc.shadow.clear();
-            sc.contrib.clear();
-            sc.owner.clear();
-            // Per shading packet: point k of its stream, the light point, the light term and the
-            // shadow packet, in one pass (the sampler and emitter calls are leaf spans). Stream j
-            // is the j-th shading packet's.
-            let mut j = 0;
-            for i in 0..pks.len() {
-                let (sh, shade) = (&hits[i], sc.shade[i]);
-                if shade.none() {
-                    continue;
-                }
-                let (u, v) = if streams {
-                    smp.light_stream_point(&sc.streams[j as usize], j, k, &point_k)
+            // Point k of the shading packet's stream (stream j is the j-th shading packet's).
+            let point = |i: usize, j: u32| {
+                if streams {
+                    smp.light_stream_point(&st[j as usize], j, k, &point_k)
                 } else {
                     table.point(smp, pks[i].pixel, k)
-                };
-                j += 1;
-                let (ls, ok) = {
-                    let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                    group.sample(it, scene, sh, u, v, shade)
-                };
-                // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-                let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(scene, sh, &ls, ok) else { continue };
-                sc.contrib.push(match group {
-                    Group::Quad(_) if warped => f.scale(g * ls.area),
-                    Group::Quad(_) => f.scale(g),
-                    Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
-                });
-                // Shadow packet from the offset point towards the light sample, stopping short.
-                let o = sh.ng.mul_add(sc.eps[i], sh.p);
-                let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
-                let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
-                sc.shadow.push((ray, lit));
-                sc.owner.push(i as u32);
-            }
-            // A quad's sum is scaled once below; the triangles' terms are complete.
-            let Buffers { shadow, contrib, owner, acc, .. } = &mut *sc;
+                }
+            };
+            let sample =
+                |sh: &SurfaceHit8, shade: Mask8, _: usize, _: u32, uv: (F8, F8)| group.sample(it, scene, sh, uv, shade);
+            // f cos_i cos_l / d^2: a quad's sum is scaled once below; the triangles' terms are
+            // complete.
+            let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| match group {
+                Group::Quad(_) if warped => f.scale(g * ls.area),
+                Group::Quad(_) => f.scale(g),
+                Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
+            };
             let target = if let Group::Quad(_) = group { &mut acc[..] } else { &mut *out };
-            trace_shadow_batch(tracer, shadow, contrib, owner, target);
+            sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, target);
         }
         if let Group::Quad(light) = group {
             let area = if warped { F8::ONE } else { F8::splat(light.area) };
             let scale = Vec3x8::splat(light.radiance).scale(inv_n * area);
-            for (o, acc) in out.iter_mut().zip(&sc.acc) {
+            for (o, acc) in out.iter_mut().zip(acc.iter()) {
                 *o += acc.mul_elem(scale);
             }
         }
     }
 }
 
-/// Per camera packet of the tile: `sc.shade`, the hit lanes of `hits` to shade (lights shade
-/// nothing themselves: black, one-sided emitters), and `sc.eps`, the shadow-ray origin offsets.
-fn shading_lanes(scene: &Scene, hits: &[SurfaceHit8], sc: &mut Buffers) {
-    sc.shade.clear();
-    sc.shade.extend(hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
-    sc.eps.clear();
-    sc.eps.extend(hits.iter().map(|sh| scene.offset_eps(sh.p)));
+/// Per camera packet of the tile: the hit lanes of `hits` to shade (lights shade nothing
+/// themselves: black, one-sided emitters), and the shadow-ray origin offsets.
+fn shading_lanes(scene: &Scene, hits: &[SurfaceHit8], lanes: &mut Lanes) {
+    lanes.shade.clear();
+    lanes.shade.extend(hits.iter().map(|sh| sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)))));
+    lanes.eps.clear();
+    lanes.eps.extend(hits.iter().map(|sh| scene.offset_eps(sh.p)));
 }
 
 /// One light dimension of pixel sample `s` drawn from the integrator's light table, over all
@@ -278,7 +264,6 @@ fn shade_one<L: LobeSet>(
     let TileCtx { scene, pks, tracer, samples: smp } = ctx;
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
-    shading_lanes(scene, hits, sc);
     // One light picked for certain: the choice is light 0 with pmf 1 whatever its sample, so the
     // choice dimension is not drawn (every sample is a pure function of its own dimension: the
     // others are unchanged).
@@ -288,140 +273,125 @@ fn shade_one<L: LobeSet>(
     let streams = it.light_streams();
     let table = LightTable::new(it, smp, LIGHT_POINT.first, s);
     let choice_table = LightTable::new(it, smp, LIGHT_CHOICE.first, s);
-    sc.streams.clear();
-    sc.choice_streams.clear();
+    let Buffers { lanes, batch, streams: st, choice_streams, .. } = sc;
+    st.clear();
+    choice_streams.clear();
     if streams {
-        smp.light_streams(pks, &sc.shade, s, LIGHT_POINT.first, true, &mut sc.streams);
+        smp.light_streams(pks, &lanes.shade, s, LIGHT_POINT.first, true, st);
         if own_choice {
-            smp.light_streams(pks, &sc.shade, s, LIGHT_CHOICE.first, false, &mut sc.choice_streams);
+            smp.light_streams(pks, &lanes.shade, s, LIGHT_CHOICE.first, false, choice_streams);
         }
     }
     // Streams (and choice streams) j are the j-th shading packet's.
-    let n_shading = sc.streams.len() as u32;
+    let n_shading = st.len() as u32;
     for k in 0..n_light {
         let point_k = it.light_set.point_k(k);
-        sc.shadow.clear();
-        sc.contrib.clear();
-        sc.owner.clear();
-        let mut j = 0;
-        for i in 0..pks.len() {
-            let (sh, shade) = (&hits[i], sc.shade[i]);
-            if shade.none() {
-                continue;
-            }
-            let (u, v) = if streams {
-                smp.light_stream_point(&sc.streams[j as usize], j, k, &point_k)
+        let point = |i: usize, j: u32| {
+            if streams {
+                smp.light_stream_point(&st[j as usize], j, k, &point_k)
             } else {
                 table.point(smp, pks[i].pixel, k)
-            };
-            let (mut ls, ok) = if one_light {
-                // What `sample_point_x8` gives for one light: light 0, pmf 1 on the shaded lanes.
-                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                (scene.emitters.place_one_x8(0, F8::ONE, u, v), shade)
+            }
+        };
+        let sample = |sh: &SurfaceHit8, shade: Mask8, i: usize, j: u32, uv: (F8, F8)| {
+            let choice = if one_light {
+                AreaChoice::Certain
             } else if own_choice {
                 let (uc, _) = if streams {
-                    smp.light_stream_point(&sc.choice_streams[j as usize], n_shading + j, k, &point_k)
+                    smp.light_stream_point(&choice_streams[j as usize], n_shading + j, k, &point_k)
                 } else {
                     choice_table.point(smp, pks[i].pixel, k)
                 };
-                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                it.light_sampler.sample_point_x8(&scene.emitters, uc, sh.p, sh.n, shade, (u, v))
+                AreaChoice::Drawn(uc)
             } else {
-                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                it.light_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, v))
+                AreaChoice::Reuse
             };
-            j += 1;
-            scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
-            let Some(LightTerm { f, g, inv_d, lit }) = light_term::<L>(scene, sh, &ls, ok) else { continue };
+            area_sample(it, scene, sh, shade, choice, uv)
+        };
+        let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| {
             let g = g * ls.area * ls.inv_pmf * inv_n;
-            sc.contrib.push(masked(f.mul_elem(ls.radiance).scale(g), lit));
-            let o = sh.ng.mul_add(sc.eps[i], sh.p);
-            let tfar = F8::ONE - scene.offset_eps(ls.y) * inv_d;
-            let (ray, lit) = Ray8::new(o, ls.y - o, F8::ZERO, tfar, lit);
-            sc.shadow.push((ray, lit));
-            sc.owner.push(i as u32);
-        }
-        let Buffers { shadow, contrib, owner, .. } = &mut *sc;
-        trace_shadow_batch(tracer, shadow, contrib, owner, out);
+            masked(f.mul_elem(ls.radiance).scale(g), lit)
+        };
+        sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, out);
     }
 }
 
-/// What a light sample adds at a shading packet before visibility (see [`light_term`]).
-pub(super) struct LightTerm {
-    /// the BSDF value for the direction to the light
-    f: Vec3x8,
-    /// cos(th_i) cos(th_l) / d^2
-    g: F8,
-    /// 1 / d
-    inv_d: F8,
-    /// the `active` lanes the sample lights: both cosines positive, d > 0 and, on smooth-shaded
-    /// lanes, the light above the geometric surface too
-    lit: Mask8,
-}
-
-/// The light term of light points `ls` at hits `sh` on lanes `active`; None where it lights no
-/// lane.
+/// Light sample k of every shading packet of the tile: its unit-square point (`point(packet,
+/// shading packet)`), a light point from it (`sample(hits, shading lanes, packet, shading packet,
+/// point)`), the light term ([`towards`], the BSDF value) and what it adds if the shadow ray is
+/// clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`), traced as one batch into `target`.
+#[allow(clippy::too_many_arguments)]
 #[inline]
-pub(super) fn light_term<L: LobeSet>(
+fn sample_batch<L: LobeSet>(
     scene: &Scene,
-    sh: &SurfaceHit8,
-    ls: &LightSample8,
-    active: Mask8,
-) -> Option<LightTerm> {
-    let to = ls.y - sh.p;
-    let d2 = to.length_squared();
-    let inv_d = F8::ONE / d2.sqrt();
-    let wi = to.scale(inv_d);
-    let cos_i = sh.n.dot(wi);
-    let cos_l = -ls.normal.dot(wi);
-    // Smooth-shaded lanes: the light must also be above the geometric surface.
-    let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
-    let lit = active & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves;
-    if lit.none() {
-        return None;
-    }
-    let f = {
-        let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-        // The path tracer's material code, in the local shading frame.
-        let frame = shading_frame::<L>(scene, sh);
-        let mat = material_in::<L>(scene, sh, &frame);
-        let strategy = crate::scene::desc::ImportanceSampling::Cosine;
-        mat.eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0
-    };
-    Some(LightTerm { f, g: cos_i * cos_l * inv_d * inv_d, inv_d, lit })
-}
-
-/// The BSDF value and cos(th_i) for the unit directions `wi` at hits `sh` on lanes `active`, and
-/// the lanes lit (cos(th_i) > 0, and above the geometric surface on smooth-shaded lanes); None
-/// where no lane is lit (for lights at a direction rather than a point: environment, delta).
-#[inline]
-fn light_term_f<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Option<(Vec3x8, F8, Mask8)> {
-    let cos_i = sh.n.dot(wi);
-    let leaves = !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
-    let lit = active & cos_i.simd_gt(F8::ZERO) & leaves;
-    if lit.none() {
-        return None;
-    }
-    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-    let frame = shading_frame::<L>(scene, sh);
-    let mat = material_in::<L>(scene, sh, &frame);
-    let strategy = crate::scene::desc::ImportanceSampling::Cosine;
-    let f = mat.eval_pdf_k::<L>(strategy, frame.to_local(sh.wo), frame.to_local(wi), lit).0;
-    Some((f, lit.select(cos_i, F8::ZERO), lit))
-}
-
-/// Traces a batch of shadow packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the
-/// lanes of packet j whose shadow ray reached the light.
-pub(super) fn trace_shadow_batch(
     tracer: &mut Tracer,
-    shadow: &mut [(Ray8, Mask8)],
-    contrib: &[Vec3x8],
-    owner: &[u32],
-    acc: &mut [Vec3x8],
+    hits: &[SurfaceHit8],
+    lanes: &Lanes,
+    batch: &mut Batch,
+    mut point: impl FnMut(usize, u32) -> (F8, F8),
+    mut sample: impl FnMut(&SurfaceHit8, Mask8, usize, u32, (F8, F8)) -> (LightSample8, Mask8),
+    weigh: impl Fn(&LightSample8, Vec3x8, F8, Mask8) -> Vec3x8,
+    target: &mut [Vec3x8],
 ) {
-    let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
-    for (j, (ray, lit)) in shadow.iter_mut().enumerate() {
-        let occluded = tracer.occluded(ray, *lit);
-        acc[owner[j] as usize] += masked(contrib[j], *lit & !occluded);
+    batch.clear();
+    // Per shading packet: the point, the light point, the light term and the shadow packet, in
+    // one pass (the sampler and emitter calls are leaf spans).
+    let mut j = 0;
+    for (i, sh) in hits.iter().enumerate() {
+        let shade = lanes.shade[i];
+        if shade.none() {
+            continue;
+        }
+        let uv = point(i, j);
+        let (ls, ok) = sample(sh, shade, i, j, uv);
+        j += 1;
+        // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
+        let PointTerm { wi, inv_d, cos_i, cos_l, lit, .. } = towards(sh, &ls, ok);
+        if lit.none() {
+            continue;
+        }
+        let (frame, mat) = frame_material::<L>(scene, sh);
+        let at = Shading::new(sh, frame, &mat, ImportanceSampling::Cosine);
+        let f = at.eval::<L>(at.frame.to_local(wi), lit).0;
+        batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
+        // Shadow packet from the offset point towards the light sample, stopping short.
+        let o = sh.ng.mul_add(lanes.eps[i], sh.p);
+        let (d, tfar) = point_shadow(scene, o, ls.y, inv_d);
+        batch.push(Ray8::new(o, d, F8::ZERO, tfar, lit), i);
+    }
+    batch.trace(tracer, target);
+}
+
+/// Shadow packets of a batch and what each adds to its owner's radiance if unoccluded.
+#[derive(Default)]
+pub(super) struct Batch {
+    shadow: Vec<(Ray8, Mask8)>,
+    contrib: Vec<Vec3x8>,
+    owner: Vec<u32>,
+}
+
+impl Batch {
+    /// Empty.
+    pub(super) fn clear(&mut self) {
+        self.shadow.clear();
+        self.contrib.clear();
+        self.owner.clear();
+    }
+
+    /// A shadow packet (its ray and lit lanes) of the camera packet `owner`; its contribution is
+    /// pushed onto `contrib` before.
+    pub(super) fn push(&mut self, ray: (Ray8, Mask8), owner: usize) {
+        self.shadow.push(ray);
+        self.owner.push(owner as u32);
+    }
+
+    /// Traces the packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the lanes of
+    /// packet j whose shadow ray reached the light.
+    pub(super) fn trace(&mut self, tracer: &mut Tracer, acc: &mut [Vec3x8]) {
+        let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
+        for (j, (ray, lit)) in self.shadow.iter_mut().enumerate() {
+            let occluded = tracer.occluded(ray, *lit);
+            acc[self.owner[j] as usize] += masked(self.contrib[j], *lit & !occluded);
+        }
     }
 }

@@ -9,88 +9,70 @@
 //! surface); camera rays that escape see
 //! the environment directly (`primary.rs`).
 
-use super::{light_term_f, trace_shadow_batch, LightTable, DIM_LIGHT_BASE};
+use super::{Batch, Lanes, LightTable, DIM_LIGHT_BASE};
 use crate::accel::Ray8;
 use crate::bsdf::LobeSet;
 use crate::integrator::context::{masked, TileCtx};
+use crate::integrator::light_term::{env_sample, frame_material, Shading, SkySampling};
 use crate::integrator::samples::{Dim, Source};
 use crate::integrator::settings::Integrator;
-use crate::scene::build::SurfaceHit8;
-use crate::simd::{Frame8, Mask8, Vec3x8, F8};
+use crate::scene::desc::ImportanceSampling;
+use crate::scene::gather::SurfaceHit8;
+use crate::simd::{Mask8, Vec3x8, F8};
 
 /// The environment direction (2D), with an environment light only.
 pub const ENVIRONMENT: Dim =
     Dim { name: "environment direction", first: DIM_LIGHT_BASE - 8, stride: 0, source: Source::Light };
 
 /// Adds the environment's and the delta lights' direct light at the hits `hits` (shading lanes
-/// `shade`, shadow-ray offsets `eps`) of pixel sample `s` to `out`.
+/// and shadow-ray offsets `lanes`) of pixel sample `s` to `out`.
 pub(super) fn shade_outside<L: LobeSet>(
     it: &Integrator,
     ctx: &mut TileCtx,
     hits: &[SurfaceHit8],
-    shade: &[Mask8],
-    eps: &[F8],
+    lanes: &Lanes,
     s: u32,
     out: &mut [Vec3x8],
 ) {
     let TileCtx { scene, pks, tracer, samples: smp } = ctx;
-    let (mut shadow, mut contrib, mut owner) = (Vec::new(), Vec::new(), Vec::new());
+    let mut batch = Batch::default();
     let n_light = it.light_set.n();
     let inv_n = F8::splat(1.0 / n_light as f32);
+    // No throughput: the light term itself (1 f is f, bit for bit).
+    let one = Vec3x8::splat(glam::Vec3::ONE);
     if scene.sky.is_some() || scene.envmap.is_some() {
         let table = LightTable::new(it, smp, ENVIRONMENT.first, s);
         for k in 0..n_light {
             for (i, sh) in hits.iter().enumerate() {
-                if shade[i].none() {
+                let shade = lanes.shade[i];
+                if shade.none() {
                     continue;
                 }
-                let (u, v) = table.point(smp, pks[i].pixel, k);
-                let frame = Frame8::from_normal(sh.n);
-                let (wi, pdf, le) = {
-                    let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                    match (&scene.sky, &scene.envmap) {
-                        (Some(sky), _) => {
-                            // Cosine-weighted about the shading normal: for a diffuse surface the
-                            // estimate is `L kd` wherever the sky is visible (Mitsuba's MIS of
-                            // light and BSDF samples comes close to it; uniform hemisphere samples
-                            // had 12 times its variance on a plane, which its z-test rejects).
-                            let (wl, pdf) = crate::sampling::sample_cosine_hemisphere_x8([u, v], shade[i]);
-                            (frame.to_world(wl), pdf, Vec3x8::splat(sky.radiance))
-                        }
-                        (None, Some(env)) => env.sample_x8(u, v, shade[i]),
-                        (None, None) => unreachable!("checked above"),
-                    }
-                };
-                let ok = shade[i] & pdf.simd_gt(F8::ZERO);
-                let Some((f, cos, lit)) = light_term_f::<L>(scene, sh, wi, ok) else { continue };
-                contrib.push(masked(f.mul_elem(le).scale(cos / pdf * inv_n), lit));
-                let o = sh.ng.mul_add(eps[i], sh.p);
-                let (ray, lit) = Ray8::new(o, wi, F8::ZERO, F8::splat(f32::INFINITY), lit);
-                shadow.push((ray, lit));
-                owner.push(i as u32);
+                let uv = table.point(smp, pks[i].pixel, k);
+                let (frame, mat) = frame_material::<L>(scene, sh);
+                let at = Shading::new(sh, frame, &mat, ImportanceSampling::Cosine);
+                let Some(e) = env_sample(scene, SkySampling::Cosine, &at.frame, uv, shade) else { continue };
+                let Some((lit, wi, c)) = at.env_event::<L>(&e, one, shade, |_, _| inv_n) else { continue };
+                batch.contrib.push(masked(c, lit));
+                let o = sh.ng.mul_add(lanes.eps[i], sh.p);
+                batch.push(Ray8::new(o, wi, F8::ZERO, F8::splat(f32::INFINITY), lit), i);
             }
         }
     }
-    for light in &scene.delta {
+    if !scene.delta.is_empty() {
         for (i, sh) in hits.iter().enumerate() {
-            if shade[i].none() {
+            let shade = lanes.shade[i];
+            if shade.none() {
                 continue;
             }
-            let (wi, dist, li, ok) = {
-                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                light.sample_x8(sh.p, shade[i])
-            };
-            let Some((f, cos, lit)) = light_term_f::<L>(scene, sh, wi, ok) else { continue };
-            contrib.push(masked(f.mul_elem(li).scale(cos), lit));
-            let o = sh.ng.mul_add(eps[i], sh.p);
-            let tfar = match light.position() {
-                Some(y) => dist - scene.offset_eps(Vec3x8::splat(y)),
-                None => F8::splat(f32::INFINITY),
-            };
-            let (ray, lit) = Ray8::new(o, wi, F8::ZERO, tfar, lit);
-            shadow.push((ray, lit));
-            owner.push(i as u32);
+            let (frame, mat) = frame_material::<L>(scene, sh);
+            let at = Shading::new(sh, frame, &mat, ImportanceSampling::Cosine);
+            let o = sh.ng.mul_add(lanes.eps[i], sh.p);
+            at.delta_events::<L>(scene, one, shade, |lit: Mask8, wi, tfar, c| {
+                batch.contrib.push(masked(c, lit));
+                batch.push(Ray8::new(o, wi, F8::ZERO, tfar, lit), i);
+            });
         }
     }
-    trace_shadow_batch(tracer, &mut shadow, &contrib, &owner, out);
+    batch.trace(tracer, out);
 }

@@ -28,6 +28,7 @@ pub mod context;
 pub mod direct;
 pub mod estimator;
 pub mod kernel;
+pub mod light_term;
 pub mod path;
 mod primary;
 pub mod ptracer;

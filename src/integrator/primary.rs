@@ -6,7 +6,7 @@ use super::context::{masked, TileCtx};
 use super::stats::RayKind;
 use crate::accel::{Hits8, RayHit8};
 use crate::sampler::Stream;
-use crate::scene::build::SurfaceHit8;
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 /// Per-thread buffers of the camera-hit wavefront, reused across samples and tiles.

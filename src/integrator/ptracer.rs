@@ -35,7 +35,8 @@
 //! `DIM_PT_BASE + 2 + 2 (k - 1)` and (roulette, lobe choice) one after, each over the pixel's spp
 //! samples of the pixel the path is started for.
 
-use super::context::{material, TileCtx};
+use super::context::TileCtx;
+use super::light_term::frame_material;
 use super::estimator::Estimator;
 use super::samples::{Dim, Source};
 use super::settings::Integrator;
@@ -45,7 +46,8 @@ use crate::bsdf::LobeSet;
 use crate::camera::PixelPacket;
 use crate::light::emission::EmissionSample;
 use crate::profile::Phase;
-use crate::scene::build::{Lens, Scene, SurfaceHit8};
+use crate::scene::build::{Lens, Scene};
+use crate::scene::gather::SurfaceHit8;
 use crate::scene::desc::IntegratorKind;
 use crate::simd::{mask_from_bools, mask_to_bools, Frame8, Vec3x8, F8, U8};
 use glam::{Mat3, Vec3};
@@ -310,9 +312,8 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
             if shade.none() {
                 break;
             }
-            let frame = Frame8::from_normal(sh.n);
+            let (frame, mat) = frame_material::<L>(scene, &sh);
             let wo = frame.to_local(sh.wo);
-            let mat = material::<L>(scene, &sh);
             let eps = scene.offset_eps(sh.p);
             // The connection to the sensor of every shaded lane.
             conn.clear();

@@ -15,8 +15,9 @@ use super::settings::Integrator;
 use super::stats::RayKind;
 use crate::accel::{Hits8, Ray8, RayHit8};
 use crate::bsdf::LobeSet;
-use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
+use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8};
 
 /// Mirror bounces when `maxdepth` is negative (unbounded is not meaningful without roulette).

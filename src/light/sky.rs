@@ -56,14 +56,22 @@ impl Sky {
     /// pdf the direction was sampled with).
     #[inline]
     pub fn escaped_x8(&self, nee: bool, mis: bool, v: u32, pdf_bsdf: F8, missed: Mask8) -> Vec3x8 {
-        let w = if v == 1 || !nee {
-            missed.select(F8::ONE, F8::ZERO)
-        } else if mis {
-            power_heuristic_x8(pdf_bsdf, F8::splat(Self::PDF), missed)
-        } else {
-            F8::ZERO
-        };
-        Vec3x8::splat(self.radiance).scale(w)
+        Vec3x8::splat(self.radiance).scale(escaped_weight_x8(nee, mis, v, pdf_bsdf, F8::splat(Self::PDF), missed))
+    }
+}
+
+/// The weight of an environment's radiance that the escaped rays `missed` of path vertex `v` (1:
+/// camera rays) bring, by next-event mode: `nee` off counts it always, `nee` on only for camera
+/// rays (next events counted it after), MIS weighs it with the power heuristic of `pdf_bsdf` (the
+/// pdf the direction was sampled with) against the light's `p_light`. The sky's and the envmap's.
+#[inline]
+pub fn escaped_weight_x8(nee: bool, mis: bool, v: u32, pdf_bsdf: F8, p_light: F8, missed: Mask8) -> F8 {
+    if v == 1 || !nee {
+        missed.select(F8::ONE, F8::ZERO)
+    } else if mis {
+        power_heuristic_x8(pdf_bsdf, p_light, missed)
+    } else {
+        F8::ZERO
     }
 }
 

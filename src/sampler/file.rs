@@ -436,19 +436,24 @@ mod tests {
         fixed24(f64::from(x))
     }
 
+    /// Eight lanes of kind `k`'s points (mixed pixels and point indices) equal its scalar points.
+    fn assert_x8_is_scalar(k: SamplerKind) {
+        use crate::simd::U8;
+        let set = PointSet::for_image(k, 5, 9);
+        let pixel = U8::new([0, 1, 2, 3, 100, 1000, 77, 5]);
+        let kk = U8::new([0, 1, 2, 3, 4, 0, 1, 2]);
+        let (x, y) = set.point_x8(pixel, U8::splat(2), 3, kk, 11);
+        let (x, y) = (x.to_array(), y.to_array());
+        for l in 0..8 {
+            assert_eq!(set.point(pixel.to_array()[l], 2, 3, kk.to_array()[l], 11), [x[l], y[l]]);
+        }
+    }
+
     #[test]
     fn scalar_and_x8_agree() {
-        use crate::simd::U8;
         for scramble in [Scramble::Shift, Scramble::Xor, Scramble::Owen, Scramble::None] {
             let k = kind(SetMap::Hash, scramble, "x8");
-            let set = PointSet::for_image(k, 5, 9);
-            let pixel = U8::new([0, 1, 2, 3, 100, 1000, 77, 5]);
-            let kk = U8::new([0, 1, 2, 3, 4, 0, 1, 2]);
-            let (x, y) = set.point_x8(pixel, U8::splat(2), 3, kk, 11);
-            let (x, y) = (x.to_array(), y.to_array());
-            for l in 0..8 {
-                assert_eq!(set.point(pixel.to_array()[l], 2, 3, kk.to_array()[l], 11), [x[l], y[l]]);
-            }
+            assert_x8_is_scalar(k);
         }
     }
 
@@ -581,7 +586,6 @@ mod tests {
 
     #[test]
     fn shuffled_lanes_agree() {
-        use crate::simd::U8;
         for progressive in [false, true] {
             let layout = FileLayout {
                 table: table(3, 16),
@@ -593,14 +597,7 @@ mod tests {
             };
             let k = register("file:x8", if progressive { "x8 shuffled p" } else { "x8 shuffled" }, layout).unwrap();
             assert_eq!(whole_set_points(k), (!progressive).then_some(16));
-            let set = PointSet::for_image(k, 5, 9);
-            let pixel = U8::new([0, 1, 2, 3, 100, 1000, 77, 5]);
-            let kk = U8::new([0, 1, 2, 3, 4, 0, 1, 2]);
-            let (x, y) = set.point_x8(pixel, U8::splat(2), 3, kk, 11);
-            let (x, y) = (x.to_array(), y.to_array());
-            for l in 0..8 {
-                assert_eq!(set.point(pixel.to_array()[l], 2, 3, kk.to_array()[l], 11), [x[l], y[l]]);
-            }
+            assert_x8_is_scalar(k);
         }
     }
 }

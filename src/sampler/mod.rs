@@ -169,7 +169,7 @@ impl SamplerKind {
     pub const fn named(name: &str) -> Self {
         let mut i = 0;
         while i < SAMPLERS.len() {
-            if const_eq(SAMPLERS[i].name.as_bytes(), name.as_bytes()) {
+            if crate::registry::same_name(SAMPLERS[i].name, name) {
                 return SamplerKind(i as u8);
             }
             i += 1;
@@ -242,20 +242,6 @@ impl std::fmt::Debug for SamplerKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
-}
-
-const fn const_eq(a: &[u8], b: &[u8]) -> bool {
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
 }
 
 // ------------------------------------------------------------------------------------------------

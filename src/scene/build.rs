@@ -12,7 +12,7 @@
 //! below that shading normal (`ns . wo <= 0`, although above the geometric one), or the
 //! interpolation vanishes, the hit falls back to the geometric normal (no bending): a hit is never
 //! shaded from the back of its shading frame. The geometric normal `ng` stays in the record for ray
-//! offsets and for the side tests of integrators ([`SurfaceHit8::smooth`] marks the lanes where
+//! offsets and for the side tests of integrators ([`super::gather::SurfaceHit8::smooth`] marks the lanes where
 //! the two differ); light emission and facing use the geometric normals of the lights.
 
 use crate::accel::{self, INVALID_ID};
@@ -20,8 +20,6 @@ use crate::light::emitters::{Emitter, Emitters};
 use crate::scene::desc::{CameraDesc, FilmCrop, Material, Projection, SceneDesc, SensorDesc};
 use crate::simd::{Vec3x8, F8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
-
-pub use super::gather::SurfaceHit8;
 
 /// The camera: the `.test` look-at pinhole (full vertical field of view), or a Mitsuba sensor
 /// ([`Lens`]), with the pixel filter's jitter warp.
@@ -248,7 +246,7 @@ pub struct Scene {
     /// the scene's textures (`desc.textures`, `mesh_attribute`s bound to `desc.triangle_attrs`)
     pub textures: Vec<crate::texture::Texture>,
     /// per material: the index in `textures` of its diffuse texture or
-    /// [`super::texturing::NO_TEXTURE`]; empty when no material is textured (then gather reads
+    /// [`NO_TEXTURE`]; empty when no material is textured (then gather reads
     /// no texture and builds no uv)
     pub material_texture: Vec<u32>,
     /// per material: its textured BSDF parameters (`SceneDesc::param_textures`); empty when no
@@ -256,7 +254,7 @@ pub struct Scene {
     /// is (hits then carry their texture query, [`SurfaceHit8::tex`])
     pub param_textures: Vec<Vec<(crate::bsdf::interface::Slot, u32)>>,
     /// some material is a registry BSDF (not the course's): hits then carry material ids and
-    /// sides ([`SurfaceHit8::material`], [`SurfaceHit8::back`]), which only such BSDFs read
+    /// sides ([`super::gather::SurfaceHit8::material`], [`super::gather::SurfaceHit8::back`]), which only such BSDFs read
     pub registry_bsdfs: bool,
     /// per scene triangle: its corner uvs, `[ZERO; 3]` for none; empty when the scene has no
     /// uvs, or neither a textured material nor tangents
@@ -397,6 +395,9 @@ pub struct Backend {
     pub spheres: &'static str,
 }
 
+/// The entry of `Scene::material_texture` of a material without a texture.
+pub const NO_TEXTURE: u32 = u32::MAX;
+
 /// A scene's textures (mesh attributes bound) and the texture index of each scene material.
 type TexturingTables = (Vec<crate::texture::Texture>, Vec<u32>);
 
@@ -411,7 +412,7 @@ fn texturing_tables(desc: &SceneDesc, n_materials: usize) -> Result<Option<Textu
     }
     // Only normal or bump maps: the textures without a diffuse texture table (textured BSDF
     // parameters are evaluated where the reflectance textures are, so they need one).
-    let mut material_texture = vec![super::texturing::NO_TEXTURE; if textured || params { n_materials } else { 0 }];
+    let mut material_texture = vec![NO_TEXTURE; if textured || params { n_materials } else { 0 }];
     for (m, t) in desc.diffuse_textures.iter().enumerate() {
         let Some(t) = *t else { continue };
         if t as usize >= desc.textures.len() || m >= desc.materials.len() {

@@ -4,15 +4,12 @@
 //! reflectance of the lanes whose material has one. [`Scene::gather`] calls this only when the
 //! scene has a textured material, so a scene without textures runs none of it.
 
-use super::build::Scene;
+use super::build::{Scene, NO_TEXTURE};
 use super::gather::SurfaceHit8;
 use crate::accel::{Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES};
 use crate::simd::{Vec3x8, F8, U8};
 use crate::texture::{TexQuery8, NO_TRIANGLE};
 use glam::{Vec2, Vec3};
-
-/// The entry of `Scene::material_texture` of a material without a texture.
-pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// Mitsuba's uv of a point of the unit sphere (object space): `u = phi / 2pi` with `phi` the
 /// azimuth about +z in [0, 2pi) from +x, `v = theta / pi` with `theta` the angle from +z.

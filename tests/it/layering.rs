@@ -7,14 +7,6 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Circles left for a later session, as sorted file lists (relative to `src/`). Break one and
-/// delete its line here: the test also fails when a listed circle is gone, so the list only shrinks.
-const KNOWN: &[&[&str]] = &[
-    // In folders another branch of issue 34 is rewriting (bsdf/, scene/): broken there.
-    &["bsdf/lobe.rs", "bsdf/material.rs"],
-    &["scene/build.rs", "scene/gather.rs", "scene/texturing.rs"],
-];
-
 /// Every `.rs` file under `dir`, relative to `root`, with `/` separators.
 fn rust_files(root: &Path, dir: &Path, out: &mut Vec<String>) {
     for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
@@ -260,17 +252,13 @@ fn circles(g: &BTreeMap<String, BTreeSet<String>>) -> BTreeSet<Vec<String>> {
 }
 
 #[test]
-fn no_file_circles_in_src_beyond_the_known_ones() {
+fn no_file_circles_in_src() {
     let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src");
     let found = circles(&graph(&src));
-    let known: BTreeSet<Vec<String>> = KNOWN.iter().map(|c| c.iter().map(|f| f.to_string()).collect()).collect();
-    let new: Vec<_> = found.difference(&known).collect();
-    let gone: Vec<_> = known.difference(&found).collect();
     assert!(
-        new.is_empty(),
-        "files that import each other (around a circle): {new:?}; move the shared piece down a level"
+        found.is_empty(),
+        "files that import each other (around a circle): {found:?}; move the shared piece down a level"
     );
-    assert!(gone.is_empty(), "circles no longer there (delete them from KNOWN): {gone:?}");
 }
 
 /// The checker itself, on a made-up tree: a circle through `super::` and a `use` tree is found,

@@ -19,8 +19,9 @@
 //! from dim 0's first coordinate); dim 3 only where roulette or the lobe pick needs it. A
 //! dimension not drawn changes no other.
 
-use super::context::{masked, material_in, shading_frame, TileCtx};
+use super::context::{masked, TileCtx};
 use super::estimator::Estimator;
+use super::light_term::{area_sample, env_sample, frame_material, point_shadow, towards, AreaChoice, PointTerm, Shading, SkySampling};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
 use super::stats::RayKind;
@@ -29,14 +30,16 @@ use crate::bsdf::interface::flags as lobe_flags;
 use crate::bsdf::{BsdfSet, LobeSet};
 use crate::light::emitters::LightSample8;
 use crate::light::select::LightChoice;
+use crate::light::sky::Sky;
 use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
-use crate::scene::build::{Scene, SurfaceHit8};
+use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
 use crate::scene::desc::{ImportanceSampling, Nee};
-use crate::simd::{Frame8, Mask8, Vec3x8, F8, U8};
+use crate::scene::gather::SurfaceHit8;
+use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 use wave::{add_lanes, bits, Columns, Pack};
 
@@ -218,13 +221,11 @@ fn path_tile<L: LobeSet>(
             scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
             // Under `hide_emitters` camera rays (v = 1) see no emitter.
             let missed = if v == 1 && scene.desc.hide_emitters { Mask8::default() } else { *traced & !sh.valid };
-            if let Some(sky) = scene.sky.as_ref().filter(|_| missed.any()) {
-                let le = sky::escaped::<L>(it, sky, v, paths.get(PDF, ci), missed);
-                add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
-            }
-            if let Some(env) = scene.envmap.as_ref().filter(|_| has_env && missed.any()) {
-                let le = sky::escaped_envmap::<L>(it, env, v, r.ray.dir(), paths.get(PDF, ci), missed);
-                add_lanes(radiance, paths.get_u(SLOT, ci), paths.get3(BETA, ci).mul_elem(le), missed);
+            if has_env && missed.any() {
+                let (slot, beta) = (paths.get_u(SLOT, ci), paths.get3(BETA, ci));
+                escaped::<L>(it, scene, v, r.ray.dir(), paths.get(PDF, ci), missed, |le| {
+                    add_lanes(radiance, slot, beta.mul_elem(le), missed)
+                });
             }
             if sh.valid.none() {
                 continue;
@@ -280,6 +281,30 @@ fn path_tile<L: LobeSet>(
         }
     }
     std::mem::swap(out, radiance);
+}
+
+/// The environment's radiance (sky, then envmap), weighted by the next-event mode
+/// ([`sky::escaped`]), that the rays `missed` of vertex `v` leaving along `dir` (sampled with
+/// `pdf`) bring, each handed to `add` (kept out of line: scenes without an environment never run
+/// it).
+#[inline(never)]
+fn escaped<L: LobeSet>(
+    it: &Integrator,
+    scene: &Scene,
+    v: u32,
+    dir: Vec3x8,
+    pdf: F8,
+    missed: Mask8,
+    mut add: impl FnMut(Vec3x8),
+) {
+    if let Some(sky) = scene.sky.as_ref() {
+        let (le, p_sky) = (Vec3x8::splat(sky.radiance), F8::splat(Sky::PDF));
+        add(sky::escaped::<L>(it, v, le, p_sky, pdf, missed));
+    }
+    if let Some(env) = scene.envmap.as_ref() {
+        let (le, p_env) = env.radiance_pdf_x8(dir, missed);
+        add(sky::escaped::<L>(it, v, le, p_env, pdf, missed));
+    }
 }
 
 /// +z in every lane.
@@ -363,9 +388,9 @@ impl Bounce<'_> {
             return;
         }
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
-        let frame = shading_frame::<L>(scene, sh);
-        let wo = frame.to_local(sh.wo);
-        let mat = material_in::<L>(scene, sh, &frame);
+        let (frame, mat) = frame_material::<L>(scene, sh);
+        let at = Shading::new(sh, frame, &mat, it.path.strategy);
+        let (frame, wo) = (&at.frame, at.wo);
         // Registry BSDFs that transmit: directions may cross the surface (compile-time).
         let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;
         let eps = scene.offset_eps(sh.p);
@@ -373,7 +398,7 @@ impl Bounce<'_> {
         let o = sh.ng.mul_add(eps, sh.p);
         // Smooth-shaded lanes: directions must also leave the geometric surface (on the side of
         // the shading normal they leave: transmitted ones below both).
-        let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+        let leaves = |wi: Vec3x8| at.leaves(wi);
         let leaves_either = |wi: Vec3x8| {
             let (a, b) = (sh.ng.dot(wi), sh.n.dot(wi));
             !sh.smooth | (a.simd_gt(F8::ZERO) & b.simd_gt(F8::ZERO)) | (a.simd_lt(F8::ZERO) & b.simd_lt(F8::ZERO))
@@ -387,10 +412,10 @@ impl Bounce<'_> {
         let own_choice = picks && it.light_choice == LightChoice::Dimension;
 
         if nee_here {
-            self.sky_next_event::<L>(vx, &frame, wo, &mat, o, shade, leaves);
+            self.env_next_event::<L>(vx, &at, o, shade);
         }
         if delta_here {
-            self.delta_next_events::<L>(vx, &frame, wo, &mat, o, shade);
+            self.delta_next_events::<L>(vx, &at, o, shade);
         }
         if nee_here && n_lights > 0 {
             let u_choice = if own_choice {
@@ -401,15 +426,8 @@ impl Bounce<'_> {
             let (u, w) = self.smp.table_point(&self.dk[0], true, Phase::SamplerPath, pixel, s);
             let shadow = &mut *self.shadow;
             let mut push = |ls: &LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
-                let (y, ln, l_rad, area, inv_pmf) = (ls.y, ls.normal, ls.radiance, ls.area, ls.inv_pmf);
-                let to = y - sh.p;
-                let d2 = to.length_squared();
-                let inv_d = F8::ONE / d2.sqrt();
-                let wi = to.scale(inv_d);
-                let mut cos_i = sh.n.dot(wi);
-                let cos_l = -ln.dot(wi);
-                let mut lit =
-                    ok & cos_i.simd_gt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO) & leaves(wi);
+                let (y, l_rad, area, inv_pmf) = (ls.y, ls.radiance, ls.area, ls.inv_pmf);
+                let PointTerm { wi, d2, inv_d, mut cos_i, cos_l, mut lit } = towards(sh, ls, ok);
                 // Transmitting lanes: lights below the surface too.
                 let below = if transmits && general.any() {
                     let below = ok & general & cos_i.simd_lt(F8::ZERO) & cos_l.simd_gt(F8::ZERO) & d2.simd_gt(F8::ZERO);
@@ -423,10 +441,7 @@ impl Bounce<'_> {
                 if lit.none() {
                     return;
                 }
-                let (f, pdf_b) = {
-                    let _p = crate::profile::leaf(crate::profile::Phase::BsdfEval);
-                    mat.eval_pdf_k::<L>(it.path.strategy, wo, frame.to_local(wi), lit)
-                };
+                let (f, pdf_b) = at.eval::<L>(frame.to_local(wi), lit);
                 // No shadow ray where a registry BSDF has no value (delta lobes only).
                 let lit = if <L::Bsdfs as BsdfSet>::BITS != 0 {
                     lit & !(general & f.max_elem().simd_le(F8::ZERO))
@@ -451,9 +466,8 @@ impl Bounce<'_> {
                     F8::ONE
                 };
                 let c = beta.mul_elem(f).mul_elem(l_rad).scale(g * w_light);
-                let tfar = F8::ONE - scene.offset_eps(y) * inv_d;
                 let o = if transmits { Vec3x8::select(below, o_below, o) } else { o };
-                let d = y - o;
+                let (d, tfar) = point_shadow(scene, o, y, inv_d);
                 // The lit lanes, left-packed onto the bounce's shadow rays.
                 let pack = Pack::of(lit);
                 shadow.write(S_SLOT, &pack, &[bits(vx.slot), o.x, o.y, o.z, d.x, d.y, d.z, tfar, c.x, c.y, c.z]);
@@ -461,15 +475,8 @@ impl Bounce<'_> {
             };
             if it.light_sampler.certain() {
                 // The one light (pmf 1), a point on it uniform in area.
-                {
-                    let ls = {
-                        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                        let mut ls = scene.emitters.list[0].sample_x8(u, w);
-                        scene.emitters.list[0].warp_x8(it.light_warp, &mut ls, sh.p, shade);
-                        ls
-                    };
-                    push(&ls, None, None, shade)
-                }
+                let (ls, ok) = area_sample(it, scene, sh, shade, AreaChoice::Certain, (u, w));
+                push(&ls, None, None, ok)
             } else if !it.light_selection.picks_one() {
                 // Every light, N points each (a lattice rotated by (u, w)), each weighted 1/N
                 // and, with MIS, against N p_light.
@@ -496,20 +503,9 @@ impl Bounce<'_> {
             } else {
                 // One light from the light sampler (uniform 1/N over quads and triangles alike,
                 // power or spatial), the choice reused from u or drawn on its own.
-                {
-                    let (ls, ok) = {
-                        let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                        let ls = &it.light_sampler;
-                        let (mut ls, ok) = if own_choice {
-                            ls.sample_point_x8(&scene.emitters, u_choice, sh.p, sh.n, shade, (u, w))
-                        } else {
-                            ls.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, w))
-                        };
-                        scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
-                        (ls, ok)
-                    };
-                    push(&ls, None, None, ok);
-                }
+                let choice = if own_choice { AreaChoice::Drawn(u_choice) } else { AreaChoice::Reuse };
+                let (ls, ok) = area_sample(it, scene, sh, shade, choice, (u, w));
+                push(&ls, None, None, ok);
             }
         }
 
@@ -572,58 +568,43 @@ impl Bounce<'_> {
 
 impl Bounce<'_> {
     /// The delta lights' next events at the shaded lanes `shade` of `vx`
-    /// ([`sky::delta_next_events`]), pushed as shadow rays from `o` (kept out of line: scenes
+    /// ([`Shading::delta_events`]), pushed as shadow rays from `o` (kept out of line: scenes
     /// without delta lights never run it).
     #[inline(never)]
-    fn delta_next_events<L: LobeSet>(
-        &mut self,
-        vx: &Vertex,
-        frame: &Frame8,
-        wo: Vec3x8,
-        mat: &crate::bsdf::Material8,
-        o: Vec3x8,
-        shade: Mask8,
-    ) {
-        let sh = vx.sh;
-        let leaves = |wi: Vec3x8| !sh.smooth | sh.ng.dot(wi).simd_gt(F8::ZERO);
+    fn delta_next_events<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, o: Vec3x8, shade: Mask8) {
         let shadow = &mut *self.shadow;
-        let push = |lit: Mask8, wi: Vec3x8, tfar: F8, c: Vec3x8| {
-            let pack = Pack::of(lit);
-            let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, tfar, c.x, c.y, c.z];
-            shadow.write(S_SLOT, &pack, &row);
-            shadow.advance(&pack);
-        };
-        sky::delta_next_events::<L>(self.it, self.scene, sh.p, frame, wo, mat, vx.beta, shade, leaves, push);
+        at.delta_events::<L>(self.scene, vx.beta, shade, |lit, wi, tfar, c| {
+            push_shadow(shadow, vx, o, wi, tfar, c, lit)
+        });
     }
 
-    /// The sky's next event at the shaded lanes `shade` of `vx` ([`sky::next_event`]), pushed as
-    /// a shadow ray to infinity from `o`.
-    #[allow(clippy::too_many_arguments)]
+    /// The environment's next event at the shaded lanes `shade` of `vx` (the sky's own
+    /// distribution or the envmap's, [`Shading::env_event`]), MIS-weighted against the BSDF and
+    /// pushed as a shadow ray to infinity from `o`.
     #[inline]
-    fn sky_next_event<L: LobeSet>(
-        &mut self,
-        vx: &Vertex,
-        frame: &Frame8,
-        wo: Vec3x8,
-        mat: &crate::bsdf::Material8,
-        o: Vec3x8,
-        shade: Mask8,
-        leaves: impl Fn(Vec3x8) -> Mask8,
-    ) {
+    fn env_next_event<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, o: Vec3x8, shade: Mask8) {
         let Some(dim) = self.dsky.as_ref() else { return };
         let uw = self.smp.table_point(dim, true, Phase::SamplerPath, vx.pixel, vx.s);
-        let event = match (self.scene.sky.as_ref(), self.scene.envmap.as_ref()) {
-            (Some(sky), _) => sky::next_event::<L>(self.it, sky, uw, frame, wo, mat, vx.beta, shade, leaves),
-            (None, Some(env)) => sky::envmap_next_event::<L>(self.it, env, uw, frame, wo, mat, vx.beta, shade, leaves),
-            (None, None) => None,
+        let Some(e) = env_sample(self.scene, SkySampling::Sky, &at.frame, uw, shade) else { return };
+        let mis = self.it.path.nee == Nee::Mis;
+        let weight = |pdf_b: F8, lit: Mask8| match self.scene.sky {
+            Some(_) => Sky::nee_weight_x8(mis, pdf_b, lit),
+            None if mis => power_heuristic_x8(e.pdf, pdf_b, lit),
+            None => F8::ONE,
         };
-        let Some((lit, wi, c)) = event else { return };
-        let inf = F8::splat(f32::INFINITY);
-        let pack = Pack::of(lit);
-        let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, inf, c.x, c.y, c.z];
-        self.shadow.write(S_SLOT, &pack, &row);
-        self.shadow.advance(&pack);
+        let Some((lit, wi, c)) = at.env_event::<L>(&e, vx.beta, shade, weight) else { return };
+        push_shadow(self.shadow, vx, o, wi, F8::splat(f32::INFINITY), c, lit);
     }
+}
+
+/// A next event's shadow rays from `o` along `wi` up to `tfar`, adding `c` to the pixel samples
+/// of `vx` if clear: the lit lanes, left-packed onto the bounce's shadow rays.
+#[inline]
+fn push_shadow(shadow: &mut Columns<SHADOW_COLS>, vx: &Vertex, o: Vec3x8, wi: Vec3x8, tfar: F8, c: Vec3x8, lit: Mask8) {
+    let pack = Pack::of(lit);
+    let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, tfar, c.x, c.y, c.z];
+    shadow.write(S_SLOT, &pack, &row);
+    shadow.advance(&pack);
 }
 
 /// Solid-angle pdf of NEE at a light hit for a light chosen with probability `pmf` (per lane):
@@ -634,7 +615,7 @@ impl Bounce<'_> {
 fn light_pdf_at_hit_pmf(
     it: &Integrator,
     scene: &Scene,
-    sh: &crate::scene::build::SurfaceHit8,
+    sh: &crate::scene::gather::SurfaceHit8,
     rh: &RayHit8,
     is_light: Mask8,
     pmf: F8,

@@ -147,20 +147,6 @@ impl std::fmt::Debug for RuleInfo {
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct LightSelection(u8);
 
-const fn const_eq(a: &[u8], b: &[u8]) -> bool {
-    if a.len() != b.len() {
-        return false;
-    }
-    let mut i = 0;
-    while i < a.len() {
-        if a[i] != b[i] {
-            return false;
-        }
-        i += 1;
-    }
-    true
-}
-
 impl LightSelection {
     /// Every emitter, `lightsamples` points each (no selection).
     pub const ALL: Self = Self::named("all");
@@ -171,7 +157,7 @@ impl LightSelection {
     pub const fn named(name: &str) -> Self {
         let mut i = 0;
         while i < RULES.len() {
-            if const_eq(RULES[i].name.as_bytes(), name.as_bytes()) {
+            if crate::registry::same_name(RULES[i].name, name) {
                 return Self(i as u8);
             }
             i += 1;

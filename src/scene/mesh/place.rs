@@ -28,27 +28,22 @@ impl SceneDesc {
             self.triangle_uvs.extend(mesh.indices.iter().map(|t| corner(t).map(|i| mesh.uvs[i])));
         }
         let count = mesh.indices.len() as u32;
+        // A vertex attribute per corner of every triangle, a face attribute as it is.
+        let attr = |name: &str, dims: usize, per_corner: bool, data: Vec<f32>| TriangleAttrDesc {
+            name: name.to_string(),
+            dims: dims as u32,
+            per_corner,
+            first: first as u32,
+            count,
+            data,
+        };
         for a in &mesh.vertex_attrs {
             let mut data = Vec::with_capacity(mesh.indices.len() * 3 * a.dims);
             mesh.indices.iter().flatten().for_each(|&i| data.extend_from_slice(a.get(i as usize)));
-            self.triangle_attrs.push(TriangleAttrDesc {
-                name: a.name.clone(),
-                dims: a.dims as u32,
-                per_corner: true,
-                first: first as u32,
-                count,
-                data,
-            });
+            self.triangle_attrs.push(attr(&a.name, a.dims, true, data));
         }
         for a in &mesh.face_attrs {
-            self.triangle_attrs.push(TriangleAttrDesc {
-                name: a.name.clone(),
-                dims: a.dims as u32,
-                per_corner: false,
-                first: first as u32,
-                count,
-                data: a.data.clone(),
-            });
+            self.triangle_attrs.push(attr(&a.name, a.dims, false, a.data.clone()));
         }
         first as u32
     }
