@@ -221,7 +221,7 @@ pub struct Scene {
     pub desc: SceneDesc,
     /// camera for the image size in `desc`
     pub camera: Camera,
-    /// quad lights (indices `0..lights.len()` of `emitters`)
+    /// quad lights, then sphere lights (indices `0..lights.len()` of `emitters`)
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
@@ -268,6 +268,8 @@ pub struct Scene {
     pub tri_light: Vec<u32>,
     /// per sphere/ellipsoid of the desc: material index
     pub ell_material: Vec<u32>,
+    /// per sphere/ellipsoid of the desc: light index (a sphere light) or `INVALID_ID`
+    pub ell_light: Vec<u32>,
     /// desc sphere index of each Embree sphere point (primID of [`GEOM_SPHERES`])
     pub sphere_point_index: Vec<u32>,
     /// desc sphere index of each user-geometry ellipsoid (primID of [`GEOM_ELLIPSOIDS`])
@@ -482,6 +484,14 @@ impl Scene {
             tri_light.extend([i as u32, i as u32]);
             lights.push(light);
         }
+        // Sphere lights after the quads (their spheres are placed with the other spheres).
+        let mut ell_light = vec![INVALID_ID; desc.spheres.len()];
+        for s in &desc.emissive_spheres {
+            if let Some(slot) = ell_light.get_mut(s.sphere as usize) {
+                *slot = lights.len() as u32;
+                lights.push(Emitter::sphere(s.center, s.radius, s.radiance));
+            }
+        }
         let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
         for (k, t) in desc.emissive_triangles.iter().enumerate() {
             let e = Emitter::triangle(t.v, t.radiance);
@@ -620,6 +630,7 @@ impl Scene {
             backend,
             tri_light,
             ell_material,
+            ell_light,
             sphere_point_index,
             ellipsoid_index,
             ell_world_to_object,

@@ -121,6 +121,20 @@ pub struct SphereDesc {
     pub material: u32,
 }
 
+/// A sphere light: the sphere `sphere` (an index into `SceneDesc::spheres`, which places and
+/// shades it) with Mitsuba's one-sided `area` emitter of `radiance` on its outside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissiveSphereDesc {
+    /// index into `SceneDesc::spheres` (its object-to-world map is a similarity)
+    pub sphere: u32,
+    /// centre, world space
+    pub center: Vec3,
+    /// radius, world space
+    pub radius: f32,
+    /// emitted radiance
+    pub radiance: Vec3,
+}
+
 /// Parallelogram light a + u ab + v ac; one-sided radiance towards normalize(ac x ab).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuadLightDesc {
@@ -237,6 +251,8 @@ pub struct SceneDesc {
     pub quad_lights: Vec<QuadLightDesc>,
     /// emissive triangles (area lights from OBJ faces with `Ke`)
     pub emissive_triangles: Vec<EmissiveTriangleDesc>,
+    /// sphere lights (Mitsuba spheres with an `area` emitter; their spheres are in `spheres`)
+    pub emissive_spheres: Vec<EmissiveSphereDesc>,
     /// point lights
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
@@ -373,6 +389,11 @@ impl SceneDesc {
             h.word(self.triangle_normals.len() as u32);
             self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
         }
+        // Only when present, so that scenes without sphere lights keep their hash.
+        if !self.emissive_spheres.is_empty() {
+            h.word(0x7370_6800);
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", self.emissive_spheres));
+        }
         // Only when present, so that `.test` and OBJ scenes keep their hash.
         if !self.emissive_materials.is_empty() {
             h.word(0x656d_6d00);
@@ -433,6 +454,7 @@ impl Default for SceneDesc {
             spheres: Vec::new(),
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),
+            emissive_spheres: Vec::new(),
             triangle_normals: Vec::new(),
             triangle_uvs: Vec::new(),
             triangle_attrs: Vec::new(),
