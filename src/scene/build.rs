@@ -247,6 +247,9 @@ pub struct Scene {
     /// [`super::texturing::NO_TEXTURE`]; empty when no material is textured (then gather reads
     /// no texture and builds no uv)
     pub material_texture: Vec<u32>,
+    /// per material: black from behind (`SceneDesc::one_sided`); empty when every material
+    /// shades both sides (then gather checks no side)
+    pub material_one_sided: Vec<bool>,
     /// some material is a registry BSDF (not the course's): hits then carry material ids and
     /// sides ([`SurfaceHit8::material`], [`SurfaceHit8::back`]), which only such BSDFs read
     pub registry_bsdfs: bool,
@@ -607,6 +610,15 @@ impl Scene {
             tri_source.resize(indices.len(), crate::texture::NO_TRIANGLE);
         }
         let (textures, material_texture) = texturing.unwrap_or_default();
+        let mut material_one_sided = Vec::new();
+        if !desc.one_sided.is_empty() {
+            material_one_sided = vec![false; materials.len()];
+            for &m in &desc.one_sided {
+                if let Some(slot) = material_one_sided.get_mut(m as usize) {
+                    *slot = true;
+                }
+            }
+        }
         let registry_bsdfs = materials.iter().any(|m| m.bsdf.kind != crate::bsdf::interface::COURSE);
         Ok(Self {
             desc,
@@ -622,6 +634,7 @@ impl Scene {
             tri_corner_normals,
             textures,
             material_texture,
+            material_one_sided,
             registry_bsdfs,
             tri_uv,
             tri_source,

@@ -253,6 +253,10 @@ pub struct SceneDesc {
     pub emissive_triangles: Vec<EmissiveTriangleDesc>,
     /// sphere lights (Mitsuba spheres with an `area` emitter; their spheres are in `spheres`)
     pub emissive_spheres: Vec<EmissiveSphereDesc>,
+    /// materials black from behind (indices into `materials`): Mitsuba's one-sided `diffuse`
+    /// (not wrapped in `twosided`); empty for `.test` and OBJ scenes, whose materials shade both
+    /// sides
+    pub one_sided: Vec<u32>,
     /// point lights
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
@@ -389,6 +393,11 @@ impl SceneDesc {
             h.word(self.triangle_normals.len() as u32);
             self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
         }
+        // Only when present, so that scenes shaded on both sides keep their hash.
+        if !self.one_sided.is_empty() {
+            h.word(0x6f6e_6500);
+            self.one_sided.iter().for_each(|&m| h.word(m));
+        }
         // Only when present, so that scenes without sphere lights keep their hash.
         if !self.emissive_spheres.is_empty() {
             h.word(0x7370_6800);
@@ -455,6 +464,7 @@ impl Default for SceneDesc {
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),
             emissive_spheres: Vec::new(),
+            one_sided: Vec::new(),
             triangle_normals: Vec::new(),
             triangle_uvs: Vec::new(),
             triangle_attrs: Vec::new(),

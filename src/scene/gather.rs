@@ -146,6 +146,22 @@ impl Scene {
         if !self.material_texture.is_empty() {
             self.texture_hits(bits, hits, out);
         }
+        if !self.material_one_sided.is_empty() && back.any() {
+            self.black_backs(back, &mat, out);
+        }
+    }
+
+    /// Mitsuba's one-sided `diffuse`: no reflection on the lanes `back` (hit from behind) whose
+    /// material is one-sided (`Scene::material_one_sided`).
+    #[cold]
+    #[inline(never)]
+    fn black_backs(&self, back: Mask8, mat: &[u32; 8], out: &mut SurfaceHit8) {
+        let one = mat.map(|m| self.material_one_sided.get(m as usize).copied().unwrap_or(false));
+        let black = back & crate::simd::mask_from_bools(one);
+        if black.any() {
+            out.kd = Vec3x8::select(black, Vec3x8::ZERO, out.kd);
+            out.ks = Vec3x8::select(black, Vec3x8::ZERO, out.ks);
+        }
     }
 
     /// The per-lane fields of hit lanes `valid` that all hit triangle `t`, not a light's: its
