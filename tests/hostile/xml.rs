@@ -31,7 +31,7 @@ fn hostile_xml_is_refused_with_file_and_line() {
         ),
         (
             "ellipsoid_light.xml",
-            format!("{HEAD}<shape type=\"sphere\">\n<transform name=\"to_world\"><scale x=\"1\" y=\"2\" z=\"1\"/></transform>\n<emitter type=\"area\"/>\n</shape>\n</scene>\n"),
+            format!("{HEAD}<shape type=\"sphere\">\n<transform name=\"to_world\"><scale x=\"1\" y=\"2\" z=\"1\"/></transform>\n<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter>\n</shape>\n</scene>\n"),
             "ellipsoid_light.xml:4: an area emitter on a sphere needs a `to_world` without non-uniform scale",
         ),
         (
