@@ -363,9 +363,11 @@ pub(crate) struct RenderArgs {
     #[arg(long, help_heading = LIGHTS, value_name = "MODE")]
     pub(crate) light_choice: Option<strata::integrator::LightChoice>,
     /// How a point is placed on the chosen area light (direct and the path tracer): area (uniform
-    /// in area; default) or solid-angle (uniform in the solid angle the light subtends: spherical
-    /// rectangles for rectangular quads, spherical triangles for emissive triangles; area sampling
-    /// where a light subtends less than 3e-4 sr). See docs/light-selection.md.
+    /// in area; default, except in scenes with sphere lights) or solid-angle (uniform in the solid
+    /// angle the light subtends: spherical rectangles for rectangular quads, spherical triangles
+    /// for emissive triangles, the visible cap's cone for sphere lights, as Mitsuba does; area
+    /// sampling where a polygon subtends less than 3e-4 sr, or from inside a sphere). See
+    /// docs/light-selection.md.
     #[arg(long, help_heading = LIGHTS, value_name = "WARP")]
     pub(crate) light_warp: Option<strata::integrator::LightWarp>,
     /// Light samples per light, at least 1 (default: the scene's lightsamples).

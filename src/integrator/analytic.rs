@@ -22,11 +22,27 @@ pub fn radiance(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
     let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)));
     // Quad lights, then emissive triangles (same polygon formula; `Emitter::corners` winds both alike).
     for light in &scene.emitters.list {
-        let phi = polygon_phi_x8(sh.p, &light.corners(), shade);
+        let phi = if light.sphere {
+            sphere_phi_x8(sh.p, light.a, light.radius)
+        } else {
+            polygon_phi_x8(sh.p, &light.corners(), shade)
+        };
         let e = phi.dot(sh.n).max(F8::ZERO);
         l_out += sh.kd.mul_elem(Vec3x8::splat(light.radiance)).scale(e * F8::splat(1.0 / PI));
     }
     l_out
+}
+
+/// The irradiance vector of a unit-radiance sphere (centre `c`, radius `r`) at `p`: `pi (r/d)^2`
+/// towards the centre (exact where the whole sphere is above the receiver's horizon, as the
+/// polygon formula is; zero from inside).
+#[inline]
+fn sphere_phi_x8(p: Vec3x8, c: glam::Vec3, r: f32) -> Vec3x8 {
+    let to = Vec3x8::splat(c) - p;
+    let d2 = to.length_squared();
+    let r2 = F8::splat(r * r);
+    let k = d2.simd_gt(r2).select(F8::splat(PI) * r2 / (d2 * d2.sqrt()), F8::ZERO);
+    to.scale(k)
 }
 
 /// The `analyticdirect` integrator: the camera-hit wavefront, shaded by [`radiance`].

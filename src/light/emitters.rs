@@ -1,9 +1,15 @@
-//! Every area light of a scene in one list (quad lights first, in file order, then emissive
-//! triangles from OBJ faces with `Ke`), and how a light is chosen and a point sampled on it.
+//! Every area light of a scene in one list (quad lights first, in file order, then sphere lights
+//! (Mitsuba `sphere` shapes with an `area` emitter), then emissive triangles from OBJ faces with
+//! `Ke` and Mitsuba meshes), and how a light is chosen and a point sampled on it.
 //!
 //! Geometry: an emitter is `a + u ab + v ac`, over the unit square for a quad light and over the
 //! triangle `u, v >= 0, u + v <= 1` for an emissive triangle (a square sample is folded onto the
-//! triangle: `(u, v) -> (1 - u, 1 - v)` when `u + v > 1`, which keeps it uniform). Emission is
+//! triangle: `(u, v) -> (1 - u, 1 - v)` when `u + v > 1`, which keeps it uniform). A sphere light
+//! is its centre `a` and `radius` (`ab`, `ac` zero): by area a point is uniform on the whole sphere
+//! (`z = 1 - 2u`, azimuth `2 pi v`), its normal outward, the points the shading point cannot see
+//! getting `cos_l <= 0` (no contribution); `light::warp` samples its visible cap by solid angle.
+//! A sphere emits outwards (Mitsuba's one-sided area emitter), its `normal` field is an unused
+//! `+z` (the normal at a point is [`Emitter::normal_at`]). Emission is
 //! one-sided, towards `normal`: `normalize(ac x ab)` for a quad light (the format's rule) and
 //! `normalize(ab x ac) = normalize((v1 - v0) x (v2 - v0))` for a triangle (the side its winding
 //! faces, counter-clockwise seen from the lit side, as OBJ meshes are written).
@@ -32,13 +38,53 @@ pub struct Emitter {
     pub area: f32,
     /// triangle rather than parallelogram
     pub triangle: bool,
+    /// a sphere of centre `a` and radius `radius` (then `ab`, `ac` are zero)
+    pub sphere: bool,
+    /// radius of a sphere light (0 for polygons)
+    pub radius: f32,
 }
 
 impl Emitter {
     /// The quad light `a + u ab + v ac`, emitting towards `normalize(ac x ab)`.
     pub fn quad(a: Vec3, ab: Vec3, ac: Vec3, radiance: Vec3) -> Self {
         let cross = ab.cross(ac);
-        Self { a, ab, ac, radiance, normal: (-cross).normalize_or_zero(), area: cross.length(), triangle: false }
+        Self {
+            a,
+            ab,
+            ac,
+            radiance,
+            normal: (-cross).normalize_or_zero(),
+            area: cross.length(),
+            triangle: false,
+            sphere: false,
+            radius: 0.0,
+        }
+    }
+
+    /// The sphere light of centre `center` and radius `radius`, emitting outwards.
+    pub fn sphere(center: Vec3, radius: f32, radiance: Vec3) -> Self {
+        Self {
+            a: center,
+            ab: Vec3::ZERO,
+            ac: Vec3::ZERO,
+            radiance,
+            normal: Vec3::Z,
+            area: 4.0 * std::f32::consts::PI * radius * radius,
+            triangle: false,
+            sphere: true,
+            radius,
+        }
+    }
+
+    /// Unit emitting normal at the point `y` of the light: `normal` for a polygon, the outward
+    /// normal `(y - a) / radius` (normalized) for a sphere.
+    #[inline]
+    pub fn normal_at(&self, y: Vec3) -> Vec3 {
+        if self.sphere {
+            (y - self.a).normalize_or_zero()
+        } else {
+            self.normal
+        }
     }
 
     /// The emissive triangle `v`, emitting towards `normalize((v1 - v0) x (v2 - v0))`.
@@ -53,6 +99,8 @@ impl Emitter {
             normal: cross.normalize_or_zero(),
             area: 0.5 * cross.length(),
             triangle: true,
+            sphere: false,
+            radius: 0.0,
         }
     }
 
@@ -74,6 +122,10 @@ impl Emitter {
 
     /// Point of the light for a unit-square sample `(u, v)`, uniform in area.
     pub fn point(&self, u: f32, v: f32) -> Vec3 {
+        if self.sphere {
+            let (y, _) = sphere_point_x8(Vec3x8::splat(self.a), F8::splat(self.radius), F8::splat(u), F8::splat(v));
+            return y.lane(0);
+        }
         let (u, v) = if self.triangle && u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
         self.ac.mul_add(Vec3::splat(v), self.ab.mul_add(Vec3::splat(u), self.a))
     }
@@ -83,9 +135,21 @@ impl Emitter {
     /// [`Emitters::sample_x8`] of the same light.
     pub fn sample_x8(&self, u: F8, v: F8) -> LightSample8 {
         let (u0, v0) = (u, v);
+        let s = Vec3x8::splat;
+        if self.sphere {
+            let (y, normal) = sphere_point_x8(s(self.a), F8::splat(self.radius), u, v);
+            return LightSample8 {
+                y,
+                normal,
+                radiance: s(self.radiance),
+                area: F8::splat(self.area),
+                inv_pmf: F8::ONE,
+                light: U8::splat(0),
+                uv: (u0, v0),
+            };
+        }
         let fold = if self.triangle { (u + v).simd_gt(F8::ONE) } else { Mask8::splat(0.0) };
         let (u, v) = (fold.select(F8::ONE - u, u), fold.select(F8::ONE - v, v));
-        let s = Vec3x8::splat;
         LightSample8 {
             y: s(self.ac).mul_add(v, s(self.ab).mul_add(u, s(self.a))),
             normal: s(self.normal),
@@ -125,8 +189,11 @@ pub struct LightSample8 {
 pub struct Emitters {
     /// quad lights (indices `0..n_quads`), then emissive triangles
     pub list: Vec<Emitter>,
-    /// number of quad lights at the front of `list`
+    /// number of lights sampled one by one at the front of `list`: the quad lights, then the
+    /// sphere lights (everything but the emissive triangles)
     pub n_quads: usize,
+    /// some light is a sphere
+    pub any_sphere: bool,
 }
 
 impl Emitters {
@@ -135,7 +202,8 @@ impl Emitters {
         let mut list: Vec<Emitter> = quads.into_iter().collect();
         let n_quads = list.len();
         list.extend(triangles);
-        Self { list, n_quads }
+        let any_sphere = list.iter().any(|e| e.sphere);
+        Self { list, n_quads, any_sphere }
     }
 
     /// Number of lights.
@@ -171,9 +239,17 @@ impl Emitters {
         let lab = Vec3x8::from_lanes(es.map(|e| e.ab));
         let lac = Vec3x8::from_lanes(es.map(|e| e.ac));
         let tri = crate::simd::mask_from_bools(es.map(|e| e.triangle));
+        let mut y = point_x8(la, lab, lac, tri, u, v);
+        let mut normal = Vec3x8::from_lanes(es.map(|e| e.normal));
+        if self.any_sphere {
+            let sph = crate::simd::mask_from_bools(es.map(|e| e.sphere));
+            let (ys, ns) = sphere_point_x8(la, F8::new(es.map(|e| e.radius)), u, v);
+            y = Vec3x8::select(sph, ys, y);
+            normal = Vec3x8::select(sph, ns, normal);
+        }
         LightSample8 {
-            y: point_x8(la, lab, lac, tri, u, v),
-            normal: Vec3x8::from_lanes(es.map(|e| e.normal)),
+            y,
+            normal,
             radiance: Vec3x8::from_lanes(es.map(|e| e.radiance)),
             area: F8::new(es.map(|e| e.area)),
             inv_pmf,
@@ -186,6 +262,9 @@ impl Emitters {
     #[inline]
     pub(crate) fn place_one_x8(&self, i: u32, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let e = &self.list[i as usize];
+        if e.sphere {
+            return LightSample8 { inv_pmf, light: U8::splat(i), ..e.sample_x8(u, v) };
+        }
         let tri = crate::simd::mask_from_bools([e.triangle; 8]);
         LightSample8 {
             y: point_x8(Vec3x8::splat(e.a), Vec3x8::splat(e.ab), Vec3x8::splat(e.ac), tri, u, v),
@@ -197,6 +276,17 @@ impl Emitters {
             uv: (u, v),
         }
     }
+}
+
+/// Points uniform in area on 8 spheres (centres `c`, radii `r`) for the unit-square samples
+/// `(u, v)`, and their outward unit normals: `z = 1 - 2u`, azimuth `2 pi v`.
+#[inline]
+fn sphere_point_x8(c: Vec3x8, r: F8, u: F8, v: F8) -> (Vec3x8, Vec3x8) {
+    let z = F8::splat(-2.0).mul_add(u, F8::ONE);
+    let rho = (F8::ONE - z * z).max(F8::ZERO).sqrt();
+    let (sin_p, cos_p) = (v * F8::splat(2.0 * std::f32::consts::PI)).sin_cos();
+    let n = Vec3x8::new(rho * cos_p, rho * sin_p, z);
+    (n.mul_add(r, c), n)
 }
 
 /// Points a + u ab + v ac of 8 lights (a, ab, ac per lane) for the unit-square samples (u, v),
@@ -217,7 +307,8 @@ mod tests {
         let t1 = Emitter::triangle([Vec3::ZERO, Vec3::X, Vec3::Y], Vec3::new(3.0, 0.0, 0.0));
         let t2 = Emitter::triangle([Vec3::Z, Vec3::Z + Vec3::Y * 2.0, Vec3::Z + Vec3::X * 2.0], Vec3::splat(0.5));
         let dark = Emitter::triangle([Vec3::ZERO, Vec3::Y, Vec3::Z], Vec3::ZERO);
-        Emitters::new([q], [t1, t2, dark])
+        let ball = Emitter::sphere(Vec3::new(0.5, 1.0, 3.0), 0.4, Vec3::new(2.0, 1.0, 0.5));
+        Emitters::new([q, ball], [t1, t2, dark])
     }
 
     #[test]

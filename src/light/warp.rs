@@ -3,11 +3,14 @@
 //! `area` (the default) places it uniformly in area (`emitters.rs`). `solid-angle` places it
 //! uniformly in the solid angle S the light subtends at the shading point: spherical rectangles
 //! for rectangular quad lights (`sampling::spherical_rect`), spherical triangles for emissive
-//! triangles (`sampling::spherical_tri`). The 2D point is the same sampler point the area warp
+//! triangles (`sampling::spherical_tri`), the cone of the visible cap for sphere lights
+//! (`sampling::spherical_cap`, from outside the sphere; from inside, area sampling as Mitsuba and
+//! pbrt do, and a one-sided sphere light sends nothing inwards anyway). The 2D point is the same sampler point the area warp
 //! would have used ([`LightSample8::uv`]), so stratification and low discrepancy carry through.
 //!
-//! A lane is warped where the light is a rectangle or a triangle (a skewed parallelogram quad is
-//! not: area sampling), the point lies on the light's emitting side, and S >= [`OMEGA_MIN`];
+//! A lane is warped where the light is a rectangle, a triangle or a sphere (a skewed parallelogram
+//! quad is not: area sampling), the point lies on the light's emitting side (outside a sphere),
+//! and S >= [`OMEGA_MIN`] ([`SPHERE_OMEGA_MIN`] for a sphere);
 //! elsewhere the area sample stays (below `OMEGA_MIN` the f32 warp no longer resolves the light,
 //! see the constant). The decision is a function of (light, point) only, so the pdf of a
 //! BSDF-sampled light hit ([`Emitters::solid_angle_x8`]) is the one next event estimation used.
@@ -17,6 +20,7 @@
 //! `L f cos_i cos_l area / d^2 = L f cos_i S` its estimate.
 
 use super::emitters::{Emitter, Emitters, LightSample8};
+use crate::sampling::spherical_cap::SphericalCap8;
 use crate::sampling::spherical_rect::SphericalRect8;
 use crate::sampling::spherical_tri::SphericalTri8;
 use crate::simd::{mask_from_bools, Mask8, Vec3x8, F8, U8};
@@ -33,6 +37,20 @@ use crate::simd::{mask_from_bools, Mask8, Vec3x8, F8, U8};
 /// is within 3e-4 of uniform in solid angle anyway, so nothing is lost by falling back there.
 pub const OMEGA_MIN: f32 = 3e-4;
 
+/// Smallest solid angle (sr) of a sphere light sampled by its cone; a sphere subtending less is
+/// sampled by area.
+///
+/// The cap warp keeps its digits far below [`OMEGA_MIN`] (it is written in `1 - cos` and sine
+/// ratios, `sampling::spherical_cap`). Measured by
+/// `sampling::spherical_cap::tests::f32_cap_warp_error_by_solid_angle` (`--nocapture`) for a unit
+/// sphere against an f64 ray-sphere construction: S within 3e-7 relative from 1.6 sr down to
+/// 3e-16 sr; the points within 5e-6 r down to 3e-4 sr, then growing as `4e-8 d / r` (4e-3 r at
+/// 3e-10 sr, 1 r at 3e-16 sr): that is the rounding of f32 positions about a centre at distance
+/// d, which area sampling's points `c + r n` share, so falling back would not help. The warp's
+/// own limit is the squared ratio `(r / d)^2`, which leaves f32's normal range below 1.2e-38:
+/// the threshold 1e-30 sr (`r / d` about 5.6e-16) keeps it clear of that.
+pub const SPHERE_OMEGA_MIN: f32 = 1e-30;
+
 /// Relative tolerance of `|ab . ac| / (|ab| |ac|)` for a quad light to count as a rectangle.
 const RECT_TOL: f32 = 1e-4;
 
@@ -42,7 +60,8 @@ pub enum LightWarp {
     /// uniform in area (the course's convention; the default)
     #[default]
     Area,
-    /// uniform in the solid angle the light subtends (spherical rectangles and triangles)
+    /// uniform in the solid angle the light subtends (spherical rectangles, triangles and the
+    /// cones of sphere lights)
     SolidAngle,
 }
 
@@ -73,7 +92,7 @@ impl Emitter {
     /// A quad light whose edges are orthogonal (within [`RECT_TOL`]): sampled by spherical
     /// rectangles.
     pub fn is_rectangle(&self) -> bool {
-        !self.triangle && self.ab.dot(self.ac).abs() <= RECT_TOL * self.ab.length() * self.ac.length()
+        !self.triangle && !self.sphere && self.ab.dot(self.ac).abs() <= RECT_TOL * self.ab.length() * self.ac.length()
     }
 }
 
@@ -83,25 +102,31 @@ struct Lights8 {
     ab: Vec3x8,
     ac: Vec3x8,
     normal: Vec3x8,
+    radius: F8,
     tri: Mask8,
     rect: Mask8,
+    sphere: Mask8,
     any_tri: bool,
     any_rect: bool,
+    any_sphere: bool,
 }
 
 impl Lights8 {
     fn one(e: &Emitter) -> Self {
         let s = Vec3x8::splat;
-        let (tri, rect) = (e.triangle, e.is_rectangle());
+        let (tri, rect, sphere) = (e.triangle, e.is_rectangle(), e.sphere);
         Self {
             a: s(e.a),
             ab: s(e.ab),
             ac: s(e.ac),
             normal: s(e.normal),
+            radius: F8::splat(e.radius),
             tri: mask_from_bools([tri; 8]),
             rect: mask_from_bools([rect; 8]),
+            sphere: mask_from_bools([sphere; 8]),
             any_tri: tri,
             any_rect: rect,
+            any_sphere: sphere,
         }
     }
 
@@ -116,16 +141,20 @@ impl Lights8 {
         let es: [Option<&Emitter>; 8] = std::array::from_fn(|i| list.get(ids[i] as usize).filter(|_| on[i]));
         let tri = es.map(|e| e.is_some_and(|e| e.triangle));
         let rect = es.map(|e| e.is_some_and(Emitter::is_rectangle));
+        let sphere = es.map(|e| e.is_some_and(|e| e.sphere));
         let get = |f: fn(&Emitter) -> glam::Vec3| Vec3x8::from_lanes(es.map(|e| e.map_or(glam::Vec3::ZERO, f)));
         Self {
             a: get(|e| e.a),
             ab: get(|e| e.ab),
             ac: get(|e| e.ac),
             normal: get(|e| e.normal),
+            radius: F8::new(es.map(|e| e.map_or(0.0, |e| e.radius))),
             tri: mask_from_bools(tri),
             rect: mask_from_bools(rect),
+            sphere: mask_from_bools(sphere),
             any_tri: tri.contains(&true),
             any_rect: rect.contains(&true),
+            any_sphere: sphere.contains(&true),
         }
     }
 
@@ -143,7 +172,16 @@ impl Lights8 {
         let s_tri = tri.map_or(F8::ZERO, |t| self.tri.select(t.solid_angle(), F8::ZERO));
         let omega = self.tri.select(s_tri, s_rect);
         let warped = active & front & (self.tri | self.rect) & omega.simd_ge(F8::splat(OMEGA_MIN));
-        Subtended { rect, tri, omega, warped }
+        if !self.any_sphere {
+            return Subtended { rect, tri, cap: None, omega, warped };
+        }
+        // Spheres: S is 0 from inside (not warped).
+        let cap = SphericalCap8::new(p, self.a, self.radius);
+        let s_cap = cap.solid_angle();
+        let omega = self.sphere.select(s_cap, omega);
+        let cap_ok = active & self.sphere & s_cap.simd_ge(F8::splat(SPHERE_OMEGA_MIN));
+        let warped = (warped & !self.sphere) | cap_ok;
+        Subtended { rect, tri, cap: Some(cap), omega, warped }
     }
 }
 
@@ -151,6 +189,7 @@ impl Lights8 {
 struct Subtended {
     rect: Option<SphericalRect8>,
     tri: Option<SphericalTri8>,
+    cap: Option<SphericalCap8>,
     omega: F8,
     warped: Mask8,
 }
@@ -170,14 +209,24 @@ fn rewarp(l: &Lights8, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
     if let Some(t) = sub.tri {
         y = Vec3x8::select(sub.warped & l.tri, t.sample(u, v), y);
     }
+    let mut normal = l.normal;
+    if let Some(c) = sub.cap {
+        let (yc, nc) = c.sample(u, v);
+        let on = sub.warped & l.sphere;
+        y = Vec3x8::select(on, yc, y);
+        normal = Vec3x8::select(on, nc, normal);
+    }
     let to = y - p;
     let d2 = to.length_squared();
-    let cos_l_d = -l.normal.dot(to);
+    let cos_l_d = -normal.dot(to);
     // S d^2 / cos_l with cos_l = cos_l_d / d.
     let area = sub.omega * d2 * d2.sqrt() / cos_l_d;
     let ok = sub.warped & area.simd_gt(F8::ZERO) & area.is_finite();
     ls.y = Vec3x8::select(ok, y, ls.y);
     ls.area = ok.select(area, ls.area);
+    if l.any_sphere {
+        ls.normal = Vec3x8::select(ok & l.sphere, normal, ls.normal);
+    }
 }
 
 impl Emitter {
@@ -185,7 +234,7 @@ impl Emitter {
     /// where the warp applies (module docs), on the lanes `active`.
     #[inline]
     pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
-        if warp == LightWarp::SolidAngle && (self.triangle || self.is_rectangle()) {
+        if warp == LightWarp::SolidAngle && (self.triangle || self.sphere || self.is_rectangle()) {
             rewarp(&Lights8::one(self), ls, p, active);
         }
     }
@@ -211,6 +260,9 @@ impl Emitters {
     }
 }
 
+#[cfg(test)]
+#[path = "warp_sphere_tests.rs"]
+mod sphere_tests;
 #[cfg(test)]
 #[path = "warp_tests.rs"]
 mod tests;

@@ -14,6 +14,7 @@
 //!   polynomial `ln`, `exp`, `exp_m1`, `ln_1p`, `sin_cos` differ from std's by a few ulp.
 
 pub mod filter;
+pub mod spherical_cap;
 pub mod spherical_rect;
 pub mod spherical_tri;
 mod warp;

@@ -219,7 +219,7 @@ pub struct Scene {
     pub desc: SceneDesc,
     /// camera for the image size in `desc`
     pub camera: Camera,
-    /// quad lights (indices `0..lights.len()` of `emitters`)
+    /// quad lights, then sphere lights (indices `0..lights.len()` of `emitters`)
     pub lights: Vec<Emitter>,
     /// every area light: the quad lights, then the emissive triangles; light selection
     pub emitters: Emitters,
@@ -253,6 +253,9 @@ pub struct Scene {
     /// material has one (then no hit evaluates them); `material_texture` is filled whenever this
     /// is (hits then carry their texture query, [`SurfaceHit8::tex`])
     pub param_textures: Vec<Vec<(crate::bsdf::interface::Slot, u32)>>,
+    /// per material: black from behind (`SceneDesc::one_sided`); empty when every material
+    /// shades both sides (then gather checks no side)
+    pub material_one_sided: Vec<bool>,
     /// some material is a registry BSDF (not the course's): hits then carry material ids and
     /// sides ([`super::gather::SurfaceHit8::material`], [`super::gather::SurfaceHit8::back`]), which only such BSDFs read
     pub registry_bsdfs: bool,
@@ -282,6 +285,8 @@ pub struct Scene {
     pub tri_light: Vec<u32>,
     /// per sphere/ellipsoid of the desc: material index
     pub ell_material: Vec<u32>,
+    /// per sphere/ellipsoid of the desc: light index (a sphere light) or `INVALID_ID`
+    pub ell_light: Vec<u32>,
     /// desc sphere index of each Embree sphere point (primID of [`GEOM_SPHERES`])
     pub sphere_point_index: Vec<u32>,
     /// desc sphere index of each user-geometry ellipsoid (primID of [`GEOM_ELLIPSOIDS`])
@@ -554,6 +559,14 @@ impl Scene {
             tri_light.extend([i as u32, i as u32]);
             lights.push(light);
         }
+        // Sphere lights after the quads (their spheres are placed with the other spheres).
+        let mut ell_light = vec![INVALID_ID; desc.spheres.len()];
+        for s in &desc.emissive_spheres {
+            if let Some(slot) = ell_light.get_mut(s.sphere as usize) {
+                *slot = lights.len() as u32;
+                lights.push(Emitter::sphere(s.center, s.radius, s.radiance));
+            }
+        }
         let mut tri_emitters = Vec::with_capacity(desc.emissive_triangles.len());
         let mut emitter_textures = Vec::new();
         for (k, t) in desc.emissive_triangles.iter().enumerate() {
@@ -682,6 +695,15 @@ impl Scene {
             Vec::new()
         };
         let hit_extras = !material_texture.is_empty() || tangents;
+        let mut material_one_sided = Vec::new();
+        if !desc.one_sided.is_empty() {
+            material_one_sided = vec![false; materials.len()];
+            for &m in &desc.one_sided {
+                if let Some(slot) = material_one_sided.get_mut(m as usize) {
+                    *slot = true;
+                }
+            }
+        }
         Ok(Self {
             desc,
             camera,
@@ -698,6 +720,7 @@ impl Scene {
             textures,
             material_texture,
             param_textures,
+            material_one_sided,
             registry_bsdfs,
             tri_uv,
             tri_source,
@@ -709,6 +732,7 @@ impl Scene {
             backend,
             tri_light,
             ell_material,
+            ell_light,
             sphere_point_index,
             ellipsoid_index,
             ell_world_to_object,

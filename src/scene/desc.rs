@@ -138,6 +138,20 @@ pub struct SphereDesc {
     pub material: u32,
 }
 
+/// A sphere light: the sphere `sphere` (an index into `SceneDesc::spheres`, which places and
+/// shades it) with Mitsuba's one-sided `area` emitter of `radiance` on its outside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissiveSphereDesc {
+    /// index into `SceneDesc::spheres` (its object-to-world map is a similarity)
+    pub sphere: u32,
+    /// centre, world space
+    pub center: Vec3,
+    /// radius, world space
+    pub radius: f32,
+    /// emitted radiance
+    pub radiance: Vec3,
+}
+
 /// Parallelogram light a + u ab + v ac; one-sided radiance towards normalize(ac x ab).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QuadLightDesc {
@@ -261,6 +275,12 @@ pub struct SceneDesc {
     pub quad_lights: Vec<QuadLightDesc>,
     /// emissive triangles (area lights from OBJ faces with `Ke`)
     pub emissive_triangles: Vec<EmissiveTriangleDesc>,
+    /// sphere lights (Mitsuba spheres with an `area` emitter; their spheres are in `spheres`)
+    pub emissive_spheres: Vec<EmissiveSphereDesc>,
+    /// materials black from behind (indices into `materials`): Mitsuba's one-sided `diffuse`
+    /// (not wrapped in `twosided`); empty for `.test` and OBJ scenes, whose materials shade both
+    /// sides
+    pub one_sided: Vec<u32>,
     /// point lights
     pub point_lights: Vec<PointLightDesc>,
     /// directional lights
@@ -404,6 +424,16 @@ impl SceneDesc {
             h.word(self.triangle_normals.len() as u32);
             self.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
         }
+        // Only when present, so that scenes shaded on both sides keep their hash.
+        if !self.one_sided.is_empty() {
+            h.word(0x6f6e_6500);
+            self.one_sided.iter().for_each(|&m| h.word(m));
+        }
+        // Only when present, so that scenes without sphere lights keep their hash.
+        if !self.emissive_spheres.is_empty() {
+            h.word(0x7370_6800);
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", self.emissive_spheres));
+        }
         // Only when present, so that `.test` and OBJ scenes keep their hash.
         if !self.emissive_materials.is_empty() {
             h.word(0x656d_6d00);
@@ -517,6 +547,8 @@ impl Default for SceneDesc {
             spheres: Vec::new(),
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),
+            emissive_spheres: Vec::new(),
+            one_sided: Vec::new(),
             triangle_normals: Vec::new(),
             triangle_uvs: Vec::new(),
             triangle_attrs: Vec::new(),

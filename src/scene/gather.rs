@@ -40,8 +40,8 @@ pub struct SurfaceHit8 {
     pub emitted: Vec3x8,
     /// ambient term of the material (`raytracer` only; zero on lights and misses)
     pub ambient: Vec3x8,
-    /// radiance emitted towards wo by an area light (quad or emissive triangle: its radiance on its
-    /// emitting side, else 0)
+    /// radiance emitted towards wo by an area light (quad, emissive triangle or sphere light: its
+    /// radiance on its emitting side, the outside of a sphere, else 0)
     pub le: Vec3x8,
     /// light index for hits on a light's geometry (emitting side or not), else u32::MAX
     pub light: U8,
@@ -167,6 +167,22 @@ impl Scene {
         if self.hit_extras {
             self.extras(bits, hits, out);
         }
+        if !self.material_one_sided.is_empty() && back.any() {
+            self.black_backs(back, &mat, out);
+        }
+    }
+
+    /// Mitsuba's one-sided `diffuse`: no reflection on the lanes `back` (hit from behind) whose
+    /// material is one-sided (`Scene::material_one_sided`).
+    #[cold]
+    #[inline(never)]
+    fn black_backs(&self, back: Mask8, mat: &[u32; 8], out: &mut SurfaceHit8) {
+        let one = mat.map(|m| self.material_one_sided.get(m as usize).copied().unwrap_or(false));
+        let black = back & crate::simd::mask_from_bools(one);
+        if black.any() {
+            out.kd = Vec3x8::select(black, Vec3x8::ZERO, out.kd);
+            out.ks = Vec3x8::select(black, Vec3x8::ZERO, out.ks);
+        }
     }
 
     /// The per-lane fields of hit lanes `valid` that all hit triangle `t`, not a light's: its
@@ -220,8 +236,17 @@ impl Scene {
                     let table = if geom[i] == GEOM_SPHERES { &self.sphere_point_index } else { &self.ellipsoid_index };
                     let e = table[prim] as usize;
                     let obj = self.ell_world_to_object[e].transform_point3(p.lane(i));
-                    n.set(i, (self.ell_normal[e] * obj).normalize_or_zero());
+                    let normal = (self.ell_normal[e] * obj).normalize_or_zero();
+                    n.set(i, normal);
                     mat[i] = self.ell_material[e];
+                    // A sphere light emits outwards (the outward normal against the ray).
+                    let l = self.ell_light.get(e).copied().unwrap_or(INVALID_ID);
+                    if l != INVALID_ID {
+                        light[i] = l;
+                        if normal.dot(dir.lane(i)) < 0.0 {
+                            le.set(i, self.emitters.list[l as usize].radiance);
+                        }
+                    }
                 }
                 _ => {}
             }

@@ -23,6 +23,17 @@ pub fn sphere_uv(p: Vec3) -> Vec2 {
     Vec2::new(phi * (0.5 * std::f32::consts::FRAC_1_PI), theta * std::f32::consts::FRAC_1_PI)
 }
 
+/// The corner uvs that mean "none" (the barycentrics are the uv): all `+0.0`, bit for bit. A mesh
+/// whose uv is the origin everywhere (Mitsuba's `sdfgrid`) stores [`ZERO_UV`] instead.
+#[inline]
+pub fn is_no_uv(c: &[Vec2; 3]) -> bool {
+    c.iter().all(|v| v.x.to_bits() == 0 && v.y.to_bits() == 0)
+}
+
+/// A corner uv at the origin that is not "none" ([`is_no_uv`]): `-0.0`, which every texture reads
+/// as 0.
+pub const ZERO_UV: Vec2 = Vec2::new(-0.0, -0.0);
+
 /// The uv at barycentrics `(b1, b2)` of a triangle with corner uvs `c` (`None`: the barycentrics).
 #[inline]
 pub fn triangle_uv(c: Option<&[Vec2; 3]>, b1: f32, b2: f32) -> Vec2 {
@@ -56,7 +67,7 @@ impl Scene {
             let k = prim[i] as usize;
             let (m, uv, t) = match geom[i] {
                 GEOM_TRIANGLES => {
-                    let uv = triangle_uv(self.tri_uv.get(k).filter(|c| **c != [Vec2::ZERO; 3]), bu[i], bv[i]);
+                    let uv = triangle_uv(self.tri_uv.get(k).filter(|c| !is_no_uv(c)), bu[i], bv[i]);
                     (self.tri_material[k], uv, self.tri_source.get(k).copied().unwrap_or(NO_TRIANGLE))
                 }
                 GEOM_SPHERES | GEOM_ELLIPSOIDS => {

@@ -190,7 +190,13 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     };
     let mut integrator = Integrator::new(&scene, spp, opts.seed, samplers, opts.light_samples);
     integrator.light_choice = opts.light_choice.unwrap_or(crate::light::select::LightChoice::Reuse);
-    integrator.light_warp = opts.light_warp.unwrap_or_default();
+    // Scenes with sphere lights (Mitsuba's) sample by solid angle unless told otherwise, as
+    // Mitsuba samples spheres; others keep area sampling (the course's convention).
+    integrator.light_warp = opts.light_warp.unwrap_or(if scene.emitters.any_sphere {
+        crate::light::warp::LightWarp::SolidAngle
+    } else {
+        crate::light::warp::LightWarp::Area
+    });
     if opts.general_kernel {
         integrator.kernel = Kernel::GENERAL;
     }

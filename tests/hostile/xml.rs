@@ -30,6 +30,11 @@ fn hostile_xml_is_refused_with_file_and_line() {
             "unknown.xml:2: unknown shape type \"teapot\" (supported: obj, ply",
         ),
         (
+            "ellipsoid_light.xml",
+            format!("{HEAD}<shape type=\"sphere\">\n<transform name=\"to_world\"><scale x=\"1\" y=\"2\" z=\"1\"/></transform>\n<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter>\n</shape>\n</scene>\n"),
+            "ellipsoid_light.xml:4: an area emitter on a sphere needs a `to_world` without non-uniform scale",
+        ),
+        (
             "param.xml",
             format!("{HEAD}<shape type=\"sphere\">\n<float name=\"radius\" value=\"$r\"/>\n</shape>\n</scene>\n"),
             "param.xml:3: undefined parameter $r",

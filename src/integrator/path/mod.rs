@@ -623,7 +623,8 @@ fn light_pdf_at_hit_pmf(
     let ids = sh.light.to_array();
     let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
     let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
-    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal)));
+    // (A sphere light's normal is the hit's: `normal_at`.)
+    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal_at(sh.p.lane(i)))));
     let t = F8::new(rh.ray.tfar);
     let cos_l = ln.dot(sh.wo);
     let mut p = pmf * t * t / (area * cos_l);

@@ -25,7 +25,7 @@ fn log_uniform(rng: &mut Rng, lo: f32, hi: f32) -> f32 {
     lo * (hi / lo).powf(rng.f32())
 }
 
-/// `n` emitters in a box of half-size `spread`: mixed quads and triangles, random orientation,
+/// `n` emitters in a box of half-size `spread`: mixed quads, triangles and spheres, random orientation,
 /// sizes and radiance log-uniform (2 and 3 decades), a few of power 0.
 fn random_lights(rng: &mut Rng, n: usize, spread: f32) -> Vec<Emitter> {
     (0..n)
@@ -37,7 +37,10 @@ fn random_lights(rng: &mut Rng, n: usize, spread: f32) -> Vec<Emitter> {
             let aspect = log_uniform(rng, 0.3, 3.0);
             let rad = if k % 17 == 5 { Vec3::ZERO } else { Vec3::new(1.0, 0.8, 0.6) * log_uniform(rng, 0.1, 100.0) };
             let (ab, ac) = (s * size * aspect, t * size / aspect);
-            if k % 3 == 2 {
+            if k % 11 == 7 {
+                // A sphere light now and then (the same draws: the other lights are unchanged).
+                Emitter::sphere(c, 0.5 * size, rad)
+            } else if k % 3 == 2 {
                 Emitter::triangle([c, c + ab, c + ac], rad)
             } else {
                 // quad(): emits towards normalize(ac x ab) = -(s x t) = -nrm; flip to face nrm.
@@ -53,6 +56,12 @@ fn random_lights(rng: &mut Rng, n: usize, spread: f32) -> Vec<Emitter> {
 fn can_contribute(e: &Emitter, p: Vec3, n: Vec3, margin: f32) -> bool {
     if !(e.power() > 0.0) {
         return false;
+    }
+    if e.sphere {
+        // Outside the sphere, and some of it above the receiver's plane.
+        let to = e.a - p;
+        let d = to.length();
+        return d - e.radius > margin * d && (n == Vec3::ZERO || to.dot(n) > -e.radius * (1.0 - margin) * n.length());
     }
     let front = (p - e.a).dot(e.normal) > margin * (p - e.a).length();
     let above = n == Vec3::ZERO || e.corners().iter().any(|&c| (c - p).dot(n) > margin * (c - p).length());

@@ -45,6 +45,8 @@ struct Item {
     centroid: Vec3,
     power: f32,
     normal: Vec3,
+    /// half angle of the item's own cone of normals: 0 for a polygon, pi for a sphere light
+    theta: f32,
     light: u32,
 }
 
@@ -123,7 +125,7 @@ impl Bounds {
         self.lo = self.lo.min(it.lo);
         self.hi = self.hi.max(it.hi);
         self.power += it.power as f64;
-        let c = Cone { w: it.normal, theta: 0.0 };
+        let c = Cone { w: it.normal, theta: it.theta };
         self.cone = Some(self.cone.map_or(c, |a| Cone::union(a, c)));
     }
 
@@ -159,7 +161,9 @@ impl LightTree {
             }
             let lo = cs.iter().fold(Vec3::INFINITY, |m, &c| m.min(c));
             let hi = cs.iter().fold(Vec3::NEG_INFINITY, |m, &c| m.max(c));
-            items.push(Item { lo, hi, centroid: 0.5 * (lo + hi), power, normal: e.normal, light: i as u32 });
+            // A sphere light: its box, and normals in every direction.
+            let (lo, hi, theta) = if e.sphere { (e.a - e.radius, e.a + e.radius, PI) } else { (lo, hi, 0.0) };
+            items.push(Item { lo, hi, centroid: 0.5 * (lo + hi), power, normal: e.normal, theta, light: i as u32 });
         }
         let mut tree = LightTree {
             nodes: Vec::with_capacity(2 * items.len()),
@@ -202,7 +206,7 @@ impl LightTree {
         let mut b = Bounds::EMPTY;
         items.iter().for_each(|it| b.add(it));
         let axis = b.cone.map_or(Vec3::Z, |c| c.w);
-        let theta = items.iter().map(|it| angle_between(axis, it.normal)).fold(0.0f32, f32::max);
+        let theta = items.iter().map(|it| angle_between(axis, it.normal) + it.theta).fold(0.0f32, f32::max);
         let theta = (theta + CONE_SLACK).min(PI);
         let (sin_o, cos_o) = if theta >= PI { (0.0, -1.0) } else { theta.sin_cos() };
         let center = 0.5 * (b.lo + b.hi);

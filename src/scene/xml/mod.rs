@@ -92,6 +92,15 @@ pub fn load(path: &Path, limits: &Limits, defines: &[(String, String)]) -> Resul
         b.desc.russian_roulette = true;
         b.desc.rr_depth = 5;
     }
+    // Mitsuba's `diffuse` is black from behind unless wrapped in `twosided`: the course-kind
+    // materials the `diffuse` plugin left one-sided are listed, then given the course's flag back.
+    let course = crate::bsdf::interface::COURSE;
+    for (i, m) in b.desc.materials.iter_mut().enumerate() {
+        if m.bsdf.kind == course && !m.bsdf.twosided {
+            b.desc.one_sided.push(i as u32);
+            m.bsdf.twosided = true;
+        }
+    }
     Ok(Loaded { desc: b.desc, warnings: b.warnings })
 }
 
@@ -107,3 +116,7 @@ fn collect_ids(e: &doc::Elem, ids: &mut HashMap<String, doc::Elem>) -> Result<()
     }
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "one_sided_tests.rs"]
+mod one_sided_tests;

@@ -4,7 +4,7 @@
 
 use super::doc::Loc;
 use super::props::Props;
-use crate::scene::desc::{EmissiveTriangleDesc, SceneDesc, SphereDesc};
+use crate::scene::desc::{EmissiveSphereDesc, EmissiveTriangleDesc, SceneDesc, SphereDesc};
 use crate::scene::error::SceneError;
 use crate::scene::limits::Limits;
 use crate::scene::mesh::{Mesh, MeshError};
@@ -62,8 +62,12 @@ pub fn place(
     match out {
         ShapeOut::Nothing => {}
         ShapeOut::Sphere(m) => {
-            if let Some((_, eat)) = emitter {
-                return Err(eat.err("an area emitter on a sphere is not supported yet: it needs solid-angle sphere light sampling (the `lights` work of issue 29)"));
+            if let Some((radiance, eat)) = emitter {
+                let (center, radius) = similarity_sphere(&m).ok_or_else(|| {
+                    eat.err("an area emitter on a sphere needs a `to_world` without non-uniform scale (Mitsuba's rule for spheres): this one makes an ellipsoid")
+                })?;
+                let sphere = desc.spheres.len() as u32;
+                desc.emissive_spheres.push(EmissiveSphereDesc { sphere, center, radius, radiance });
             }
             desc.spheres.push(SphereDesc { object_to_world: m, material });
         }
@@ -108,4 +112,18 @@ pub fn place(
         }
     }
     Ok(())
+}
+
+/// Centre and radius of the unit sphere under `m` when `m`'s linear part is a rotation (or
+/// reflection) times a uniform scale, to 1e-5 relative; None for an ellipsoid or a degenerate map.
+pub fn similarity_sphere(m: &Mat4) -> Option<(Vec3, f32)> {
+    let l = glam::Mat3::from_mat4(*m);
+    let g = l.transpose() * l;
+    let r2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+    if !(r2 > 0.0 && r2.is_finite()) {
+        return None;
+    }
+    let off = (g - glam::Mat3::from_diagonal(Vec3::splat(r2))).to_cols_array().iter().fold(0f32, |a, v| a.max(v.abs()));
+    let c = m.w_axis.truncate();
+    (off <= 1e-5 * r2 && c.is_finite()).then(|| (c, r2.sqrt()))
 }

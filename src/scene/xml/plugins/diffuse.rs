@@ -1,5 +1,8 @@
 //! `<bsdf type="diffuse">`: Lambertian `reflectance` (rgb, spectrum or float; default 0.5).
-//! strata shades it on both sides (as `twosided` of it).
+//! One-sided, as Mitsuba's: black from behind unless wrapped in `twosided`. The material leaves
+//! this plugin with `bsdf.twosided` false (so that the one-sided and two-sided versions intern
+//! apart); the scene's end (`scene::xml::load`) lists such materials in `SceneDesc::one_sided`
+//! and restores the course's flag.
 
 use super::{Build, Plugin, Run};
 use crate::scene::desc::Material;
@@ -15,9 +18,11 @@ pub fn default_material() -> Material {
     lambert(Vec3::splat(0.5))
 }
 
-/// A Lambertian material of reflectance `r` (the BRDF is `r / pi`).
+/// A one-sided Lambertian material of reflectance `r` (the BRDF is `r / pi`; see the module docs).
 pub fn lambert(r: Vec3) -> Material {
-    Material { diffuse: r, ambient: Vec3::ZERO, ..Material::default() }
+    let mut m = Material { diffuse: r, ambient: Vec3::ZERO, ..Material::default() };
+    m.bsdf.twosided = false;
+    m
 }
 
 /// The material of a registry BSDF row: no course lobes, no ambient term.

@@ -1,6 +1,6 @@
 //! `<bsdf type="twosided">` of one BSDF: its back mirrored onto its front
-//! (`BsdfParams::twosided`). strata's `diffuse` is shaded on both sides already. Two different
-//! BSDFs for the two sides are refused.
+//! (`BsdfParams::twosided`); for a `diffuse` it keeps the material off `SceneDesc::one_sided`.
+//! Two different BSDFs for the two sides are refused.
 
 use super::{Build, Plugin, Run};
 use crate::scene::desc::Material;
