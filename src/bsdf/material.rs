@@ -275,7 +275,9 @@ mod frame_map_tests {
     //! and an anisotropic rough mirror, grazing viewers and tilts up to 85 degrees included.
 
     use super::*;
+    use crate::bsdf::interface::Params8;
     use crate::bsdf::microfacet::Distribution;
+    use crate::bsdf::FrameMap8;
     use crate::sampling::chi2::Rng;
     use crate::simd::mask_all;
 

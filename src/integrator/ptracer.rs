@@ -36,8 +36,8 @@
 //! samples of the pixel the path is started for.
 
 use super::context::TileCtx;
-use super::light_term::frame_material;
 use super::estimator::Estimator;
+use super::light_term::frame_material;
 use super::samples::{Dim, Source};
 use super::settings::Integrator;
 use super::stats::{Counters, RayKind};
@@ -47,9 +47,9 @@ use crate::camera::PixelPacket;
 use crate::light::emission::EmissionSample;
 use crate::profile::Phase;
 use crate::scene::build::{Lens, Scene};
-use crate::scene::gather::SurfaceHit8;
 use crate::scene::desc::IntegratorKind;
-use crate::simd::{mask_from_bools, mask_to_bools, Frame8, Vec3x8, F8, U8};
+use crate::scene::gather::SurfaceHit8;
+use crate::simd::{mask_from_bools, mask_to_bools, Vec3x8, F8, U8};
 use glam::{Mat3, Vec3};
 
 /// First sampler dimension of a light path.

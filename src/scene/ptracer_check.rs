@@ -39,5 +39,14 @@ pub fn refusal(desc: &SceneDesc) -> Option<&'static str> {
     if desc.materials.iter().any(|m| transmits(m.bsdf.kind)) {
         return Some("BSDFs that transmit (the adjoint of refraction's radiance scaling is not written)");
     }
+    if !desc.emissive_spheres.is_empty() {
+        return Some("sphere area lights (light paths start from meshes and rectangles only)");
+    }
+    if desc.material_frames.iter().any(Option::is_some) {
+        return Some("`normalmap`/`bumpmap` (the adjoint of a shading-normal change is not written)");
+    }
+    if desc.materials.iter().any(|m| crate::bsdf::mask::masked(&m.bsdf)) {
+        return Some("`mask` (light paths do not pass through its null lobe)");
+    }
     None
 }

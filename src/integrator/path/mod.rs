@@ -21,7 +21,9 @@
 
 use super::context::{masked, TileCtx};
 use super::estimator::Estimator;
-use super::light_term::{area_sample, env_sample, frame_material, point_shadow, towards, AreaChoice, PointTerm, Shading, SkySampling};
+use super::light_term::{
+    area_sample, env_sample, frame_material, point_shadow, towards, AreaChoice, PointTerm, Shading, SkySampling,
+};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
 use super::stats::RayKind;

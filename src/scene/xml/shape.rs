@@ -62,7 +62,11 @@ pub fn place(
     match out {
         ShapeOut::Nothing => {}
         ShapeOut::Sphere(m) => {
-            if let Some((radiance, eat)) = emitter {
+            if let Some((em, eat)) = emitter {
+                if em.texture.is_some() {
+                    return Err(eat.err("a textured area emitter on a sphere is not supported (a bitmap radiance needs a mesh with uvs)"));
+                }
+                let radiance = em.radiance;
                 let (center, radius) = similarity_sphere(&m).ok_or_else(|| {
                     eat.err("an area emitter on a sphere needs a `to_world` without non-uniform scale (Mitsuba's rule for spheres): this one makes an ellipsoid")
                 })?;

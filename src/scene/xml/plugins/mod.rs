@@ -227,7 +227,13 @@ impl<'e> Build<'e> {
     /// and the frame map `frame` in the scene's materials (added once;
     /// `SceneDesc::diffuse_textures`, `param_textures` and `material_frames` stay empty until a
     /// material has one).
-    pub fn intern(&mut self, m: Material, texture: Option<u32>, params: Vec<(Slot, u32)>, frame: Option<FrameMap>) -> u32 {
+    pub fn intern(
+        &mut self,
+        m: Material,
+        texture: Option<u32>,
+        params: Vec<(Slot, u32)>,
+        frame: Option<FrameMap>,
+    ) -> u32 {
         let key = format!("{m:?}|{texture:?}|{params:?}|{frame:?}");
         let n = self.desc.materials.len() as u32;
         let i = *self.materials.entry(key).or_insert_with(|| {
