@@ -146,7 +146,7 @@ impl Material8 {
     /// between the nested BSDF and the null lobe by `u_lobe` (`bsdf::mask`: the null lanes come
     /// back as `general` lanes with the null sample; the nested ones with the nested sample, its
     /// pdf not scaled by the opacity, as Mitsuba's).
-    #[inline]
+    #[inline(always)]
     pub fn sample_bsdf_k<L: LobeSet>(
         &self,
         strategy: ImportanceSampling,

@@ -351,7 +351,7 @@ fn sample_batch<L: LobeSet>(
             continue;
         }
         let (frame, mat) = frame_material::<L>(scene, sh);
-        let at = Shading::new(sh, frame, &mat, ImportanceSampling::Cosine);
+        let at = Shading::new(sh, &frame, &mat, ImportanceSampling::Cosine);
         let f = at.eval::<L>(at.frame.to_local(wi), lit).0;
         batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
         // Shadow packet from the offset point towards the light sample, stopping short.

@@ -40,8 +40,8 @@ pub fn frame_material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> (Frame8, M
 pub struct Shading<'a> {
     /// the hits
     pub sh: &'a SurfaceHit8,
-    /// the shading frame (normal `sh.n`)
-    pub frame: Frame8,
+    /// the shading frame (normal `sh.n`; by reference: a copy costs)
+    pub frame: &'a Frame8,
     /// the direction to the viewer, local
     pub wo: Vec3x8,
     /// the material of every lane (by reference: it is large, and copying it costs)
@@ -71,7 +71,7 @@ impl<'a> Shading<'a> {
     /// The shading points of the hits `sh` in their shading `frame` with their material `mat`
     /// (both from [`frame_material`]), their BSDF evaluated under `strategy`.
     #[inline]
-    pub fn new(sh: &'a SurfaceHit8, frame: Frame8, mat: &'a Material8, strategy: ImportanceSampling) -> Self {
+    pub fn new(sh: &'a SurfaceHit8, frame: &'a Frame8, mat: &'a Material8, strategy: ImportanceSampling) -> Self {
         let wo = frame.to_local(sh.wo);
         Self { sh, frame, wo, mat, strategy }
     }
