@@ -51,7 +51,7 @@ pub(super) fn shade_outside<L: LobeSet>(
                 let uv = table.point(smp, pks[i].pixel, k);
                 let (frame, mat) = frame_material::<L>(scene, sh);
                 let at = Shading::new(sh, &frame, &mat, ImportanceSampling::Cosine);
-                let Some(e) = env_sample(scene, SkySampling::Cosine, &at.frame, uv, shade) else { continue };
+                let Some(e) = env_sample(scene, SkySampling::Cosine, at.frame, uv, shade) else { continue };
                 let Some((lit, wi, c)) = at.env_event::<L>(&e, one, shade, |_, _| inv_n) else { continue };
                 batch.contrib.push(masked(c, lit));
                 let o = sh.ng.mul_add(lanes.eps[i], sh.p);

@@ -392,7 +392,7 @@ impl Bounce<'_> {
         let frame = shading_frame::<L>(scene, sh);
         let mat = material_in::<L>(scene, sh, &frame);
         let at = Shading::new(sh, &frame, &mat, it.path.strategy);
-        let (frame, wo) = (&at.frame, at.wo);
+        let (frame, wo) = (at.frame, at.wo);
         // Registry BSDFs that transmit: directions may cross the surface (compile-time).
         let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;
         let eps = scene.offset_eps(sh.p);
@@ -587,7 +587,7 @@ impl Bounce<'_> {
     fn env_next_event<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, o: Vec3x8, shade: Mask8) {
         let Some(dim) = self.dsky.as_ref() else { return };
         let uw = self.smp.table_point(dim, true, Phase::SamplerPath, vx.pixel, vx.s);
-        let Some(e) = env_sample(self.scene, SkySampling::Sky, &at.frame, uw, shade) else { return };
+        let Some(e) = env_sample(self.scene, SkySampling::Sky, at.frame, uw, shade) else { return };
         let mis = self.it.path.nee == Nee::Mis;
         let weight = |pdf_b: F8, lit: Mask8| match self.scene.sky {
             Some(_) => Sky::nee_weight_x8(mis, pdf_b, lit),
