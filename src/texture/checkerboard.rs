@@ -125,9 +125,9 @@ mod tests {
                 b2: F8::ZERO,
             };
             let (x8, f8) = (c.eval_x8(&q8), c.eval_1_x8(&q8).to_array());
-            for i in 0..8 {
+            for (i, f) in f8.iter().enumerate() {
                 assert_eq!(x8.lane(i), c.eval(&q8.lane(i)));
-                assert_eq!(f8[i].to_bits(), c.eval_1(&q8.lane(i)).to_bits());
+                assert_eq!(f.to_bits(), c.eval_1(&q8.lane(i)).to_bits());
             }
         }
     }
