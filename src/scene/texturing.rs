@@ -103,8 +103,10 @@ impl Scene {
 
     /// Writes the textured BSDF parameters (`Scene::param_textures`) of the `valid` lanes of
     /// the hit record `sh` into their rows `p`: one texture evaluation, 8 lanes wide, per
-    /// distinct (slot, texture) of the packet. Colour slots take the texture's RGB, scalar slots
-    /// its luminance (grey: its value), the opacity that clamped to [0, 1]. Scenes without
+    /// distinct (slot, texture) of the packet. Colour slots take the texture's RGB
+    /// (`Texture::eval_x8`), scalar slots Mitsuba's float lookup (`Texture::eval_1_x8`: the
+    /// luminance, a grey value's own, a checkerboard's colours swapped as Mitsuba's `eval_1`),
+    /// the opacity that clamped to [0, 1]. Scenes without
     /// textured parameters never call it.
     #[cold]
     #[inline(never)]
@@ -124,18 +126,13 @@ impl Scene {
                         && self.param_textures.get(ids[j] as usize).is_some_and(|q| q.contains(&(slot, t)))
                 });
                 let m = crate::simd::mask_from_bools(lanes);
-                let value = self.textures[t as usize].eval_x8(&sh.tex);
-                let grey = value.x.simd_eq(value.y) & value.y.simd_eq(value.z);
-                let lum = || {
-                    let l = value.x * F8::splat(0.212_671)
-                        + value.y * F8::splat(0.715_160)
-                        + value.z * F8::splat(0.072_169);
-                    grey.select(value.x, l)
-                };
+                let tex = &self.textures[t as usize];
                 match slot {
-                    Slot::Color(c) => p.color[c as usize] = Vec3x8::select(m, value, p.color[c as usize]),
-                    Slot::Scalar(c) => p.scalar[c as usize] = m.select(lum(), p.scalar[c as usize]),
-                    Slot::Opacity => p.opacity = m.select(lum().max(F8::ZERO).min(F8::ONE), p.opacity),
+                    Slot::Color(c) => {
+                        p.color[c as usize] = Vec3x8::select(m, tex.eval_x8(&sh.tex), p.color[c as usize])
+                    }
+                    Slot::Scalar(c) => p.scalar[c as usize] = m.select(tex.eval_1_x8(&sh.tex), p.scalar[c as usize]),
+                    Slot::Opacity => p.opacity = m.select(tex.eval_1_x8(&sh.tex).max(F8::ZERO).min(F8::ONE), p.opacity),
                 }
             }
         }

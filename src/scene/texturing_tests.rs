@@ -176,3 +176,37 @@ fn scenes_without_textures_are_unchanged() {
     let e = Scene::build(bad).err().expect("refused").to_string();
     assert!(e.contains("texture 3"), "{e}");
 }
+
+#[test]
+fn textured_scalar_slots_read_mitsubas_float_lookup() {
+    // A checkerboard gives material 0 its colour slot 0 and its scalar slot 0 (a roughness, say).
+    // Mitsuba 3.9.1's checkerboard `eval_1` (every float parameter: alpha, opacity, weight) gives
+    // `color1` where `eval` (colours) gives `color0`, and back: its `eval` at uv (0.5, 0.5) is
+    // color0 = 0.05, its `eval_1` there 0.3 (queried from the peer). Triangle 0 of the floor has
+    // uv (x/2 + 1/2, z/2 + 1/2); the checker's to_uv doubles it.
+    use crate::bsdf::interface::Slot;
+    let mut d = desc();
+    let uv = |x: f32, z: f32| Vec2::new(x * 0.5 + 0.5, z * 0.5 + 0.5);
+    d.triangle_uvs = vec![[uv(-1.0, -1.0), uv(1.0, -1.0), uv(-1.0, 1.0)]];
+    let checker = Checkerboard {
+        color0: Vec3::splat(0.05),
+        color1: Vec3::splat(0.3),
+        to_uv: UvTransform::from_mat4(glam::Mat4::from_scale(Vec3::splat(2.0))),
+    };
+    d.textures = vec![Texture::Checkerboard(checker)];
+    d.param_textures = vec![vec![(Slot::Color(0), 0), (Slot::Scalar(0), 0)]];
+    let sc = Scene::build(d).unwrap();
+    let (mut sh, hits) = shade(&sc, XZ);
+    // Lanes 0 (-0.5, -0.5) and 2 (-0.2, -0.5) hit triangle 0 (material 0): 2 uv = (0.5, 0.5),
+    // colour 0 for `eval`, and (0.8, 0.5), colour 1.
+    for i in [0, 2] {
+        assert_eq!((hits.geom.as_array()[i], hits.prim.as_array()[i]), (GEOM_TRIANGLES, 0), "lane {i}");
+    }
+    sh.material = U8::ZERO;
+    let mut p = crate::bsdf::Params8::COURSE;
+    sc.texture_params(&sh, sh.valid, &mut p);
+    assert_eq!(p.color[0].lane(0), Vec3::splat(0.05));
+    assert_eq!(p.color[0].lane(2), Vec3::splat(0.3));
+    assert_eq!(p.scalar[0].to_array()[0], 0.3);
+    assert_eq!(p.scalar[0].to_array()[2], 0.05);
+}

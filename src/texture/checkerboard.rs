@@ -1,5 +1,8 @@
 //! The `checkerboard` texture plugin: `color0` where the fractional parts of u and v are both
-//! at most 1/2 or both above, `color1` elsewhere (Mitsuba 3's pattern and defaults).
+//! at most 1/2 or both above, `color1` elsewhere (Mitsuba 3's pattern and defaults). Mitsuba's
+//! float lookup (`eval_1`, what roughness, opacity and blend weights read) has the two colours
+//! the other way round: `color1` where `eval` gives `color0` (Mitsuba 3.9.1, checked against the
+//! peer); [`Checkerboard::eval_1`] does the same.
 
 use glam::Vec3;
 
@@ -43,6 +46,22 @@ impl Checkerboard {
         let differ = hu ^ hv;
         Vec3x8::select(differ, Vec3x8::splat(self.color1), Vec3x8::splat(self.color0))
     }
+
+    /// The colours swapped: what Mitsuba's float lookup `eval_1` reads (see the module docs).
+    fn swapped(&self) -> Self {
+        Self { color0: self.color1, color1: self.color0, to_uv: self.to_uv }
+    }
+
+    /// Mitsuba's float value at one point (`eval_1`): the scalar ([`super::scalar`]) of the
+    /// colour [`Checkerboard::eval`] gives the *other* squares.
+    pub fn eval_1(&self, q: &TexQuery) -> f32 {
+        super::scalar(self.swapped().eval(q))
+    }
+
+    /// [`Checkerboard::eval_1`] at eight points (bit-identical per lane).
+    pub fn eval_1_x8(&self, q: &TexQuery8) -> F8 {
+        super::scalar_x8(self.swapped().eval_x8(q))
+    }
 }
 
 #[cfg(test)]
@@ -72,6 +91,23 @@ mod tests {
     }
 
     #[test]
+    fn float_lookup_swaps_the_colours_as_mitsuba() {
+        // Mitsuba 3.9.1, checkerboard color0 = 0.05, color1 = 0.3: eval / eval_1 are 0.05 / 0.3
+        // at (0.25, 0.25), (0.75, 0.75), (0.5, 0.5), (1.25, 0.25) and 0.3 / 0.05 at (0.75, 0.25),
+        // (0.25, 0.75), (0.1, 0.6), (-0.25, 0.25).
+        let c = Checkerboard { color0: Vec3::splat(0.05), color1: Vec3::splat(0.3), ..Checkerboard::default() };
+        for (u, v) in [(0.25, 0.25), (0.75, 0.75), (0.5, 0.5), (1.25, 0.25)] {
+            assert_eq!((c.eval(&q(u, v)), c.eval_1(&q(u, v))), (Vec3::splat(0.05), 0.3), "({u}, {v})");
+        }
+        for (u, v) in [(0.75, 0.25), (0.25, 0.75), (0.1, 0.6), (-0.25, 0.25)] {
+            assert_eq!((c.eval(&q(u, v)), c.eval_1(&q(u, v))), (Vec3::splat(0.3), 0.05), "({u}, {v})");
+        }
+        // Colours read as their luminance.
+        let rgb = Checkerboard { color0: Vec3::X, color1: Vec3::Y, ..c };
+        assert_eq!(rgb.eval_1(&q(0.25, 0.25)), super::super::luminance(Vec3::Y));
+    }
+
+    #[test]
     fn x8_matches_scalar() {
         let c = Checkerboard {
             color0: Vec3::new(1.0, 2.0, 3.0),
@@ -88,9 +124,10 @@ mod tests {
                 b1: F8::ZERO,
                 b2: F8::ZERO,
             };
-            let x8 = c.eval_x8(&q8);
-            for i in 0..8 {
+            let (x8, f8) = (c.eval_x8(&q8), c.eval_1_x8(&q8).to_array());
+            for (i, f) in f8.iter().enumerate() {
                 assert_eq!(x8.lane(i), c.eval(&q8.lane(i)));
+                assert_eq!(f.to_bits(), c.eval_1(&q8.lane(i)).to_bits());
             }
         }
     }

@@ -21,7 +21,10 @@
 //!   eight lanes, bit-identical per lane. A query carries the hit's uv, its triangle index in
 //!   `SceneDesc::triangles` (`NO_TRIANGLE` elsewhere) and Embree's barycentrics `(b1, b2)` (the
 //!   weights of corners 1 and 2). Values are linear RGB; what a scene's material does with them
-//!   is the scene's business (`scene/gather.rs`).
+//!   is the scene's business (`scene/gather.rs`). `Texture::eval_1`/`eval_1_x8` are Mitsuba's
+//!   float lookup (`eval_1`), which scalar parameters (roughness, opacity, weights) read: the
+//!   value's [`scalar`] (a grey value's own, else its luminance), except that a checkerboard's
+//!   colours come the other way round, as Mitsuba 3.9.1 has them.
 
 mod query;
 
@@ -29,7 +32,7 @@ use std::path::PathBuf;
 
 use glam::Vec3;
 
-use crate::simd::Vec3x8;
+use crate::simd::{Vec3x8, F8};
 
 pub use bitmap::{srgb_to_linear, Bitmap, BitmapLimits, BitmapOptions, FilterType, WrapMode};
 pub use mesh_attribute::AttrRun;
@@ -74,7 +77,42 @@ pub fn luminance(c: Vec3) -> f32 {
     c.x * 0.212_671 + c.y * 0.715_160 + c.z * 0.072_169
 }
 
+/// The float a scalar parameter reads from a value: a grey value's own (bit for bit), else its
+/// [`luminance`].
+pub fn scalar(c: Vec3) -> f32 {
+    if c.x == c.y && c.y == c.z {
+        c.x
+    } else {
+        luminance(c)
+    }
+}
+
+/// [`scalar`] of eight values (bit-identical per lane).
+pub fn scalar_x8(c: Vec3x8) -> F8 {
+    let grey = c.x.simd_eq(c.y) & c.y.simd_eq(c.z);
+    let l = c.x * F8::splat(0.212_671) + c.y * F8::splat(0.715_160) + c.z * F8::splat(0.072_169);
+    grey.select(c.x, l)
+}
+
 impl Texture {
+    /// Mitsuba's float lookup (`eval_1`, what roughness, opacity and weights read) at one point:
+    /// a checkerboard's [`Checkerboard::eval_1`] (its colours the other way round), the
+    /// [`scalar`] of [`Texture::eval`] for the other plugins.
+    pub fn eval_1(&self, q: &TexQuery) -> f32 {
+        match self {
+            Texture::Checkerboard(c) => c.eval_1(q),
+            other => scalar(other.eval(q)),
+        }
+    }
+
+    /// [`Texture::eval_1`] at eight points (bit-identical per lane).
+    pub fn eval_1_x8(&self, q: &TexQuery8) -> F8 {
+        match self {
+            Texture::Checkerboard(c) => c.eval_1_x8(q),
+            other => scalar_x8(other.eval_x8(q)),
+        }
+    }
+
     /// A representative value: a bitmap's texel mean, a checkerboard's two colours averaged, a
     /// constant's value, a mesh attribute's mean over its bound values (times `scale`; 0 before
     /// binding). For a textured material's own `diffuse` (lobe choice reads it).
