@@ -24,7 +24,7 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     let opacity = match p.color("opacity", false)? {
         None => 0.5,
         Some(Color::Rgb(c)) => {
-            let o = if c.x == c.y && c.y == c.z { c.x } else { crate::texture::luminance(c) };
+            let o = crate::texture::scalar(c);
             if !o.is_finite() {
                 let at = p.get("opacity").map_or(&p.elem.at, |e| &e.at);
                 return Err(at.err(format!("{}: \"opacity\" must be finite, not {o}", p.elem.what())));
