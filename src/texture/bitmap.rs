@@ -238,13 +238,8 @@ impl Bitmap {
                 Vec3::from(self.fetch(x as i64, y as i64))
             }
             FilterType::Bilinear => {
-                let (px, py) = (uv.x * w - 0.5, uv.y * h - 0.5);
-                let (fx, fy) = (px.floor(), py.floor());
-                let (ax, ay) = (px - fx, py - fy);
-                let (bx, by) = (1.0 - ax, 1.0 - ay);
-                let (x0, y0) = (fx as i64, fy as i64);
-                let (x1, y1) = (x0.saturating_add(1), y0.saturating_add(1));
-                let [v00, v10, v01, v11] = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| self.fetch(x, y));
+                let ([ax, ay, bx, by], corners) = bilinear(uv, w, h);
+                let [v00, v10, v01, v11] = corners.map(|(x, y)| self.fetch(x, y));
                 Vec3::from(std::array::from_fn::<f32, 3, _>(|c| {
                     let s0 = bx * v00[c] + ax * v10[c];
                     let s1 = bx * v01[c] + ax * v11[c];
@@ -264,14 +259,8 @@ impl Bitmap {
         }
         let (w, h) = (self.width as f32, self.height as f32);
         let uv = Vec2::new(sanitize(uv.x), sanitize(uv.y));
-        let (px, py) = (uv.x * w - 0.5, uv.y * h - 0.5);
-        let (fx, fy) = (px.floor(), py.floor());
-        let (ax, ay) = (px - fx, py - fy);
-        let (bx, by) = (1.0 - ax, 1.0 - ay);
-        let (x0, y0) = (fx as i64, fy as i64);
-        let (x1, y1) = (x0.saturating_add(1), y0.saturating_add(1));
-        let lum = |c: [f32; 3]| 0.212_671 * c[0] + 0.715_160 * c[1] + 0.072_169 * c[2];
-        let [f00, f10, f01, f11] = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(x, y)| lum(self.fetch(x, y)));
+        let ([ax, ay, bx, by], corners) = bilinear(uv, w, h);
+        let [f00, f10, f01, f11] = corners.map(|(x, y)| super::luminance(Vec3::from(self.fetch(x, y))));
         Vec2::new((by * (f10 - f00) + ay * (f11 - f01)) * w, (bx * (f01 - f00) + ax * (f11 - f10)) * h)
     }
 
@@ -489,3 +478,15 @@ fn read_exr(path: &Path, bytes: &[u8], limits: &BitmapLimits) -> Result<(u32, u3
 #[cfg(test)]
 #[path = "bitmap_tests.rs"]
 mod tests;
+
+/// The bilinear lookup at `uv` of a `w` x `h` image (texel centres at half integers): the weights
+/// `[ax, ay, 1 - ax, 1 - ay]` and the four texels `(x0, y0), (x1, y0), (x0, y1), (x1, y1)`.
+#[inline]
+fn bilinear(uv: Vec2, w: f32, h: f32) -> ([f32; 4], [(i64, i64); 4]) {
+    let (px, py) = (uv.x * w - 0.5, uv.y * h - 0.5);
+    let (fx, fy) = (px.floor(), py.floor());
+    let (ax, ay) = (px - fx, py - fy);
+    let (x0, y0) = (fx as i64, fy as i64);
+    let (x1, y1) = (x0.saturating_add(1), y0.saturating_add(1));
+    ([ax, ay, 1.0 - ax, 1.0 - ay], [(x0, y0), (x1, y0), (x0, y1), (x1, y1)])
+}

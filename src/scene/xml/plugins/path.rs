@@ -24,8 +24,13 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     b.desc.max_depth = depth(p)?;
     b.desc.nee = Nee::Mis;
     b.desc.importance_sampling = ImportanceSampling::Brdf;
-    // Russian roulette changes the variance, not the expected image; as Mitsuba's, it is played
-    // from the vertex `rr_depth` on (a path that never reaches it never plays).
+    roulette_and_emitters(b, p)
+}
+
+/// `rr_depth` and `hide_emitters`, as Mitsuba's `path` and `ptracer` read them. Russian roulette
+/// changes the variance, not the expected image; as Mitsuba's, it is played from the vertex
+/// `rr_depth` on (a path that never reaches it never plays).
+pub(super) fn roulette_and_emitters(b: &mut Build, p: &Props) -> Result<(), SceneError> {
     let rr = p.int("rr_depth", 5)?;
     if !(1..=i64::from(u32::MAX)).contains(&rr) {
         return Err(p.elem.at.err(format!("rr_depth {rr} must be >= 1")));

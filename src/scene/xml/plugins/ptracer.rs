@@ -17,13 +17,6 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     // Mitsuba's `max_depth` counts segments from the emitter to the sensor: a light path of
     // `max_depth` segments has `max_depth - 1` surface vertices, strata's depth.
     b.desc.max_depth = super::path::depth(p)?;
-    let rr = p.int("rr_depth", 5)?;
-    if !(1..=i64::from(u32::MAX)).contains(&rr) {
-        return Err(p.elem.at.err(format!("rr_depth {rr} must be >= 1")));
-    }
-    b.desc.russian_roulette = true;
-    b.desc.rr_depth = rr as u32;
-    b.desc.hide_emitters = p.bool("hide_emitters", false)?;
     let _ = p.int("samples_per_pass", -1)?;
-    Ok(())
+    super::path::roulette_and_emitters(b, p)
 }
