@@ -114,7 +114,8 @@ pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8
         }
         p
     } else {
-        crate::bsdf::Params8::COURSE
+        // Never read in these kernels (no registry BSDF, no mask).
+        crate::bsdf::Params8::UNREAD
     };
     Material8 {
         kd: sh.kd,
