@@ -15,7 +15,9 @@
 //!   map), as one Embree user geometry whose primitive i is the unit sphere under that map (no
 //!   instancing; f32 SIMD object-space intersection with an f64 fallback chosen by an error bound,
 //!   accurate at extreme scales);
-//! - geometries from [`GEOM_FIRST_INSTANCE`] on: instances (hits report `inst_id`).
+//! - geometries from [`GEOM_FIRST_INSTANCE`] on: instances of child scenes (`add_group`: one
+//!   triangle mesh, geometry 0 of the child, shared by any number of `add_instance`s); hits report
+//!   the instance's id in `inst_id`, geometry 0 and the child's triangle.
 //!
 //! Geometry kinds must be added in this order; a kind may be skipped.
 //!
@@ -43,7 +45,7 @@ pub use approx::approx_id;
 pub use device::{cpu_has_avx512, default_isa, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
 pub use ftz::{set_ftz_daz, timestamp};
-pub use scene::{Hits8, Scene, SceneBuilder};
+pub use scene::{GroupId, Hits8, Scene, SceneBuilder};
 pub use user_geometry::{set_callback_timing, take_callback_ticks};
 
 /// Embree's invalid geometry / instance id.

@@ -23,6 +23,10 @@ pub struct SceneBuilder<'d> {
     quality: sys::RTCBuildQuality,
 }
 
+/// A child scene of a [`SceneBuilder`] (a shapegroup's triangles), placed by its instances.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GroupId(usize);
+
 /// A committed Embree scene, safe to query from many threads.
 pub struct Scene {
     raw: sys::RTCScene,
@@ -228,33 +232,52 @@ impl<'d> SceneBuilder<'d> {
 
     /// Adds an instance (geometry id >= [`GEOM_FIRST_INSTANCE`]) of a child scene holding one
     /// triangle mesh, placed by the affine `object_to_world`. Hits report `inst_id` = the returned
-    /// id, `geom_id` = 0 and `prim_id` the child's triangle.
+    /// id, `geom_id` = 0 and `prim_id` the child's triangle. (A group with one instance:
+    /// [`SceneBuilder::add_group`] then [`SceneBuilder::add_instance`].)
     pub fn add_mesh_instance(
         &mut self,
         vertices: &[Vec3],
         indices: &[[u32; 3]],
         object_to_world: &Mat4,
     ) -> Result<u32, AccelError> {
-        let id = self.next_id.max(GEOM_FIRST_INSTANCE);
-        self.reserve(id, "instance")?;
+        let group = self.add_group(vertices, indices)?;
+        self.add_instance(group, object_to_world)
+    }
+
+    /// Builds and commits a child scene holding one triangle mesh (object space), to be placed
+    /// by any number of [`SceneBuilder::add_instance`]s: its BVH and vertices are stored once.
+    /// Returns its handle for `add_instance`. Adds no geometry to this scene.
+    pub fn add_group(&mut self, vertices: &[Vec3], indices: &[[u32; 3]]) -> Result<GroupId, AccelError> {
         let mut child = SceneBuilder::new(self.device)?;
+        child.quality = self.quality;
         child.add_triangles(vertices, indices)?;
         let child = child.commit()?;
-        let xfm = affine_3x4_column_major(object_to_world);
-        // SAFETY: instance of a committed child scene whose handle we keep (and release after the
-        // parent); the transform pointer is valid for 12 floats during the call (Embree copies it).
-        unsafe {
-            let g = sys::rtcNewGeometry(self.device.raw, sys::RTCGeometryType::INSTANCE);
-            sys::rtcSetGeometryInstancedScene(g, child.raw);
-            sys::rtcSetGeometryTransform(g, 0, sys::RTCFormat::FLOAT3X4_COLUMN_MAJOR, xfm.as_ptr() as *const c_void);
-            sys::rtcCommitGeometry(g);
-            self.attach(g, id)?;
-        }
         let mut child = std::mem::ManuallyDrop::new(child);
+        let id = GroupId(self.children.len());
         self.children.push(child.raw);
         self.children.append(&mut child.children);
         self.user_data.append(&mut child._user_data);
         Ok(id)
+    }
+
+    /// Adds an instance (geometry id >= [`GEOM_FIRST_INSTANCE`], in increasing order) of the
+    /// group `group`, placed by the affine `object_to_world`. Hits report `inst_id` = the returned
+    /// id, `geom_id` = 0 and `prim_id` the group's triangle.
+    pub fn add_instance(&mut self, group: GroupId, object_to_world: &Mat4) -> Result<u32, AccelError> {
+        let child = *self.children.get(group.0).ok_or_else(|| AccelError(format!("no group {}", group.0)))?;
+        let id = self.next_id.max(GEOM_FIRST_INSTANCE);
+        self.reserve(id, "instance")?;
+        let xfm = affine_3x4_column_major(object_to_world);
+        // SAFETY: instance of a committed child scene whose handle this builder keeps (released
+        // after the parent); the transform pointer is valid for 12 floats during the call (Embree
+        // copies it).
+        unsafe {
+            let g = sys::rtcNewGeometry(self.device.raw, sys::RTCGeometryType::INSTANCE);
+            sys::rtcSetGeometryInstancedScene(g, child);
+            sys::rtcSetGeometryTransform(g, 0, sys::RTCFormat::FLOAT3X4_COLUMN_MAJOR, xfm.as_ptr() as *const c_void);
+            sys::rtcCommitGeometry(g);
+            self.attach(g, id)
+        }
     }
 
     /// Commits (builds the BVH) and returns the queryable scene. No scene flags: measured with

@@ -134,3 +134,37 @@ fn embree_errors_become_rust_errors() {
     assert!(!err.0.is_empty(), "{err}");
     dev.take_errors().unwrap();
 }
+
+/// One group (child scene) placed by two instances: each hit reports its instance's id (the
+/// `instID` field read through our `Hit8` layout), geometry 0 and the group's triangle.
+#[test]
+fn two_instances_share_one_group_and_report_their_ids() {
+    let dev = Device::new().unwrap();
+    let mut b = SceneBuilder::new(&dev).unwrap();
+    b.add_triangles(&[], &[]).unwrap();
+    let v =
+        [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)];
+    let g = b.add_group(&v, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+    let near = Mat4::from_translation(Vec3::new(0.0, 0.0, 2.0));
+    let far = Mat4::from_translation(Vec3::new(5.0, 0.0, 7.0)) * Mat4::from_scale(Vec3::splat(2.0));
+    assert_eq!(b.add_instance(g, &near).unwrap(), GEOM_FIRST_INSTANCE);
+    assert_eq!(b.add_instance(g, &far).unwrap(), GEOM_FIRST_INSTANCE + 1);
+    let scene = b.commit().unwrap();
+    let (org, dir) = packet([0.5, -0.5, 5.5, 4.0, 20.0, 0.5, 6.9, 3.5], [-0.5, 0.5, -1.0, 1.0, 0.0, 0.9, 1.9, -1.0]);
+    let mut rh = RayHit8::default();
+    rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
+    let traced = scene.intersect8(&mut rh, false, mask_all());
+    let h = Hits8::from_rayhit(&rh, traced);
+    assert_eq!(mask_to_bools(h.hit), [true, true, true, true, false, true, true, true]);
+    let (i0, i1) = (GEOM_FIRST_INSTANCE, GEOM_FIRST_INSTANCE + 1);
+    let inst = h.inst.to_array();
+    assert_eq!([inst[0], inst[1], inst[5]], [i0; 3]);
+    assert_eq!([inst[2], inst[3], inst[6], inst[7]], [i1; 4]);
+    assert_eq!(inst[4], INVALID_ID);
+    let (geom, prim) = (h.geom.to_array(), h.prim.to_array());
+    assert!([0, 1, 2, 3, 5, 6, 7].iter().all(|&i| geom[i] == 0), "the group's geometry 0: {geom:?}");
+    // x > y: triangle 0 (below the diagonal), else 1 (in group space)
+    assert_eq!([prim[0], prim[1], prim[2], prim[3]], [0, 1, 0, 1]);
+    let t = h.t.to_array();
+    assert!((t[0] - 2.0).abs() < 1e-5 && (t[2] - 7.0).abs() < 1e-5, "{t:?}");
+}

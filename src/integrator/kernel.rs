@@ -90,7 +90,7 @@ pub fn features_json(scene: &Scene, kind: IntegratorKind, nee: Nee, rr: bool, st
         materials.push("emission");
     }
     let mut geometry = Vec::new();
-    if !d.triangles.is_empty() {
+    if !d.triangles.is_empty() || !d.instances.is_empty() {
         geometry.push("triangles");
     }
     if !d.spheres.is_empty() {

@@ -297,6 +297,8 @@ pub struct Scene {
     pub ell_normal: Vec<Mat3>,
     /// radius of the scene's bounding sphere (for offsets)
     pub extent: f32,
+    /// Mitsuba's instances: their matrices and their groups' stored triangles (empty: none)
+    pub instances: super::instances::Instances,
     /// the Embree scene
     pub accel: accel::Scene,
     _device: accel::Device,
@@ -482,7 +484,7 @@ fn area_overflows(v: &[Vec3; 3]) -> bool {
 
 impl Scene {
     /// Builds the scene. Quad lights become two triangles each, after the scene's triangles, then
-    /// come the emissive triangles. Zero-area triangles (no unit normal: the cross product of two
+    /// come the emissive triangles, then the shapegroups' (group space, `scene::instances`). Zero-area triangles (no unit normal: the cross product of two
     /// edges vanishes or is not finite) of either kind are dropped and counted in
     /// [`Scene::degenerate_dropped`].
     pub fn build(desc: SceneDesc) -> Result<Self, BuildError> {
@@ -590,7 +592,7 @@ impl Scene {
             tri_emitters.push(e);
         }
         let emitters = Emitters::new(lights.iter().copied(), tri_emitters);
-        let tri_normal: Vec<Vec3> = indices
+        let mut tri_normal: Vec<Vec3> = indices
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| vertices[i as usize]);
@@ -654,6 +656,28 @@ impl Scene {
         b.add_triangles(&vertices, &indices)?;
         b.add_spheres(&points)?;
         b.add_ellipsoids(&ell_user)?;
+        // Shapegroups: their triangles after every other, in group space, shared by instances.
+        let base = indices.len();
+        let (instances, groups, ilo, ihi) = super::instances::Instances::build(&desc, base as u32, &mut b)?;
+        let n_group = groups.material.len();
+        degenerate_dropped += groups.dropped;
+        tri_material.extend_from_slice(&groups.material);
+        tri_light.resize(base + n_group, INVALID_ID);
+        tri_normal.extend_from_slice(&groups.normal);
+        if !groups.corner_normals.is_empty() {
+            tri_corner_normals.resize(base, [Vec3::ZERO; 3]);
+            tri_corner_normals.extend_from_slice(&groups.corner_normals);
+        }
+        if uvs && !groups.uvs.is_empty() {
+            tri_uv.resize(base, [glam::Vec2::ZERO; 3]);
+            tri_uv.extend_from_slice(&groups.uvs);
+        }
+        let extent = if ilo.x.is_finite() {
+            let (lo, hi) = if lo.x.is_finite() { (lo.min(ilo), hi.max(ihi)) } else { (ilo, ihi) };
+            ((hi - lo).length() * 0.5).max(f32::MIN_POSITIVE)
+        } else {
+            extent
+        };
         let accel = b.commit()?;
         let backend = Backend {
             isa: device.isa(),
@@ -684,7 +708,7 @@ impl Scene {
             .collect::<Result<Vec<_>, _>>()?;
         if uvs {
             // Light triangles carry no texture coordinates.
-            tri_source.resize(indices.len(), crate::texture::NO_TRIANGLE);
+            tri_source.resize(indices.len() + n_group, crate::texture::NO_TRIANGLE);
         }
         let (textures, material_texture) = texturing.unwrap_or_default();
         let param_textures = if desc.param_textures.iter().any(|p| !p.is_empty()) {
@@ -738,6 +762,7 @@ impl Scene {
             ell_world_to_object,
             ell_normal,
             extent,
+            instances,
             accel,
             _device: device,
         })

@@ -129,6 +129,33 @@ pub struct TriangleAttrDesc {
     pub data: Vec<f32>,
 }
 
+/// Mitsuba's `shapegroup`: its triangles in the group's own space, stored once however many
+/// [`InstanceDesc`]s place it (each instance is an Embree instance of one shared BVH).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GroupDesc {
+    /// the group's `id` in the scene file (an instance finds its group by it)
+    pub id: String,
+    /// triangles, group space
+    pub triangles: Vec<TriangleDesc>,
+    /// per-corner unit shading normals of `triangles[i]` (group space), as
+    /// `SceneDesc::triangle_normals`
+    pub triangle_normals: Vec<[Vec3; 3]>,
+    /// per-corner texture coordinates of `triangles[i]`, as `SceneDesc::triangle_uvs`
+    pub triangle_uvs: Vec<[Vec2; 3]>,
+    /// the group's spheres (group-space object-to-group map, material): each instance places a
+    /// copy in `SceneDesc::spheres` (one matrix each, so nothing to share)
+    pub spheres: Vec<(glam::Mat4, u32)>,
+}
+
+/// Mitsuba's `instance`: the group `SceneDesc::groups[group]` placed by `to_world`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InstanceDesc {
+    /// index into `SceneDesc::groups`
+    pub group: u32,
+    /// group space to world space (affine, invertible)
+    pub to_world: glam::Mat4,
+}
+
 /// A unit sphere at the origin mapped by `object_to_world` (= M * T(c) * S(r)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SphereDesc {
@@ -269,6 +296,10 @@ pub struct SceneDesc {
     /// per material index: its shading-frame perturbation (Mitsuba's `normalmap` or `bumpmap`
     /// around it), or None (the table may be shorter than `materials`; empty: none)
     pub material_frames: Vec<Option<FrameMap>>,
+    /// shapegroups' triangles, stored once each (placed only by `instances`); empty: none
+    pub groups: Vec<GroupDesc>,
+    /// instances of `groups` (Embree instances at build); empty: none
+    pub instances: Vec<InstanceDesc>,
     /// spheres / ellipsoids
     pub spheres: Vec<SphereDesc>,
     /// quad area lights (not transformed by the stack)
@@ -361,6 +392,19 @@ impl SceneDesc {
         for t in &self.emissive_triangles {
             t.v.iter().for_each(|&v| h.vec3(v));
             h.vec3(t.radiance);
+        }
+        // Only when present, so that the hash of a scene without instances is unchanged.
+        for g in &self.groups {
+            h.word(0x6772_7000);
+            g.triangles.iter().for_each(|t| {
+                t.v.iter().for_each(|&v| h.vec3(v));
+                h.word(t.material);
+            });
+            g.triangle_normals.iter().flatten().for_each(|&n| h.vec3(n));
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (&g.triangle_uvs, &g.spheres)));
+        }
+        for i in &self.instances {
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", i));
         }
         // Only when present, so that the hash of a scene without a sky is unchanged.
         match &self.environment {
@@ -544,6 +588,8 @@ impl Default for SceneDesc {
             importance_sampling: ImportanceSampling::Hemisphere,
             materials: Vec::new(),
             triangles: Vec::new(),
+            groups: Vec::new(),
+            instances: Vec::new(),
             spheres: Vec::new(),
             quad_lights: Vec::new(),
             emissive_triangles: Vec::new(),

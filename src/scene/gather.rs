@@ -112,6 +112,24 @@ impl Scene {
     #[inline]
     pub fn gather_into(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8, out: &mut SurfaceHit8) {
         let _p = crate::profile::leaf(crate::profile::Phase::Gather);
+        if !self.instances.is_empty() {
+            return self.gather_instanced(org, dir, hits, out);
+        }
+        self.gather_scene::<false>(org, dir, hits, out);
+    }
+
+    /// [`Scene::gather_into`] in a scene with instances: their hits name their group's triangle,
+    /// made the scene's first. Out of line, so that scenes without instances keep their code.
+    #[cold]
+    #[inline(never)]
+    fn gather_instanced(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8, out: &mut SurfaceHit8) {
+        self.gather_scene::<true>(org, dir, &self.instances.remap(hits), out);
+    }
+
+    /// [`Scene::gather_into`] of hits whose primitives are scene triangles; `INST`: the scene
+    /// has instances.
+    #[inline(always)]
+    fn gather_scene<const INST: bool>(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8, out: &mut SurfaceHit8) {
         let p = dir.mul_add(hits.t, org);
         let valid = hits.hit;
         let bits = valid.to_bitmask();
@@ -129,11 +147,12 @@ impl Scene {
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());
         let first = prim[bits.trailing_zeros() as usize];
         let same = F8::from_bits(hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES)) & hits.prim.simd_eq(U8::splat(first)));
-        let one_triangle = same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
+        let one_triangle =
+            !INST && same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
         let Lanes8 { n, m, light, le, any_tri, mat } = if one_triangle {
             self.one_triangle(first as usize, valid)
         } else {
-            self.lane_by_lane(bits, valid, geom, prim, p, dir)
+            self.lane_by_lane::<INST>(bits, valid, [geom, prim, hits.inst.as_array()], p, dir)
         };
         // Shade two-sided: flip the normal to face the incoming ray (the scalar Vec3::dot's
         // operation order, so the sign is the same as per lane).
@@ -144,7 +163,7 @@ impl Scene {
             out.material = U8::new(mat);
             out.back = back;
         }
-        let (ns, smooth) = if any_tri && !self.desc.triangle_normals.is_empty() {
+        let (ns, smooth) = if any_tri && !self.tri_corner_normals.is_empty() {
             self.smooth_normals(bits, geom, prim, hits, dir, ng)
         } else {
             (ng, crate::simd::mask_from_bools([false; 8]))
@@ -200,17 +219,18 @@ impl Scene {
     }
 
     /// The per-lane fields of the hit lanes `bits` (`valid`), one table lookup per lane: normal,
-    /// material, light index and light emission; points `p` (spheres and ellipsoids) and ray
-    /// directions `dir`.
-    fn lane_by_lane(
+    /// material, light index and light emission; `ids`: the lanes' geometry, primitive and
+    /// instance ids; points `p` (spheres and ellipsoids) and ray directions `dir`.
+    /// `INST`: the scene has instances (their lanes' normals are mapped to world space).
+    fn lane_by_lane<const INST: bool>(
         &self,
         bits: u32,
         valid: Mask8,
-        geom: &[u32; 8],
-        prim: &[u32; 8],
+        ids: [&[u32; 8]; 3],
         p: Vec3x8,
         dir: Vec3x8,
     ) -> Lanes8 {
+        let [geom, prim, inst] = ids;
         let mut n = Lanes3::splat(Vec3::Z);
         let mut mat = [0u32; 8];
         let mut light = [INVALID_ID; 8];
@@ -230,6 +250,9 @@ impl Scene {
                         }
                     }
                     n.set(i, self.tri_normal[prim]);
+                    if INST && inst[i] != INVALID_ID {
+                        n.set(i, self.instances.normal_of(inst[i], self.tri_normal[prim]));
+                    }
                     mat[i] = self.tri_material[prim];
                 }
                 GEOM_SPHERES | GEOM_ELLIPSOIDS => {
@@ -277,7 +300,10 @@ impl Scene {
                 continue;
             };
             let (u, v) = (bu[i], bv[i]);
-            let s = (c[0] * (1.0 - u - v) + c[1] * u + c[2] * v).normalize_or_zero();
+            let mut s = (c[0] * (1.0 - u - v) + c[1] * u + c[2] * v).normalize_or_zero();
+            if !self.instances.is_empty() && hits.inst.as_array()[i] != INVALID_ID {
+                s = self.instances.normal_of(hits.inst.as_array()[i], s);
+            }
             let g = ng.lane(i);
             let s = if s.dot(g) < 0.0 { -s } else { s };
             // The guard: the ray must arrive from above the shading normal too. Registry BSDFs
@@ -508,7 +534,7 @@ mod tests {
             let (geom, prim) = ([GEOM_TRIANGLES; 8], [t; 8]);
             let p = Vec3x8::splat(Vec3::new(0.1, 0.0, 0.2));
             let fast = sc.one_triangle(t as usize, valid);
-            let slow = sc.lane_by_lane(b, valid, &geom, &prim, p, dir);
+            let slow = sc.lane_by_lane::<false>(b, valid, [&geom, &prim, &[INVALID_ID; 8]], p, dir);
             assert_eq!(bits(fast.n), bits(slow.n));
             assert_eq!(fast.light.to_array(), slow.light.to_array());
             assert_eq!(bits(fast.le), bits(slow.le));

@@ -3,6 +3,7 @@ pub mod build;
 pub mod desc;
 pub mod error;
 pub mod gather;
+pub mod instances;
 pub mod limits;
 pub mod mesh;
 pub mod obj;

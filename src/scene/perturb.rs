@@ -82,10 +82,13 @@ impl Scene {
         match geom {
             GEOM_TRIANGLES => {
                 let src = *self.tri_source.get(k)?;
-                if src == NO_TRIANGLE {
-                    return None;
-                }
-                let v = self.desc.triangles.get(src as usize)?.v;
+                // A group's triangle (group space, mapped by its instance below) or the scene's.
+                let group = self.instances.corners(k).filter(|_| !self.instances.is_empty());
+                let v = match group {
+                    Some(v) => v,
+                    None if src == NO_TRIANGLE => return None,
+                    None => self.desc.triangles.get(src as usize)?.v,
+                };
                 let ng = self.tri_normal[k];
                 let corners = self.tri_uv.get(k).filter(|c| **c != [Vec2::ZERO; 3]);
                 let uv = triangle_uv(corners, bary.x, bary.y);
@@ -111,7 +114,14 @@ impl Scene {
                     None => ng,
                 };
                 let q = TexQuery { uv, tri: src, bary };
-                Some(Local { material: self.tri_material[k], ng, ns, dp_du, dp_dv, q })
+                let material = self.tri_material[k];
+                if group.is_some() {
+                    let (inst, x) = (hits.inst.as_array()[i], &self.instances);
+                    let (ng, ns) = (x.normal_of(inst, ng), x.normal_of(inst, ns));
+                    let (dp_du, dp_dv) = (x.tangent_of(inst, dp_du), x.tangent_of(inst, dp_dv));
+                    return Some(Local { material, ng, ns, dp_du, dp_dv, q });
+                }
+                Some(Local { material, ng, ns, dp_du, dp_dv, q })
             }
             GEOM_SPHERES | GEOM_ELLIPSOIDS => {
                 let table = if geom == GEOM_SPHERES { &self.sphere_point_index } else { &self.ellipsoid_index };

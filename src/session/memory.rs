@@ -81,7 +81,10 @@ pub fn estimate(desc: &SceneDesc, range: std::ops::Range<u32>, threads: usize) -
     let state = 52 * px + 48 * px * b;
     let pass = 52 * px + 48 * px * (b + b.next_power_of_two());
     let film = pass.max(state + (100 * px).max(48 * px * b));
-    let tris = (desc.triangles.len() + desc.emissive_triangles.len() + 2 * desc.quad_lights.len()) as u64;
+    // A shapegroup's triangles are stored once, however many instances place them.
+    let tris =
+        (desc.triangles.len() + desc.emissive_triangles.len() + 2 * desc.quad_lights.len() + desc.group_triangles())
+            as u64;
     let normals = if desc.triangle_normals.is_empty() { 0 } else { PER_TRIANGLE_NORMALS * tris };
     // A bad STRATA_BVH was refused by the command-line checks; here it counts as unset.
     let by_count = tris >= crate::scene::build::HIGH_QUALITY_MIN_TRIANGLES as u64;

@@ -163,7 +163,7 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     let plural = |n: usize| if n == 1 { "" } else { "s" };
     let (zero, huge) = (scene.degenerate_dropped - scene.overflow_dropped, scene.overflow_dropped);
     let d = &scene.desc;
-    let triangles = d.triangles.len() + d.emissive_triangles.len();
+    let triangles = d.triangles.len() + d.emissive_triangles.len() + d.group_triangles();
     if triangles > 0 && scene.degenerate_dropped >= triangles && d.spheres.is_empty() {
         // Before: an OBJ whose only triangle overflowed got a camera framing the dropped vertices
         // and rendered black with exit 0.

@@ -1,7 +1,7 @@
 //! How a [`Mesh`] enters a [`SceneDesc`]: [`SceneDesc::add_mesh`].
 
 use super::Mesh;
-use crate::scene::desc::{SceneDesc, TriangleAttrDesc, TriangleDesc};
+use crate::scene::desc::{GroupDesc, InstanceDesc, SceneDesc, SphereDesc, TriangleAttrDesc, TriangleDesc};
 use glam::{Vec2, Vec3};
 
 impl SceneDesc {
@@ -53,18 +53,51 @@ impl SceneDesc {
 pub type ShapeGroup = [(Mesh, u32)];
 
 impl SceneDesc {
-    /// Mitsuba's `instance` of a `shapegroup`, flattened: a copy of each member mesh mapped by
-    /// `to_world` (as [`Mesh::transform`] does) is added with [`SceneDesc::add_mesh`]. (Embree
-    /// instancing, `accel::SceneBuilder::add_mesh_instance`, would share the members' BVH; the
-    /// shading tables are per world triangle, so this copy is what the renderer reads today.)
-    /// Returns the index of the first triangle added.
-    pub fn add_instance(&mut self, group: &ShapeGroup, to_world: &glam::Mat4) -> u32 {
-        let first = self.triangles.len() as u32;
+    /// Stores Mitsuba's `shapegroup` `id` once: its member meshes (group space, without
+    /// attributes) as a [`GroupDesc`]'s triangles with their normals and uvs, and its spheres
+    /// (group-space maps with their materials). Returns its index in `groups`.
+    pub fn add_group(&mut self, id: &str, group: &ShapeGroup, spheres: Vec<(glam::Mat4, u32)>) -> u32 {
+        let mut g = GroupDesc { id: id.to_string(), spheres, ..GroupDesc::default() };
         for (mesh, material) in group {
-            let mut copy = mesh.clone();
-            copy.transform(to_world);
-            self.add_mesh(&copy, *material);
+            let first = g.triangles.len();
+            let corner = |t: &[u32; 3]| t.map(|i| i as usize);
+            g.triangles.extend(
+                mesh.indices
+                    .iter()
+                    .map(|t| TriangleDesc { v: corner(t).map(|i| mesh.positions[i]), material: *material }),
+            );
+            if !mesh.normals.is_empty() {
+                g.triangle_normals.resize(first, [Vec3::ZERO; 3]);
+                g.triangle_normals.extend(mesh.indices.iter().map(|t| corner(t).map(|i| mesh.normals[i])));
+            }
+            if !mesh.uvs.is_empty() {
+                g.triangle_uvs.resize(first, [Vec2::ZERO; 3]);
+                g.triangle_uvs.extend(mesh.indices.iter().map(|t| corner(t).map(|i| mesh.uvs[i])));
+            }
         }
-        first
+        self.groups.push(g);
+        (self.groups.len() - 1) as u32
+    }
+
+    /// How many triangles the shapegroups store (each once, however many instances place it).
+    pub fn group_triangles(&self) -> usize {
+        self.groups.iter().map(|g| g.triangles.len()).sum()
+    }
+
+    /// The index of the stored shapegroup `id`, if [`SceneDesc::add_group`] stored it.
+    pub fn group_index(&self, id: &str) -> Option<u32> {
+        self.groups.iter().position(|g| g.id == id).map(|i| i as u32)
+    }
+
+    /// Mitsuba's `instance` of the stored group `group` through `to_world`: an [`InstanceDesc`]
+    /// (its triangles stay stored once; the build makes it an Embree instance) and a copy of each
+    /// of the group's spheres composed with `to_world`.
+    pub fn add_instance(&mut self, group: u32, to_world: &glam::Mat4) {
+        self.instances.push(InstanceDesc { group, to_world: *to_world });
+        if let Some(g) = self.groups.get(group as usize) {
+            let spheres =
+                g.spheres.iter().map(|&(m, material)| SphereDesc { object_to_world: *to_world * m, material });
+            self.spheres.extend(spheres.collect::<Vec<_>>());
+        }
     }
 }

@@ -123,18 +123,24 @@ fn add_mesh_fills_tables_and_keeps_hash_without_extras() {
 use crate::scene::desc::TriangleDesc;
 
 #[test]
-fn instance_is_a_transformed_copy() {
+fn instances_store_the_group_once() {
     let group = vec![(tri(), 2u32)];
     let mut desc = SceneDesc::default();
     let t = Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0)) * Mat4::from_scale(Vec3::new(-2.0, 2.0, 2.0));
-    assert_eq!(desc.add_instance(&group, &Mat4::IDENTITY), 0);
-    assert_eq!(desc.add_instance(&group, &t), 1);
-    assert_eq!(desc.triangles.len(), 2);
-    // mirrored: winding reversed, so the copy's corners are v0, v2, v1 of the mapped triangle
-    assert_eq!(desc.triangles[1].v, [Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 2.0, 5.0), Vec3::new(-2.0, 0.0, 5.0)]);
-    assert_eq!(desc.triangles[1].material, 2);
-    assert_eq!(desc.triangle_normals[1], [Vec3::Z; 3]);
-    assert_eq!(desc.triangle_attrs.len(), 4, "each copy carries its attributes");
+    let sphere = Mat4::from_scale(Vec3::splat(0.5));
+    let g = desc.add_group("g", &group, vec![(sphere, 1)]);
+    assert_eq!(desc.group_index("g"), Some(g));
+    desc.add_instance(g, &Mat4::IDENTITY);
+    desc.add_instance(g, &t);
+    assert!(desc.triangles.is_empty(), "no world copy");
+    assert_eq!(desc.groups[0].triangles.len(), 1);
+    assert_eq!(desc.groups[0].triangles[0].material, 2);
+    assert_eq!(desc.groups[0].triangle_normals[0], [Vec3::Z; 3]);
+    assert_eq!(desc.instances.len(), 2);
+    assert_eq!(desc.instances[1].to_world, t);
+    // spheres are placed per instance
+    assert_eq!(desc.spheres.len(), 2);
+    assert_eq!(desc.spheres[1].object_to_world, t * sphere);
 }
 
 /// Every loader reads through `files::open_regular`: a FIFO (nobody writes to it) is refused

@@ -118,5 +118,8 @@ fn collect_ids(e: &doc::Elem, ids: &mut HashMap<String, doc::Elem>) -> Result<()
 }
 
 #[cfg(test)]
+#[path = "instance_tests.rs"]
+mod instance_tests;
+#[cfg(test)]
 #[path = "one_sided_tests.rs"]
 mod one_sided_tests;

@@ -1,8 +1,8 @@
-//! `<shape type="instance">`: a `shapegroup` (by `<ref>`) through `to_world`, flattened (each
-//! member's triangles copied; spheres composed with the instance's transform).
+//! `<shape type="instance">`: a `shapegroup` (by `<ref>`) through `to_world`. The group's
+//! triangles are stored once (on its first instance) and each instance becomes an Embree instance
+//! of them at build; the group's spheres are placed per instance (composed with `to_world`).
 
 use super::{Build, Plugin, Run};
-use crate::scene::desc::SphereDesc;
 use crate::scene::error::SceneError;
 use crate::scene::xml::props::Props;
 use crate::scene::xml::shape::ShapeOut;
@@ -16,19 +16,43 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<ShapeOut, SceneError> {
         _ => return Err(p.elem.at.err("an instance takes one <ref> to a shapegroup")),
     };
     let to_world = p.transform("to_world")?;
-    let gp = Props::new(group, b.ids)?;
-    let mut meshes = Vec::new();
-    for member in gp.objects("shape") {
-        let (out, material, emitter) = b.shape_parts(member)?;
-        if emitter.is_some() {
-            return Err(member.at.err("emitters inside a shapegroup are not supported (Mitsuba refuses them too)"));
-        }
-        match out {
-            ShapeOut::Mesh(m) => meshes.push((m, material)),
-            ShapeOut::Sphere(m) => b.desc.spheres.push(SphereDesc { object_to_world: to_world * m, material }),
-            ShapeOut::Nothing => return Err(member.at.err("nested shapegroups are not supported")),
-        }
+    if !(to_world.determinant().is_normal()) {
+        return Err(p.elem.at.err("an instance's to_world must be invertible"));
     }
-    b.desc.add_instance(&meshes, &to_world);
+    let key = group.attr("id").map_or_else(|| format!("{:?}", group.at), str::to_string);
+    let index = match b.desc.group_index(&key) {
+        Some(i) => i,
+        None => {
+            let gp = Props::new(group, b.ids)?;
+            let (mut meshes, mut spheres) = (Vec::new(), Vec::new());
+            for member in gp.objects("shape") {
+                let (out, material, emitter) = b.shape_parts(member)?;
+                if emitter.is_some() {
+                    return Err(member
+                        .at
+                        .err("emitters inside a shapegroup are not supported (Mitsuba refuses them too)"));
+                }
+                match out {
+                    ShapeOut::Mesh(m) if !m.vertex_attrs.is_empty() || !m.face_attrs.is_empty() => {
+                        return Err(member.at.err("mesh attributes inside a shapegroup are not supported"));
+                    }
+                    ShapeOut::Mesh(m) => meshes.push((m, material)),
+                    ShapeOut::Sphere(m) => spheres.push((m, material)),
+                    ShapeOut::Nothing => return Err(member.at.err("nested shapegroups are not supported")),
+                }
+            }
+            let d = &b.desc;
+            let stored = d.triangles.len() + d.emissive_triangles.len() + d.group_triangles();
+            if stored + meshes.iter().map(|(m, _)| m.indices.len()).sum::<usize>() > b.limits.max_primitives {
+                return Err(group.at.err(format!(
+                    "the scene has more than {} triangles ({})",
+                    b.limits.max_primitives,
+                    crate::scene::limits::limit_hint("max_primitives")
+                )));
+            }
+            b.desc.add_group(&key, &meshes, spheres)
+        }
+    };
+    b.desc.add_instance(index, &to_world);
     Ok(ShapeOut::Nothing)
 }
