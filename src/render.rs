@@ -316,8 +316,7 @@ fn render_light(
                 })
                 .collect()
         });
-        let mut images =
-            SplatImages { start: part.start, width: w, data: vec![vec![[0.0; 3]; pixels as usize]; part.len()] };
+        let mut images = SplatImages { start: part.start, data: vec![vec![[0.0; 3]; pixels as usize]; part.len()] };
         for (&(s, _, _), (splats, c, busy, phases, wall)) in blocks.iter().zip(&traced) {
             for (a, b) in stats.phase_ns.iter_mut().zip(phases) {
                 *a += b;
@@ -346,7 +345,6 @@ fn render_light(
 /// The particle tracer's images of samples `start..start + data.len()`: `data[s - start][pixel]`.
 pub(crate) struct SplatImages {
     start: u32,
-    width: u32,
     data: Vec<Vec<[f32; 3]>>,
 }
 
@@ -354,7 +352,6 @@ impl SplatImages {
     /// The samples `batch` of the packets `pks`, sample-major as `Integrator::radiance_tile`
     /// writes them (lanes outside the image zero).
     fn fill(&self, pks: &[PixelPacket], batch: std::ops::Range<u32>, out: &mut Vec<Vec3x8>) {
-        let _ = self.width;
         out.clear();
         for s in batch {
             let im = &self.data[(s - self.start) as usize];
