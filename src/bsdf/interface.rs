@@ -144,17 +144,6 @@ impl Params8 {
         opacity: F8::ONE,
     };
 
-    /// All zero: what a kernel that compiles no registry BSDF carries (it reads no slot, and the
-    /// opacity only in kernels with `mask`). Cheaper to make per shading call than [`Self::COURSE`]
-    /// (zero stores rather than a 512-byte copy of a constant); the same kind and sides.
-    pub const UNREAD: Self = Self {
-        kind: U8::ZERO,
-        twosided: F8::ZERO,
-        color: [Vec3x8::ZERO; COLORS],
-        scalar: [F8::ZERO; SCALARS],
-        opacity: F8::ZERO,
-    };
-
     /// One row in every lane.
     #[inline]
     pub fn splat(p: &BsdfParams) -> Self {

@@ -24,12 +24,6 @@ pub struct Material {
     pub kind: BrdfKind,
 }
 
-impl From<&crate::bsdf::desc::Material> for Material {
-    fn from(m: &crate::bsdf::desc::Material) -> Self {
-        Self { kd: m.diffuse, ks: m.specular, shininess: m.shininess, alpha: m.roughness, kind: m.brdf }
-    }
-}
-
 impl Material {
     /// Probability t of picking the specular lobe under `importancesampling brdf` (see module docs).
     #[inline]
@@ -115,7 +109,9 @@ pub struct Sampled8 {
 }
 
 impl Material8 {
-    /// Gathers eight scalar materials into lanes.
+    /// Gathers eight scalar materials into lanes (the tests' x8-against-scalar checks; a render's
+    /// lanes are written by the hit gather, `scene::gather`).
+    #[cfg(test)]
     pub fn from_lanes(m: [Material; 8]) -> Self {
         Self {
             kd: Vec3x8::from_lanes(m.map(|m| m.kd)),

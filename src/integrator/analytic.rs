@@ -28,7 +28,7 @@ pub fn radiance(scene: &Scene, sh: &SurfaceHit8) -> Vec3x8 {
             polygon_phi_x8(sh.p, &light.corners(), shade)
         };
         let e = phi.dot(sh.n).max(F8::ZERO);
-        l_out += sh.kd.mul_elem(Vec3x8::splat(light.radiance)).scale(e * F8::splat(1.0 / PI));
+        l_out += sh.mat.kd.mul_elem(Vec3x8::splat(light.radiance)).scale(e * F8::splat(1.0 / PI));
     }
     l_out
 }

@@ -6,7 +6,7 @@
 use super::samples::Samples;
 use super::stats::{Counters, RayKind, RayLog};
 use crate::accel::{Ray8, RayHit8};
-use crate::bsdf::{BsdfSet, LobeSet, Material8};
+use crate::bsdf::{BsdfSet, LobeSet};
 use crate::camera::PixelPacket;
 use crate::scene::build::Scene;
 use crate::scene::gather::SurfaceHit8;
@@ -103,50 +103,15 @@ pub(super) fn masked(v: Vec3x8, m: Mask8) -> Vec3x8 {
     Vec3x8::new(m.select(v.x, F8::ZERO), m.select(v.y, F8::ZERO), m.select(v.z, F8::ZERO))
 }
 
-/// The material of a hit record, with the registry BSDF rows looked up only in a kernel that
-/// compiles registry BSDFs in.
-#[inline(always)]
-pub(super) fn material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Material8 {
-    let bsdf = if <L::Bsdfs as BsdfSet>::BITS != 0 {
-        let mut p = scene.bsdf_params(sh.material, sh.valid);
-        if !scene.param_textures.is_empty() {
-            scene.texture_params(sh, sh.valid, &mut p);
-        }
-        p
-    } else {
-        // Never read in these kernels (no registry BSDF, no mask).
-        crate::bsdf::Params8::UNREAD
-    };
-    Material8 {
-        kd: sh.kd,
-        ks: sh.ks,
-        shininess: sh.shininess,
-        alpha: sh.roughness,
-        ggx: sh.ggx,
-        bsdf,
-        back: sh.back,
-        frame_map: None,
-    }
-}
-
 /// The local shading frame of a hit record: in kernels with registry BSDFs (which every scene
 /// with tangents or normal/bump maps runs) built from the hit's tangent (Mitsuba's: dp/du made
-/// orthogonal to the normal) where the scene has tangents; from the normal alone otherwise.
+/// orthogonal to the normal) where the scene has tangents; from the normal alone otherwise. With
+/// the hit's material (`sh.mat`, written by the gather) it is all a packet is shaded with: the
+/// one way `direct`, the path tracer and the particle tracer build a [`super::light_term::Shading`].
 #[inline(always)]
 pub(super) fn shading_frame<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> Frame8 {
     if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.tangents {
         return Frame8::from_normal_tangent(sh.n, sh.s);
     }
     Frame8::from_normal(sh.n)
-}
-
-/// [`material`] with the terms of the hit's normal or bump maps ([`crate::bsdf::FrameMap8`]) in
-/// the local `frame` (from [`shading_frame`]), in kernels with registry BSDFs of scenes with maps.
-#[inline(always)]
-pub(super) fn material_in<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8, frame: &Frame8) -> Material8 {
-    let mut mat = material::<L>(scene, sh);
-    if <L::Bsdfs as BsdfSet>::BITS != 0 && scene.frame_maps() {
-        mat.frame_map = Some(crate::bsdf::FrameMap8 { base: frame.to_local(sh.base_n), a2: sh.bump_a2 });
-    }
-    mat
 }

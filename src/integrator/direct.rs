@@ -17,9 +17,9 @@
 //! `direct` does with one emitter sample. `uniform` is then truly 1/#lights (quads and triangles
 //! alike).
 
-use super::context::{masked, TileCtx, Tracer};
+use super::context::{masked, shading_frame, TileCtx, Tracer};
 use super::estimator::Estimator;
-use super::light_term::{area_sample, frame_material, point_shadow, towards, AreaChoice, PointTerm, Shading};
+use super::light_term::{area_sample, point_shadow, towards, AreaChoice, PointTerm, Shading};
 use super::primary::{self, Wave};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
@@ -350,8 +350,8 @@ fn sample_batch<L: LobeSet>(
         if lit.none() {
             continue;
         }
-        let (frame, mat) = frame_material::<L>(scene, sh);
-        let at = Shading::new(sh, &frame, &mat, ImportanceSampling::Cosine);
+        let frame = shading_frame::<L>(scene, sh);
+        let at = Shading::new(sh, &frame, ImportanceSampling::Cosine);
         let f = at.eval::<L>(at.frame.to_local(wi), lit).0;
         batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
         // Shadow packet from the offset point towards the light sample, stopping short.

@@ -12,8 +12,8 @@
 use super::{Batch, Lanes, LightTable, DIM_LIGHT_BASE};
 use crate::accel::Ray8;
 use crate::bsdf::LobeSet;
-use crate::integrator::context::{masked, TileCtx};
-use crate::integrator::light_term::{env_sample, frame_material, Shading, SkySampling};
+use crate::integrator::context::{masked, shading_frame, TileCtx};
+use crate::integrator::light_term::{env_sample, Shading, SkySampling};
 use crate::integrator::samples::{Dim, Source};
 use crate::integrator::settings::Integrator;
 use crate::scene::desc::ImportanceSampling;
@@ -49,8 +49,8 @@ pub(super) fn shade_outside<L: LobeSet>(
                     continue;
                 }
                 let uv = table.point(smp, pks[i].pixel, k);
-                let (frame, mat) = frame_material::<L>(scene, sh);
-                let at = Shading::new(sh, &frame, &mat, ImportanceSampling::Cosine);
+                let frame = shading_frame::<L>(scene, sh);
+                let at = Shading::new(sh, &frame, ImportanceSampling::Cosine);
                 let Some(e) = env_sample(scene, SkySampling::Cosine, at.frame, uv, shade) else { continue };
                 let Some((lit, wi, c)) = at.env_event::<L>(&e, one, shade, |_, _| inv_n) else { continue };
                 batch.contrib.push(masked(c, lit));
@@ -65,8 +65,8 @@ pub(super) fn shade_outside<L: LobeSet>(
             if shade.none() {
                 continue;
             }
-            let (frame, mat) = frame_material::<L>(scene, sh);
-            let at = Shading::new(sh, &frame, &mat, ImportanceSampling::Cosine);
+            let frame = shading_frame::<L>(scene, sh);
+            let at = Shading::new(sh, &frame, ImportanceSampling::Cosine);
             let o = sh.ng.mul_add(lanes.eps[i], sh.p);
             at.delta_events::<L>(scene, one, shade, |lit: Mask8, wi, tfar, c| {
                 batch.contrib.push(masked(c, lit));

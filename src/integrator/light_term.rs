@@ -14,9 +14,8 @@
 //! scales them once, the path tracer weighs with MIS and its throughput. Their products are
 //! ordered differently, and both keep their images bit for bit.
 
-use super::context::{material_in, shading_frame};
 use super::settings::Integrator;
-use crate::bsdf::{LobeSet, Material8};
+use crate::bsdf::LobeSet;
 use crate::light::delta::DeltaLight;
 use crate::light::emitters::LightSample8;
 use crate::profile::{leaf, Phase};
@@ -25,27 +24,16 @@ use crate::scene::desc::ImportanceSampling;
 use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8};
 
-/// The shading frame of the hits `sh` (`context::shading_frame`: Mitsuba's, from the tangent, in
-/// kernels with registry BSDFs) and their material in it (`context::material_in`, with a normal or
-/// bump map's terms): what [`Shading::new`] takes.
-#[inline(always)]
-pub fn frame_material<L: LobeSet>(scene: &Scene, sh: &SurfaceHit8) -> (Frame8, Material8) {
-    let frame = shading_frame::<L>(scene, sh);
-    let mat = material_in::<L>(scene, sh, &frame);
-    (frame, mat)
-}
-
-/// A packet of shading points as next events see it: the hits, their shading frame, the
-/// direction to the viewer in it and the material, built once per packet.
+/// A packet of shading points as next events see it: the hits (with their material, `sh.mat`),
+/// their shading frame and the direction to the viewer in it, built once per packet.
 pub struct Shading<'a> {
-    /// the hits
+    /// the hits, with the material of every lane (`sh.mat`, by reference: it is large, and
+    /// copying it costs)
     pub sh: &'a SurfaceHit8,
     /// the shading frame (normal `sh.n`; by reference: a copy costs)
     pub frame: &'a Frame8,
     /// the direction to the viewer, local
     pub wo: Vec3x8,
-    /// the material of every lane (by reference: it is large, and copying it costs)
-    pub mat: &'a Material8,
     /// the strategy whose pdf [`Shading::eval`] returns
     pub strategy: ImportanceSampling,
 }
@@ -68,12 +56,12 @@ pub struct PointTerm {
 }
 
 impl<'a> Shading<'a> {
-    /// The shading points of the hits `sh` in their shading `frame` with their material `mat`
-    /// (both from [`frame_material`]), their BSDF evaluated under `strategy`.
+    /// The shading points of the hits `sh` in their shading `frame` (from
+    /// `context::shading_frame`), their BSDF (`sh.mat`) evaluated under `strategy`.
     #[inline]
-    pub fn new(sh: &'a SurfaceHit8, frame: &'a Frame8, mat: &'a Material8, strategy: ImportanceSampling) -> Self {
+    pub fn new(sh: &'a SurfaceHit8, frame: &'a Frame8, strategy: ImportanceSampling) -> Self {
         let wo = frame.to_local(sh.wo);
-        Self { sh, frame, wo, mat, strategy }
+        Self { sh, frame, wo, strategy }
     }
 
     /// [`leaves`] at these shading points.
@@ -86,7 +74,7 @@ impl<'a> Shading<'a> {
     #[inline]
     pub fn eval<L: LobeSet>(&self, wi_l: Vec3x8, lit: Mask8) -> (Vec3x8, F8) {
         let _p = leaf(Phase::BsdfEval);
-        self.mat.eval_pdf_k::<L>(self.strategy, self.wo, wi_l, lit)
+        self.sh.mat.eval_pdf_k::<L>(self.strategy, self.wo, wi_l, lit)
     }
 
     /// The environment's next event for the direction `e` (from [`env_sample`]) at the lanes

@@ -35,9 +35,8 @@
 //! `DIM_PT_BASE + 2 + 2 (k - 1)` and (roulette, lobe choice) one after, each over the pixel's spp
 //! samples of the pixel the path is started for.
 
-use super::context::TileCtx;
+use super::context::{shading_frame, TileCtx};
 use super::estimator::Estimator;
-use super::light_term::frame_material;
 use super::samples::{Dim, Source};
 use super::settings::Integrator;
 use super::stats::{Counters, RayKind};
@@ -312,7 +311,7 @@ fn trace_tile<L: LobeSet>(it: &Integrator, ctx: &mut TileCtx, paths: &LightPaths
             if shade.none() {
                 break;
             }
-            let (frame, mat) = frame_material::<L>(scene, &sh);
+            let (frame, mat) = (shading_frame::<L>(scene, &sh), &sh.mat);
             let wo = frame.to_local(sh.wo);
             let eps = scene.offset_eps(sh.p);
             // The connection to the sensor of every shaded lane.

@@ -69,7 +69,7 @@ pub fn radiance(scene: &Scene, max_depth: i32, sh0: &SurfaceHit8, tracer: &mut T
         if depth >= bounces {
             break;
         }
-        weight = weight.mul_elem(sh.ks);
+        weight = weight.mul_elem(sh.mat.ks);
         alive &= weight.max_elem().simd_gt(F8::ZERO);
         if alive.none() {
             break;
@@ -136,6 +136,7 @@ fn blinn_phong(sh: &SurfaceHit8, wi: Vec3x8, active: Mask8) -> Vec3x8 {
     let nh = sh.n.dot(h);
     let has_spec = nh.simd_gt(F8::ZERO);
     // x^s = exp(s ln x), only where x > 0.
-    let pow = has_spec.select((sh.shininess * has_spec.select(nh, F8::ONE).ln()).exp(), F8::ZERO);
-    masked(sh.kd.scale(cos_l) + sh.ks.scale(pow), active)
+    let m = &sh.mat;
+    let pow = has_spec.select((m.shininess * has_spec.select(nh, F8::ONE).ln()).exp(), F8::ZERO);
+    masked(m.kd.scale(cos_l) + m.ks.scale(pow), active)
 }

@@ -5,6 +5,7 @@
 use super::build::Scene;
 use crate::accel::{Hits8, GEOM_ELLIPSOIDS, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
 use crate::bsdf::interface::COURSE;
+use crate::bsdf::{FrameMap8, Material8, Params8};
 use crate::scene::desc::{BrdfKind, Material};
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
@@ -26,16 +27,13 @@ pub struct SurfaceHit8 {
     pub smooth: Mask8,
     /// unit direction towards the viewer (-ray direction)
     pub wo: Vec3x8,
-    /// diffuse reflectance kd
-    pub kd: Vec3x8,
-    /// specular reflectance ks
-    pub ks: Vec3x8,
-    /// Phong exponent
-    pub shininess: F8,
-    /// GGX alpha
-    pub roughness: F8,
-    /// lanes whose material is GGX
-    pub ggx: Mask8,
+    /// the lanes' material, written in place by the gather (the one per-lane material shape):
+    /// the course's fields (kd, ks, shininess, alpha, ggx; textured kd evaluated at the hit) on
+    /// every packet with a hit; in scenes with registry BSDFs also the lanes' registry rows
+    /// (`bsdf`, [`Scene::bsdf_params`] with their textured parameters), the sides hit (`back`)
+    /// and, in scenes with normal or bump maps, the maps' terms in the shading frame
+    /// (`frame_map`); the miss record's elsewhere
+    pub mat: Material8,
     /// radiance emitted towards wo by the material (`emission`, every hit, any side)
     pub emitted: Vec3x8,
     /// ambient term of the material (`raytracer` only; zero on lights and misses)
@@ -48,9 +46,6 @@ pub struct SurfaceHit8 {
     /// material index per lane (into `Scene::materials`; 0 on misses): the registry BSDF's row
     /// ([`Scene::bsdf_params`]); filled only in scenes with registry BSDFs
     pub material: U8,
-    /// hit lanes that hit the back of the surface (the normals were flipped to face the ray);
-    /// filled only in scenes with registry BSDFs
-    pub back: Mask8,
     /// where textures are evaluated at the hit (uv, triangle, barycentrics); filled only in
     /// scenes with textured BSDF parameters (`Scene::param_textures`)
     pub tex: crate::texture::TexQuery8,
@@ -73,17 +68,21 @@ impl SurfaceHit8 {
         ng: Z8,
         smooth: F8::ZERO,
         wo: Vec3x8::ZERO,
-        kd: Vec3x8::ZERO,
-        ks: Vec3x8::ZERO,
-        shininess: F8::ZERO,
-        roughness: F8::ONE,
-        ggx: F8::ZERO,
+        mat: Material8 {
+            kd: Vec3x8::ZERO,
+            ks: Vec3x8::ZERO,
+            shininess: F8::ZERO,
+            alpha: F8::ONE,
+            ggx: F8::ZERO,
+            bsdf: Params8::COURSE,
+            back: F8::ZERO,
+            frame_map: None,
+        },
         emitted: Vec3x8::ZERO,
         ambient: Vec3x8::ZERO,
         le: Vec3x8::ZERO,
         light: U8::MAX,
         material: U8::ZERO,
-        back: F8::ZERO,
         tex: crate::texture::TexQuery8 { u: F8::ZERO, v: F8::ZERO, tri: U8::MAX, b1: F8::ZERO, b2: F8::ZERO },
         s: Vec3x8::ZERO,
         base_n: Z8,
@@ -139,9 +138,10 @@ impl Scene {
             // them keeps this path as short as before they existed).
             let m = &SurfaceHit8::MISS;
             (out.valid, out.p, out.n, out.ng, out.smooth, out.wo) = (m.valid, p, m.n, m.ng, m.smooth, -dir);
-            (out.kd, out.ks, out.shininess, out.roughness, out.ggx) = (m.kd, m.ks, m.shininess, m.roughness, m.ggx);
+            let (o, z) = (&mut out.mat, &m.mat);
+            (o.kd, o.ks, o.shininess, o.alpha, o.ggx, o.back) = (z.kd, z.ks, z.shininess, z.alpha, z.ggx, z.back);
             (out.emitted, out.ambient, out.le, out.light) = (m.emitted, m.ambient, m.le, m.light);
-            (out.material, out.back) = (m.material, m.back);
+            out.material = m.material;
             return;
         }
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());
@@ -149,19 +149,24 @@ impl Scene {
         let same = F8::from_bits(hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES)) & hits.prim.simd_eq(U8::splat(first)));
         let one_triangle =
             !INST && same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
-        let Lanes8 { n, m, light, le, any_tri, mat } = if one_triangle {
+        let Lanes8 { n, light, le, any_tri, mat } = if one_triangle {
             self.one_triangle(first as usize, valid)
         } else {
-            self.lane_by_lane::<INST>(bits, valid, [geom, prim, hits.inst.as_array()], p, dir)
+            self.lane_by_lane::<INST>(bits, [geom, prim, hits.inst.as_array()], p, dir)
         };
         // Shade two-sided: flip the normal to face the incoming ray (the scalar Vec3::dot's
         // operation order, so the sign is the same as per lane).
         let facing = (n.x * dir.x + n.y * dir.y) + n.z * dir.z;
         let back = valid & facing.simd_gt(F8::ZERO);
         let ng = Vec3x8::select(back, -n, n);
+        if one_triangle {
+            self.uniform_materials(mat[0], valid, out);
+        } else {
+            self.gather_materials(bits, valid, &mat, out);
+        }
         if self.registry_bsdfs {
             out.material = U8::new(mat);
-            out.back = back;
+            out.mat.back = back;
         }
         let (ns, smooth) = if any_tri && !self.tri_corner_normals.is_empty() {
             self.smooth_normals(bits, geom, prim, hits, dir, ng)
@@ -174,17 +179,13 @@ impl Scene {
         out.ng = ng;
         out.smooth = smooth;
         out.wo = -dir;
-        out.kd = m.kd;
-        out.ks = m.ks;
-        out.shininess = m.shininess;
-        out.roughness = m.roughness;
-        out.ggx = m.ggx;
-        out.emitted = m.emitted;
-        out.ambient = m.ambient;
         out.le = le;
         out.light = light;
         if self.hit_extras {
             self.extras(bits, hits, out);
+        }
+        if self.registry_bsdfs || self.frame_maps() {
+            self.registry_rows(valid, out);
         }
         if !self.material_one_sided.is_empty() && back.any() {
             self.black_backs(back, &mat, out);
@@ -199,8 +200,29 @@ impl Scene {
         let one = mat.map(|m| self.material_one_sided.get(m as usize).copied().unwrap_or(false));
         let black = back & crate::simd::mask_from_bools(one);
         if black.any() {
-            out.kd = Vec3x8::select(black, Vec3x8::ZERO, out.kd);
-            out.ks = Vec3x8::select(black, Vec3x8::ZERO, out.ks);
+            out.mat.kd = Vec3x8::select(black, Vec3x8::ZERO, out.mat.kd);
+            out.mat.ks = Vec3x8::select(black, Vec3x8::ZERO, out.mat.ks);
+        }
+    }
+
+    /// The part of the hit lanes' material that only scenes with registry BSDFs or maps have:
+    /// the lanes' registry rows with their textured parameters evaluated at the hits, and the
+    /// terms of a normal or bump map in the shading frame (the general kernel's
+    /// `integrator::context::shading_frame`: the same function of the same normal and tangent,
+    /// so the same bits).
+    #[cold]
+    #[inline(never)]
+    fn registry_rows(&self, valid: Mask8, out: &mut SurfaceHit8) {
+        if self.registry_bsdfs {
+            let mut p = self.bsdf_params(out.material, valid);
+            if !self.param_textures.is_empty() {
+                self.texture_params(out, valid, &mut p);
+            }
+            out.mat.bsdf = p;
+        }
+        if self.frame_maps() {
+            let frame = crate::simd::Frame8::from_normal_tangent(out.n, out.s);
+            out.mat.frame_map = Some(FrameMap8 { base: frame.to_local(out.base_n), a2: out.bump_a2 });
         }
     }
 
@@ -210,7 +232,6 @@ impl Scene {
     fn one_triangle(&self, t: usize, valid: Mask8) -> Lanes8 {
         Lanes8 {
             n: Vec3x8::select(valid, Vec3x8::splat(self.tri_normal[t]), Z8),
-            m: self.uniform_materials(self.tri_material[t], valid),
             light: U8::MAX,
             le: Vec3x8::ZERO,
             any_tri: true,
@@ -218,18 +239,11 @@ impl Scene {
         }
     }
 
-    /// The per-lane fields of the hit lanes `bits` (`valid`), one table lookup per lane: normal,
-    /// material, light index and light emission; `ids`: the lanes' geometry, primitive and
+    /// The per-lane fields of the hit lanes `bits`, one table lookup per lane: normal, material
+    /// index, light index and light emission; `ids`: the lanes' geometry, primitive and
     /// instance ids; points `p` (spheres and ellipsoids) and ray directions `dir`.
     /// `INST`: the scene has instances (their lanes' normals are mapped to world space).
-    fn lane_by_lane<const INST: bool>(
-        &self,
-        bits: u32,
-        valid: Mask8,
-        ids: [&[u32; 8]; 3],
-        p: Vec3x8,
-        dir: Vec3x8,
-    ) -> Lanes8 {
+    fn lane_by_lane<const INST: bool>(&self, bits: u32, ids: [&[u32; 8]; 3], p: Vec3x8, dir: Vec3x8) -> Lanes8 {
         let [geom, prim, inst] = ids;
         let mut n = Lanes3::splat(Vec3::Z);
         let mut mat = [0u32; 8];
@@ -274,8 +288,7 @@ impl Scene {
                 _ => {}
             }
         }
-        let m = self.gather_materials(bits, valid, &mat);
-        Lanes8 { n: n.get(), m, light: U8::new(light), le: le.get(), any_tri, mat }
+        Lanes8 { n: n.get(), light: U8::new(light), le: le.get(), any_tri, mat }
     }
 
     /// Shading normals from the triangles' vertex normals (see the module docs) on the triangle
@@ -337,31 +350,31 @@ impl Scene {
         crate::bsdf::Params8::from_lanes(std::array::from_fn(row))
     }
 
-    /// The fields of material `m0` on the hit lanes `valid`, the miss record's on the others.
+    /// The course's fields of material `m0` (into `out.mat`) and its emission and ambient term
+    /// on the hit lanes `valid`, the miss record's on the others.
     #[inline]
-    fn uniform_materials(&self, m0: u32, valid: Mask8) -> Materials8 {
+    fn uniform_materials(&self, m0: u32, valid: Mask8, out: &mut SurfaceHit8) {
         let (m, z) = (&self.materials[m0 as usize], &MISS_MATERIAL);
         let pick3 = |a: Vec3, b: Vec3| Vec3x8::select(valid, Vec3x8::splat(a), Vec3x8::splat(b));
         let pick = |a: f32, b: f32| valid.select(F8::splat(a), F8::splat(b));
-        Materials8 {
-            kd: pick3(m.diffuse, z.diffuse),
-            ks: pick3(m.specular, z.specular),
-            shininess: pick(m.shininess, z.shininess),
-            roughness: pick(m.roughness, z.roughness),
-            ggx: if m.brdf == BrdfKind::Ggx { valid } else { crate::simd::mask_from_bools([false; 8]) },
-            // 0 + emission, as the per-lane sum did (-0 becomes +0)
-            emitted: Vec3x8::ZERO + pick3(m.emission, z.emission),
-            ambient: pick3(m.ambient, z.ambient),
-        }
+        let o = &mut out.mat;
+        o.kd = pick3(m.diffuse, z.diffuse);
+        o.ks = pick3(m.specular, z.specular);
+        o.shininess = pick(m.shininess, z.shininess);
+        o.alpha = pick(m.roughness, z.roughness);
+        o.ggx = if m.brdf == BrdfKind::Ggx { valid } else { crate::simd::mask_from_bools([false; 8]) };
+        // 0 + emission, as the per-lane sum did (-0 becomes +0)
+        out.emitted = Vec3x8::ZERO + pick3(m.emission, z.emission);
+        out.ambient = pick3(m.ambient, z.ambient);
     }
 
-    /// The material fields of the hit lanes `bits` (`mat`: material index per lane), the miss
-    /// record's on the other lanes.
-    fn gather_materials(&self, bits: u32, valid: Mask8, mat: &[u32; 8]) -> Materials8 {
+    /// [`Scene::uniform_materials`] of the hit lanes `bits` (`mat`: material index per lane),
+    /// the miss record's on the other lanes.
+    fn gather_materials(&self, bits: u32, valid: Mask8, mat: &[u32; 8], out: &mut SurfaceHit8) {
         let first = if bits == 0 { None } else { Some(mat[bits.trailing_zeros() as usize]) };
         let uniform = first.filter(|&m0| lanes_of(bits).all(|i| mat[i] == m0));
         if let Some(m0) = uniform {
-            return self.uniform_materials(m0, valid);
+            return self.uniform_materials(m0, valid, out);
         }
         let (mut kd, mut ks, mut emitted, mut ambient) = (
             Lanes3::splat(Vec3::ZERO),
@@ -380,15 +393,14 @@ impl Scene {
             emitted.set(i, Vec3::ZERO + m.emission);
             ambient.set(i, m.ambient);
         }
-        Materials8 {
-            kd: kd.get(),
-            ks: ks.get(),
-            shininess: F8::new(shin),
-            roughness: F8::new(rough),
-            ggx: crate::simd::mask_from_bools(ggx),
-            emitted: emitted.get(),
-            ambient: ambient.get(),
-        }
+        let o = &mut out.mat;
+        o.kd = kd.get();
+        o.ks = ks.get();
+        o.shininess = F8::new(shin);
+        o.alpha = F8::new(rough);
+        o.ggx = crate::simd::mask_from_bools(ggx);
+        out.emitted = emitted.get();
+        out.ambient = ambient.get();
     }
 }
 
@@ -408,24 +420,12 @@ const MISS_MATERIAL: Material = Material {
 struct Lanes8 {
     /// geometric normal, not yet flipped (+z on missed lanes)
     n: Vec3x8,
-    m: Materials8,
     light: U8,
     le: Vec3x8,
     /// some lane hit a triangle
     any_tri: bool,
     /// material index per lane (0 on misses)
     mat: [u32; 8],
-}
-
-/// Material fields of 8 lanes (a part of [`SurfaceHit8`]).
-struct Materials8 {
-    kd: Vec3x8,
-    ks: Vec3x8,
-    shininess: F8,
-    roughness: F8,
-    ggx: Mask8,
-    emitted: Vec3x8,
-    ambient: Vec3x8,
 }
 
 /// Eight vectors as three coordinate arrays, filled lane by lane (no AoS -> SoA transpose).
@@ -508,13 +508,14 @@ mod tests {
     fn same_record(a: &SurfaceHit8, b: &SurfaceHit8) {
         let f = |x: F8| x.to_array().map(f32::to_bits);
         assert_eq!(f(a.valid), f(b.valid));
-        for (x, y) in [(a.p, b.p), (a.n, b.n), (a.ng, b.ng), (a.wo, b.wo), (a.kd, b.kd), (a.ks, b.ks)] {
+        for (x, y) in [(a.p, b.p), (a.n, b.n), (a.ng, b.ng), (a.wo, b.wo), (a.mat.kd, b.mat.kd), (a.mat.ks, b.mat.ks)] {
             assert_eq!(bits(x), bits(y));
         }
         for (x, y) in [(a.emitted, b.emitted), (a.ambient, b.ambient), (a.le, b.le)] {
             assert_eq!(bits(x), bits(y));
         }
-        for (x, y) in [(a.smooth, b.smooth), (a.shininess, b.shininess), (a.roughness, b.roughness), (a.ggx, b.ggx)] {
+        let (m, n) = (&a.mat, &b.mat);
+        for (x, y) in [(a.smooth, b.smooth), (m.shininess, n.shininess), (m.alpha, n.alpha), (m.ggx, n.ggx)] {
             assert_eq!(f(x), f(y));
         }
         assert_eq!(a.light.to_array(), b.light.to_array());
@@ -534,19 +535,18 @@ mod tests {
             let (geom, prim) = ([GEOM_TRIANGLES; 8], [t; 8]);
             let p = Vec3x8::splat(Vec3::new(0.1, 0.0, 0.2));
             let fast = sc.one_triangle(t as usize, valid);
-            let slow = sc.lane_by_lane::<false>(b, valid, [&geom, &prim, &[INVALID_ID; 8]], p, dir);
+            let slow = sc.lane_by_lane::<false>(b, [&geom, &prim, &[INVALID_ID; 8]], p, dir);
             assert_eq!(bits(fast.n), bits(slow.n));
             assert_eq!(fast.light.to_array(), slow.light.to_array());
             assert_eq!(bits(fast.le), bits(slow.le));
             assert_eq!(fast.any_tri, slow.any_tri);
-            for (x, y) in [(fast.m.kd, slow.m.kd), (fast.m.ks, slow.m.ks), (fast.m.emitted, slow.m.emitted)] {
-                assert_eq!(bits(x), bits(y));
+            for i in lanes_of(b) {
+                assert_eq!(fast.mat[i], slow.mat[i], "lane {i}: material id");
             }
-            assert_eq!(bits(fast.m.ambient), bits(slow.m.ambient));
-            let f = |x: F8| x.to_array().map(f32::to_bits);
-            assert_eq!(f(fast.m.shininess), f(slow.m.shininess));
-            assert_eq!(f(fast.m.roughness), f(slow.m.roughness));
-            assert_eq!(f(fast.m.ggx), f(slow.m.ggx));
+            let (mut a, mut c) = (SurfaceHit8::MISS, SurfaceHit8::MISS);
+            sc.uniform_materials(fast.mat[0], valid, &mut a);
+            sc.gather_materials(b, valid, &slow.mat, &mut c);
+            same_record(&a, &c);
         }
         // Packets the splat path must not take still gather per lane: a light triangle, two
         // triangles, a sphere lane.
@@ -571,7 +571,7 @@ mod tests {
         let (org, dir) = rays();
         let h = hits([false; 8], [INVALID_ID; 8], [INVALID_ID; 8]);
         let mut out = SurfaceHit8::MISS;
-        out.kd = Vec3x8::splat(Vec3::ONE); // stale contents of a reused buffer
+        out.mat.kd = Vec3x8::splat(Vec3::ONE); // stale contents of a reused buffer
         sc.gather_into(org, dir, &h, &mut out);
         let want = SurfaceHit8 { p: dir.mul_add(h.t, org), wo: -dir, ..SurfaceHit8::MISS };
         same_record(&out, &want);

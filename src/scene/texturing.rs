@@ -53,7 +53,7 @@ impl Scene {
         self.material_texture.get(m as usize).copied().filter(|&t| t != NO_TEXTURE)
     }
 
-    /// Sets `out.kd` on the hit lanes `bits` whose material has a diffuse texture to its value
+    /// Sets `out.mat.kd` on the hit lanes `bits` whose material has a diffuse texture to its value
     /// there (one texture evaluation, 8 lanes wide, per distinct texture of the packet). Out of
     /// line and cold, so that the gather of an untextured scene keeps its code.
     #[cold]
@@ -90,7 +90,7 @@ impl Scene {
         if todo == 0 {
             return;
         }
-        let mut kd = out.kd;
+        let mut kd = out.mat.kd;
         while todo != 0 {
             let t = tex[todo.trailing_zeros() as usize];
             let lanes: [bool; 8] = std::array::from_fn(|i| tex[i] == t);
@@ -98,7 +98,7 @@ impl Scene {
             kd = Vec3x8::select(crate::simd::mask_from_bools(lanes), value, kd);
             todo &= !(0..8).filter(|&i| lanes[i]).map(|i| 1u32 << i).sum::<u32>();
         }
-        out.kd = kd;
+        out.mat.kd = kd;
     }
 
     /// Writes the textured BSDF parameters (`Scene::param_textures`) of the `valid` lanes of

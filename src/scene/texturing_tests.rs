@@ -77,7 +77,7 @@ fn textured_kd_at_real_hits() {
     assert_eq!(crate::simd::mask_to_bools(sh.valid), [true, true, true, true, true, true, true, false]);
     // Everything but kd is as without textures.
     assert_eq!(f(sh.n.y), f(plain.n.y));
-    assert_eq!(f(sh.ks.x), f(plain.ks.x));
+    assert_eq!(f(sh.mat.ks.x), f(plain.mat.ks.x));
     for (i, &(x, z)) in XZ.iter().enumerate().take(7) {
         let (geom, prim) = (hits.geom.as_array()[i], hits.prim.as_array()[i] as usize);
         let want = if geom == GEOM_TRIANGLES && prim == 0 {
@@ -86,16 +86,16 @@ fn textured_kd_at_real_hits() {
         } else {
             Vec3::splat(0.7)
         };
-        assert!((sh.kd.lane(i) - want).abs().max_element() < 1e-5, "lane {i}: {} != {want}", sh.kd.lane(i));
+        assert!((sh.mat.kd.lane(i) - want).abs().max_element() < 1e-5, "lane {i}: {} != {want}", sh.mat.kd.lane(i));
     }
     // By hand, on triangle 0 (x + z < 0): lane 0 (-0.5, -0.5) has 2 uv = (0.5, 0.5), fractional
     // parts not above 1/2: colour 0; lane 2 (-0.2, -0.5) has 2 uv = (0.8, 0.5): colour 1. Lane 4
     // (0.2, 0.1) is on triangle 1: its constant.
-    assert_eq!(sh.kd.lane(0), Vec3::new(1.0, 0.0, 0.0));
-    assert_eq!(sh.kd.lane(2), Vec3::new(0.0, 1.0, 0.0));
-    assert_eq!(sh.kd.lane(4), Vec3::splat(0.7));
+    assert_eq!(sh.mat.kd.lane(0), Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(sh.mat.kd.lane(2), Vec3::new(0.0, 1.0, 0.0));
+    assert_eq!(sh.mat.kd.lane(4), Vec3::splat(0.7));
     // The miss lane stays black.
-    assert_eq!(sh.kd.lane(7), Vec3::ZERO);
+    assert_eq!(sh.mat.kd.lane(7), Vec3::ZERO);
 }
 
 #[test]
@@ -114,11 +114,11 @@ fn mesh_attributes_interpolate_at_hits() {
         let (b1, b2) = (hits.u.as_array()[i], hits.v.as_array()[i]);
         // (t, 0 b0 + 1 b1 + 2 b2, 1)
         let want = Vec3::new(prim, b1 + 2.0 * b2, 1.0);
-        assert!((sh.kd.lane(i) - want).abs().max_element() < 1e-5, "lane {i}: {} != {want}", sh.kd.lane(i));
+        assert!((sh.mat.kd.lane(i) - want).abs().max_element() < 1e-5, "lane {i}: {} != {want}", sh.mat.kd.lane(i));
         assert!(b1 > 0.0 && b2 > 0.0, "inside the triangle");
     }
     // The sphere has no such attribute: 0.
-    assert_eq!(sh.kd.lane(5), Vec3::ZERO);
+    assert_eq!(sh.mat.kd.lane(5), Vec3::ZERO);
     // An attribute no mesh has is refused, naming the ones there are.
     let mut bad = desc();
     bad.triangle_attrs = vec![TriangleAttrDesc {
@@ -153,10 +153,10 @@ fn sphere_lanes_read_the_sphere_uv() {
         let uv = sphere_uv(Vec3::new(x - 3.0, y, z) / 0.5) * 8.0;
         let h = |t: f32| t - t.floor() > 0.5;
         let want = if h(uv.x) == h(uv.y) { Vec3::X } else { Vec3::Y };
-        assert_eq!(sh.kd.lane(i), want, "lane {i}");
+        assert_eq!(sh.mat.kd.lane(i), want, "lane {i}");
     }
     // Material 0 (the triangle under lane 7) is not textured.
-    assert_eq!(sh.kd.lane(7), Vec3::new(0.3, 0.3, 0.5));
+    assert_eq!(sh.mat.kd.lane(7), Vec3::new(0.3, 0.3, 0.5));
 }
 
 #[test]

@@ -19,7 +19,7 @@
 //! from dim 0's first coordinate); dim 3 only where roulette or the lobe pick needs it. A
 //! dimension not drawn changes no other.
 
-use super::context::{masked, material_in, shading_frame, TileCtx};
+use super::context::{masked, shading_frame, TileCtx};
 use super::estimator::Estimator;
 use super::light_term::{area_sample, env_sample, point_shadow, towards, AreaChoice, PointTerm, Shading, SkySampling};
 use super::samples::{Dim, Samples, Source, CAMERA};
@@ -388,10 +388,8 @@ impl Bounce<'_> {
             return;
         }
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
-        // (Not `frame_material`: returning the pair costs a copy of the material per call here.)
-        let frame = shading_frame::<L>(scene, sh);
-        let mat = material_in::<L>(scene, sh, &frame);
-        let at = Shading::new(sh, &frame, &mat, it.path.strategy);
+        let (frame, mat) = (shading_frame::<L>(scene, sh), &sh.mat);
+        let at = Shading::new(sh, &frame, it.path.strategy);
         let (frame, wo) = (at.frame, at.wo);
         // Registry BSDFs that transmit: directions may cross the surface (compile-time).
         let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;

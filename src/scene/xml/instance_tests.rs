@@ -101,7 +101,7 @@ fn instance_hits_gather_as_directly_placed_copies() {
         let (a, b) = (shade(&inst), shade(&flat));
         assert_eq!(a.valid.to_bitmask(), b.valid.to_bitmask(), "packet {k}: the same lanes hit");
         assert_eq!(a.smooth.to_bitmask(), b.smooth.to_bitmask(), "packet {k}");
-        assert_eq!(a.back.to_bitmask(), b.back.to_bitmask(), "packet {k}");
+        assert_eq!(a.mat.back.to_bitmask(), b.mat.back.to_bitmask(), "packet {k}");
         for i in 0..8 {
             if a.valid.to_bitmask() & (1 << i) == 0 {
                 continue;
@@ -112,7 +112,7 @@ fn instance_hits_gather_as_directly_placed_copies() {
             assert!(close(a.ng.lane(i), b.ng.lane(i), 1e-4), "packet {k} lane {i}: ng");
             assert!(close(a.n.lane(i), b.n.lane(i), 1e-4), "packet {k} lane {i}: n");
             assert!(close(a.s.lane(i), b.s.lane(i), 1e-3), "packet {k} lane {i}: s");
-            assert!(close(a.kd.lane(i), b.kd.lane(i), 0.0), "packet {k} lane {i}: kd");
+            assert!(close(a.mat.kd.lane(i), b.mat.kd.lane(i), 0.0), "packet {k} lane {i}: kd");
             let (ma, mb) = (a.material.as_array()[i] as usize, b.material.as_array()[i] as usize);
             assert_eq!(inst.materials[ma].bsdf, flat.materials[mb].bsdf, "packet {k} lane {i}: material");
         }
