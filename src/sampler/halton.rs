@@ -1,29 +1,44 @@
-//! `halton`: bases 2 and 3, nested (Owen) scrambled per (pixel, dim, seed), at global index
-//! `i = sample * n + k` (wrapping in u32), shuffled per (pixel, dim, seed) by a permutation that
-//! keeps every prefix [0, 2^m) (so the first 2^m points of a stream are the first 2^m Halton
-//! points, and dims are decorrelated): the n points of one pixel sample are consecutive Halton
-//! points and successive samples continue the sequence, so for the camera `n = spp, k = s,
-//! sample = 0` and `n = 1, k = 0, sample = s` give the same points.
+//! `halton`: bases 2 and 3 at global index `i = sample * n + k` (wrapping in u32), scrambled per
+//! (pixel, dim, seed) and shuffled per (pixel, dim, seed) by a permutation that keeps every prefix
+//! [0, 2^m) (so the first 2^m points of a stream are the first 2^m Halton points, and dims are
+//! decorrelated): the n points of one pixel sample are consecutive Halton points and successive
+//! samples continue the sequence, so for the camera `n = spp, k = s, sample = 0` and
+//! `n = 1, k = 0, sample = s` give the same points.
+//!
+//! Scrambles (issue 33: the cheapest scrambles that keep the quality; they replaced a hashed
+//! nested (Owen) scramble of both bases, one 32-bit hash per digit, 4x Sobol's cost):
+//! - base 2: nested (Owen) scrambling by the Laine-Karras-style hash `sobol::lk_permute` on the
+//!   index before the bit reversal (Burley 2020), as Sobol's x axis;
+//! - base 3: random digit permutations (pbrt-v4's `DigitPermutation` strategy, "PermuteDigits"):
+//!   digit j of the index goes through a permutation of {0, 1, 2} chosen per stream, the same for
+//!   every index. The 15 digits are read in five chunks of three; chunk c of a stream is mapped by
+//!   one of the [`TABLES3`] = 6^3 precomputed tables (27 entries each: the chunk's three digits
+//!   permuted and reversed; one table per choice of the three permutations), picked per
+//!   (stream, chunk) by a hash: the digits' permutations are independent and uniform over all six
+//!   (the last chunks' picks share fewer hash bits), so each output digit is uniform, each point
+//!   is uniform on the 3^-15 grid (unbiased), and base-3 intervals map to base-3 intervals (the
+//!   2^a x 3^b elementary intervals are kept). A 36-table variant over five-digit chunks (three
+//!   look-ups) failed the registry's chi-square test: its top digits were not jointly uniform.
 //!
 //! Precision: Halton uses the low 24 base-2 digits and the low 15 base-3 digits of the index (the
 //! coordinates repeat with periods 2^24 and 3^15 ~ 1.4e7 points per (pixel, dim)); the
 //! 2^a x 3^b elementary-interval property holds exactly for a <= 24, b <= 15.
 
 use super::divisor::Divisor;
-use super::hash::{fmix, mix, stream_key, SPREAD};
+use super::hash::{mix, stream_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
-use super::sobol::{prefix_shuffle, reverse_bits};
+use super::sobol::{lk_permute, prefix_shuffle, reverse_bits};
 
 const TAG_HALTON: u32 = 0x51a7_0003;
 
-/// Owen-scrambled Halton points (bases 2, 3) at index `sample * n + k`.
+/// Scrambled Halton points (base 2 Owen, base 3 random digit permutations) at `sample * n + k`.
 #[derive(Clone, Copy, Debug)]
 pub struct Halton;
 
 /// Its entry in the registry [`super::SAMPLERS`].
 pub(super) const INFO: super::SamplerInfo =
-    super::SamplerInfo::new("halton", &[], "Owen-scrambled Halton (bases 2, 3)", &Halton).period(1 << 24);
+    super::SamplerInfo::new("halton", &[], "scrambled Halton (bases 2, 3)", &Halton).period(1 << 24);
 
 impl Layout for Halton {
     #[inline]
@@ -46,83 +61,75 @@ impl Layout for Halton {
 
 /// Point `index` of the stream keyed `key` in dimension `dim`: outside dimension 0 the index is
 /// shuffled per stream (keeping every prefix [0, 2^m), `sobol::prefix_shuffle`), then both
-/// radical inverses are taken, each nested-scrambled. Without the shuffle every dim of a pixel
-/// would draw the same index of the same two bases, and nested scrambling flips the top digits by
-/// a constant per stream, so two dims' points were tied to each other (a pixel's light choice
-/// followed its light point). Dimension 0 (the camera) keeps the classic sequence, with its
-/// 2^a x 3^b elementary intervals for every prefix; shuffled dims keep them for prefixes of 2^m.
+/// radical inverses are taken and scrambled. Without the shuffle every dim of a pixel would draw
+/// the same index of the same two bases, and both scrambles map the top digits by a constant per
+/// stream, so two dims' points were tied to each other (a pixel's light choice followed its light
+/// point). Dimension 0 (the camera) keeps the classic sequence, with its 2^a x 3^b elementary
+/// intervals for every prefix; shuffled dims keep them for prefixes of 2^m.
 #[inline]
 fn halton_point<L: Lanes>(key: L, index: L, dim: u32) -> (L::F, L::F) {
-    let index = if dim == 0 { index } else { prefix_shuffle(index, mix(key, L::splat(4))) };
-    let x = owen2(index, mix(key, L::splat(2)));
-    let y = RADIX3.to_fixed24(owen3(index, mix(key, L::splat(3))));
+    let index = if dim == 0 { index } else { prefix_shuffle(index, key) };
+    // Owen in base 2: output digit j (from the top) is index bit j - 1 flipped by a keyed function
+    // of the lower index bits (the digits above it); the reversal makes it a radical inverse.
+    let x = reverse_bits(lk_permute(index, mix(key, L::splat(2)))).shr(8);
+    let y = RADIX3.to_fixed24(permute3(index, mix(key, L::splat(3))));
     (x.unit24(), y.unit24())
 }
 
-/// `RADIX2.inverse(index, Some(key))`, bit for bit, in about a third of the instructions: in
-/// base 2 the nested permutation of digit j is a flip by bit 31 ^ bit 30 of
-/// `mix(key, index mod 2^j + 2^j)` (a reflection and a cyclic shift by `floor(2 (h << 1) / 2^32)`,
-/// i.e. bit 30), so the result is the bit-reversed index XOR 24 flip bits, and the fixed-point map
-/// of base 2 is the identity.
-#[inline]
-fn owen2<L: Lanes>(index: L, key: L) -> L {
-    let mut flips = L::splat(0);
-    for j in 0..24 {
-        // mix(key, w) with w = (index mod 2^j) | 2^j (= index mod 2^j + 2^j).
-        let w = index.and(L::splat((1u32 << j) - 1)).or(L::splat(1 << j));
-        let h = fmix(key.xor(w.mul(L::splat(SPREAD))));
-        // Output digit 23 - j first: flips collects bit 31 of h ^ (h << 1) = h_31 ^ h_30.
-        flips = flips.shl(1).or(h.xor(h.shl(1)).shr(31));
-    }
-    reverse_bits(index).shr(8).xor(flips)
+/// Precomputed digit-permutation tables for base 3: 6^3, one per choice of the three digits'
+/// permutations.
+pub(super) const TABLES3: u32 = 216;
+/// Entries per table: the 3^3 values of a three-digit chunk.
+const CHUNK: u32 = 27;
+
+/// The six permutations of {0, 1, 2}.
+const PERMS3: [[u16; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+
+/// Permutation of digit `p` (0..3, 0 least significant) of a chunk under table `t`: base-6 digit
+/// p of t, so over a uniform t the three permutations are independent and uniform over all six.
+const fn digit_perm(t: usize, p: usize) -> &'static [u16; 3] {
+    &PERMS3[t / [1, 6, 36][p] % 6]
 }
 
-/// 3^j * SPREAD (wrapping) for j < 15: the step of `(index mod 3^j + 3^j) * SPREAD` per digit.
-const POW3_SPREAD: [u32; 15] = {
-    let (mut t, mut j, mut p) = ([0u32; 15], 0, 1u32);
-    while j < 15 {
-        t[j] = p.wrapping_mul(SPREAD);
-        p *= 3;
-        j += 1;
+/// Table t at entries `t * 27 ..`: chunk value c (three base-3 digits d_0..d_2, d_0 least
+/// significant) to `sum_p perm_{t,p}(d_p) 3^(2 - p)`: permuted and digit-reversed.
+static DIGIT_TABLES: [u16; (TABLES3 * CHUNK) as usize] = {
+    let mut out = [0u16; (TABLES3 * CHUNK) as usize];
+    let mut t = 0;
+    while t < TABLES3 as usize {
+        let mut c = 0;
+        while c < CHUNK as usize {
+            let (mut rest, mut v, mut p) = (c, 0u16, 0);
+            while p < 3 {
+                v = v * 3 + digit_perm(t, p)[rest % 3];
+                rest /= 3;
+                p += 1;
+            }
+            out[t * CHUNK as usize + c] = v;
+            c += 1;
+        }
+        t += 1;
     }
-    t
+    out
 };
 
-/// The digit integer of `RADIX3.inverse(index, Some(key))` before its fixed-point map, bit for
-/// bit: the 15 base-3 digits come from three 5-digit chunks (two exact divisions by 243, one
-/// remainder), each digit of a chunk by a small multiply (`x / 3 = (x * 171) >> 9` for x < 243);
-/// `mix(key, index mod 3^j + 3^j)` is kept incrementally as `prefix * SPREAD`; the reflection is a
-/// sign mask, the cyclic shift `floor(3 (h << 1) / 2^32)` two compares; the digits are summed by
-/// Horner's rule (digit j has weight 3^(14 - j)).
+/// The digit integer of the base-3 radical inverse of `index` (its low 15 digits) with random
+/// digit permutations, before the fixed-point map: five chunks of three digits (exact divisions
+/// by 27), chunk c through table t_c, the base-216 digits of the stream's hash `h` (t = floor(216 u)
+/// for successive fractions u of h; the last chunks, the least significant output digits, share
+/// fewer random bits), weighted 27^(4 - c) (Horner's rule).
 #[inline]
-fn owen3<L: Lanes>(index: L, key: L) -> L {
-    const D243: Divisor = Divisor::new(243);
-    let (q1, c0) = D243.div_rem(index);
-    let (q2, c1) = D243.div_rem(q1);
-    let c2 = D243.rem(q2);
-    // floor(3 x / 2^32) >= 1 iff x >= ceil(2^32 / 3); >= 2 iff x >= ceil(2^33 / 3).
-    const T1: u32 = ((1u64 << 32).div_ceil(3)) as u32;
-    const T2: u32 = ((1u64 << 33).div_ceil(3)) as u32;
-    let (mut acc, mut spread) = (L::splat(0), L::splat(0));
-    let mut j = 0;
-    for chunk in [c0, c1, c2] {
-        let mut x = chunk;
-        for _ in 0..5 {
-            let q = x.mul(L::splat(171)).shr(9);
-            let a = x.sub(q.add(q.shl(1)));
-            x = q;
-            let h = fmix(key.xor(spread.add(L::splat(POW3_SPREAD[j]))));
-            spread = spread.add(a.mul(L::splat(POW3_SPREAD[j])));
-            // Reflection (top bit of h): a -> 2 - a.
-            let neg = h.sign_mask();
-            let r = a.xor(neg.and(a.xor(L::splat(2).sub(a))));
-            // Cyclic shift: 2 - [x < T1] - [x < T2] with lt masks of all ones.
-            let x2 = h.shl(1);
-            let d = r.add(L::splat(2)).add(x2.lt_mask(L::splat(T1))).add(x2.lt_mask(L::splat(T2)));
-            let d = d.lt_select(L::splat(3), d, d.sub(L::splat(3)));
-            acc = acc.add(acc.shl(1)).add(d);
-            j += 1;
-        }
+fn permute3<L: Lanes>(index: L, h: L) -> L {
+    const D27: Divisor = Divisor::new(CHUNK);
+    let n = L::splat(TABLES3);
+    let (mut rest, mut r, mut acc) = (index, h, L::splat(0));
+    for c in 0..5 {
+        let (q, chunk) = D27.div_rem(rest);
+        let t = r.mulhi(n);
+        let v = t.mul(L::splat(CHUNK)).add(chunk).gather16(&DIGIT_TABLES);
+        acc = if c == 0 { v } else { acc.mul(L::splat(CHUNK)).add(v) };
+        r = r.mul(n);
+        rest = q;
     }
     acc
 }
@@ -136,7 +143,7 @@ pub fn radical_inverse(base: u32, index: u32) -> Option<f32> {
         3 => &RADIX3,
         _ => return None,
     };
-    Some(radix.inverse(index, None).unit24())
+    Some(radix.inverse(index).unit24())
 }
 
 /// One Halton axis: `digits` base-`base` digits, and the map from the digit integer
@@ -167,32 +174,14 @@ pub(super) const RADIX3: Radix = Radix {
 };
 
 impl Radix {
-    /// Digit-reversed `index` (its low `digits` digits) as 24-bit fixed point. With a `key`, output
-    /// digit j is a random permutation of index digit j chosen by hash(key, j, index mod base^j):
-    /// nested uniform scrambling, a bijection on every level, so base^-j intervals are preserved.
-    pub(super) fn inverse<L: Lanes>(&self, index: L, key: Option<L>) -> L {
-        let b = self.base;
-        let (mut rest, mut prefix, mut acc) = (index, L::splat(0), L::splat(0));
-        let (mut pow, mut weight) = (1u32, b.pow(self.digits - 1));
+    /// Digit-reversed `index` (its low `digits` digits) as 24-bit fixed point, unscrambled.
+    pub(super) fn inverse<L: Lanes>(&self, index: L) -> L {
+        let (mut rest, mut acc, mut weight) = (index, L::splat(0), self.base.pow(self.digits - 1));
         for _ in 0..self.digits {
             let (q, a) = self.div.div_rem(rest);
-            let d = match key {
-                None => a,
-                Some(key) => {
-                    // prefix + b^j is unique per (level j, prefix < b^j).
-                    let h = mix(key, prefix.add(L::splat(pow)));
-                    // Permutation = optional reflection (top hash bit), then a cyclic shift by
-                    // floor(b * bits30..0 / 2^31); for b <= 3 this reaches all b! permutations evenly.
-                    let r = h.lt_select(L::splat(1 << 31), a, L::splat(b - 1).sub(a));
-                    let d = r.add(h.shl(1).mulhi(L::splat(b)));
-                    d.lt_select(L::splat(b), d, d.sub(L::splat(b)))
-                }
-            };
-            acc = acc.add(d.mul(L::splat(weight)));
-            prefix = prefix.add(a.mul(L::splat(pow)));
+            acc = acc.add(a.mul(L::splat(weight)));
             rest = q;
-            pow *= b;
-            weight /= b;
+            weight /= self.base;
         }
         self.to_fixed24(acc)
     }
@@ -213,37 +202,78 @@ mod tests {
     use super::*;
     use crate::simd::U8;
 
-    /// The fast scrambles equal the digit-by-digit reference `Radix::inverse`, bit for bit, scalar
-    /// and 8-wide, on low indices, random ones and the ends of the range.
+    /// Reference: the base-3 scramble digit by digit (digit j of the index through the
+    /// permutation of its chunk's table, weight 3^(14 - j)).
+    fn permute3_reference(index: u32, h: u32) -> u32 {
+        let mut t = [0usize; 5];
+        let mut r = h;
+        for tc in &mut t {
+            *tc = ((u64::from(r) * u64::from(TABLES3)) >> 32) as usize;
+            r = r.wrapping_mul(TABLES3);
+        }
+        let (mut rest, mut acc) = (index, 0u32);
+        for j in 0..15 {
+            let d = u32::from(digit_perm(t[j / 3], j % 3)[(rest % 3) as usize]);
+            acc += d * 3u32.pow(14 - j as u32);
+            rest /= 3;
+        }
+        acc
+    }
+
+    /// The table scramble equals the digit-by-digit reference, scalar and 8-wide; the x axis is
+    /// the bit-reversed index XOR a nested scramble.
     #[test]
-    fn fast_scrambles_equal_the_reference() {
+    fn base3_tables_equal_the_digit_reference() {
         let mut st = 0x1234_5678_9abc_def0u64;
         let mut next = || {
             st = st.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
             (st >> 32) as u32
         };
         let mut indices: Vec<u32> = (0..3000).chain([u32::MAX, u32::MAX - 1, 1 << 31, POW3_15 as u32]).collect();
-        indices.extend((0..20_000).map(|_| next()));
+        indices.extend((0..5000).map(|_| next()));
         for t in 0..40 {
-            let key = if t == 0 { 0 } else { next() };
+            let h = if t == 0 { 0 } else { next() };
             for &i in &indices {
-                assert_eq!(owen2(i, key), RADIX2.inverse(i, Some(key)), "base 2, key {key:#x}, index {i}");
-                assert_eq!(
-                    RADIX3.to_fixed24(owen3(i, key)),
-                    RADIX3.inverse(i, Some(key)),
-                    "base 3, key {key:#x}, index {i}"
-                );
+                assert_eq!(permute3(i, h), permute3_reference(i, h), "h {h:#x}, index {i}");
             }
             for c in indices.chunks_exact(8).step_by(97) {
-                let (i8, k8) = (U8::new(c.try_into().unwrap()), U8::splat(key) ^ U8::new([0, 1, 2, 3, 4, 5, 6, 7]));
-                let (a, b) = (owen2(i8, k8).to_array(), owen3(i8, k8).to_array());
+                let (i8, h8) = (U8::new(c.try_into().unwrap()), U8::splat(h) ^ U8::new([0, 1, 2, 3, 4, 5, 6, 7]));
+                let got = permute3(i8, h8).to_array();
                 for l in 0..8 {
-                    assert_eq!(a[l], owen2(c[l], key ^ l as u32));
-                    assert_eq!(b[l], owen3(c[l], key ^ l as u32));
+                    assert_eq!(got[l], permute3(c[l], h ^ l as u32));
                 }
             }
         }
-        // The small division of a base-3 chunk is exact on its whole range.
-        assert!((0..243u32).all(|x| (x * 171) >> 9 == x / 3));
+    }
+
+    /// Every table is a bijection of the 27 chunks, and the 216 tables are all 6^3 choices of
+    /// the three digits' permutations (so over a uniform pick they are independent and uniform).
+    #[test]
+    fn digit_tables_are_all_choices_of_digit_permutations() {
+        let mut choices = std::collections::HashSet::new();
+        for t in 0..TABLES3 as usize {
+            let mut seen = [false; CHUNK as usize];
+            for &v in &DIGIT_TABLES[t * CHUNK as usize..(t + 1) * CHUNK as usize] {
+                assert!(!std::mem::replace(&mut seen[v as usize], true), "table {t}");
+            }
+            choices.insert([0, 1, 2].map(|p| *digit_perm(t, p)));
+        }
+        assert_eq!(choices.len(), 216);
+    }
+
+    /// Base 2's scramble is nested: flipping index bit q (a digit of the radical inverse) never
+    /// changes the digits above it.
+    #[test]
+    fn base2_scramble_is_nested() {
+        let x = |i: u32, key: u32| reverse_bits(lk_permute(i, key)) >> 8;
+        for key in [0, 7, 0xdead_beef] {
+            for i in (0..5000u32).map(|i| i.wrapping_mul(2_654_435_761)) {
+                for q in 0..24 {
+                    let (a, b) = (x(i, key), x(i ^ 1 << q, key));
+                    assert_eq!(a >> (24 - q), b >> (24 - q), "key {key} i {i} q {q}");
+                    assert_ne!(a >> (23 - q) & 1, b >> (23 - q) & 1);
+                }
+            }
+        }
     }
 }

@@ -60,6 +60,8 @@ pub trait Lanes: Copy {
     fn lookup8(self, table: [u32; 8]) -> Self;
     /// Per lane both words of `table[self]` (panics if out of range).
     fn gather2(self, table: &[[u32; 2]]) -> (Self, Self);
+    /// Per lane `table[self]` widened to u32 (panics if out of range).
+    fn gather16(self, table: &[u16]) -> Self;
     /// The largest lane.
     fn max_lane(self) -> u32;
     /// `f`'s point for these lanes (a run-time point function inside a generic one: file padding).
@@ -133,6 +135,9 @@ impl Lanes for u32 {
     fn gather2(self, table: &[[u32; 2]]) -> (Self, Self) {
         let [x, y] = table[self as usize];
         (x, y)
+    }
+    fn gather16(self, table: &[u16]) -> Self {
+        u32::from(table[self as usize])
     }
     fn max_lane(self) -> u32 {
         self
@@ -220,6 +225,10 @@ impl Lanes for U8 {
             [x[l], y[l]] = table[i as usize];
         }
         (U8::new(x), U8::new(y))
+    }
+    #[inline]
+    fn gather16(self, table: &[u16]) -> Self {
+        U8::new(self.to_array().map(|i| u32::from(table[i as usize])))
     }
     #[inline]
     fn max_lane(self) -> u32 {

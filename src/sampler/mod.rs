@@ -143,7 +143,7 @@ impl SamplerKind {
     pub const STRATIFIED: Self = Self::named("stratified");
     /// Cell centres of the `strata_shape(n)` grid; deterministic, biased.
     pub const GRID_CENTER: Self = Self::named("grid-center");
-    /// Owen-scrambled Halton points (bases 2, 3) at index `sample * n + k`.
+    /// Scrambled Halton points (base 2 Owen, base 3 random digit permutations) at `sample * n + k`.
     pub const HALTON: Self = Self::named("halton");
     /// Owen-scrambled Sobol' (dimensions 0, 1; hash-based nested scrambling) at `sample * n + k`.
     pub const SOBOL: Self = Self::named("sobol");

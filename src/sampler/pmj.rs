@@ -127,7 +127,7 @@ fn table_point<L: Lanes>(key: L, index: L, pick: L) -> (L::F, L::F) {
     // The index, shuffled per (pixel, dim) keeping every prefix [0, 2^m) (so prefixes stay nets):
     // without it two dims drawing the same index of tables built by the same forced construction
     // are correlated (a pixel's light choice then follows its light point).
-    let index = prefix_shuffle(index, combine(key, L::splat(4))).and(L::splat(TABLE_POINTS - 1));
+    let index = prefix_shuffle(index, key).and(L::splat(TABLE_POINTS - 1));
     // Table from the high bits, axis swap from the lowest bit (as an all-ones/all-zeros mask).
     let slot = pick.shr(1).shl(LOG_POINTS).or(index);
     let swap = pick.and(L::splat(1)).mul(L::splat(u32::MAX));

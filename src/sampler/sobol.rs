@@ -97,9 +97,10 @@ fn sobol_owen<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) 
     keyed_point(stream_key(pixel, dim, seed), sample.mul(L::splat(n.max(1))).add(k))
 }
 
-/// Point `index` of the sequence scrambled with stream key `key`.
+/// Point `index` of the sequence scrambled with stream key `key` (also `zsobol`'s point, with its
+/// own key and index).
 #[inline]
-fn keyed_point<L: Lanes>(key: L, index: L) -> (L::F, L::F) {
+pub(super) fn keyed_point<L: Lanes>(key: L, index: L) -> (L::F, L::F) {
     // The index shuffle i' = nus(index) = rev(lk(rev(index))).
     let i = reverse_bits(lk_permute(reverse_bits(index), combine(key, L::splat(1))));
     let (x, y) = scrambled_point(i, key);
@@ -108,25 +109,33 @@ fn keyed_point<L: Lanes>(key: L, index: L) -> (L::F, L::F) {
 
 /// A keyed permutation of u32 that keeps every prefix `[0, 2^m)` (and every block
 /// `[2^m, 2^(m+1))`) as a set: the highest set bit of `i` stays, and each bit below it is flipped
-/// by a hash of `key` and the bits above it (a nested, top-down scramble of the index). Two
+/// by a keyed function of the bits above it (a nested, top-down scramble of the index). Two
 /// dimensions that draw index i of the same base-2 construction (pmj02's tables, Halton's radical
 /// inverse, ZSobol's pixel block) are correlated however each is scrambled; shuffling the index
 /// per dimension with this permutation decorrelates them, while the first 2^m indices of a stream
 /// are still exactly the first 2^m points of the sequence (so nets and stratification of prefixes
-/// are kept, and the sequence stays progressive). Built on Burley's shuffle `nus`: bit q of
-/// `nus(i)` is bit q of i flipped by a function of the bits above q, so on the bits at and above
-/// the highest set bit (whose higher bits are all zero) it flips exactly the bits of `nus(0)`;
-/// undoing those flips keeps the highest set bit and the zeros above it.
+/// are kept, and the sequence stays progressive).
+///
+/// It is Burley's `nus` (bit reversal, Laine-Karras-style hash, bit reversal) with the hash's two
+/// key additions left out ([`lk_shift_free`]): the multiplications alone keep the lowest set bit of
+/// the reversed index and the zeros below it, i.e. the highest set bit of the index and the zeros
+/// above it, so no correction is needed. Until issue 33 it was `nus(i) ^ (nus(0) & top)` (two
+/// hashes, four reversals); this is one hash and two reversals.
 #[inline]
 pub(super) fn prefix_shuffle<L: Lanes>(i: L, key: L) -> L {
-    let nus = |x: L| reverse_bits(lk_permute(reverse_bits(x), key));
-    // Bits at and above the highest set bit of i (all bits for i = 0).
-    let mut smear = i;
-    for s in [1, 2, 4, 8, 16] {
-        smear = smear.or(smear.shr(s));
-    }
-    let top = smear.shr(1).xor(L::splat(u32::MAX));
-    nus(i).xor(nus(L::splat(0)).and(top))
+    reverse_bits(lk_shift_free(reverse_bits(i), key))
+}
+
+/// [`lk_permute`] without its key additions: bit j of the result is bit j of `x` XOR a keyed
+/// function of the bits below j, and that function is 0 while those bits are all 0 (every step is
+/// a multiplication by an odd number or an XOR with `x` times an even number), so 0 stays 0 and
+/// the lowest set bit stays.
+#[inline]
+fn lk_shift_free<L: Lanes>(x: L, key: L) -> L {
+    let x = x.xor(x.mul(rotl(key, 11).shl(1)));
+    let x = x.mul(rotl(key, 22).or(L::splat(1)));
+    let x = x.xor(x.mul(L::splat(0x6d4e_1c2a)));
+    x.xor(x.mul(rotl(key, 27).shl(1)))
 }
 
 /// Sobol' point `i` (dimensions 0, 1), Owen-scrambled with the axis keys `combine(key, 2)` and
@@ -156,7 +165,7 @@ fn pascal<L: Lanes>(i: L) -> L {
 /// even number only carry upwards. Key-dependent multipliers (rotations of the key) make the flips
 /// depend on the key non-linearly, which Burley's fixed multipliers do not.
 #[inline]
-fn lk_permute<L: Lanes>(x: L, key: L) -> L {
+pub(super) fn lk_permute<L: Lanes>(x: L, key: L) -> L {
     let x = x.add(key);
     let x = x.xor(x.mul(rotl(key, 11).shl(1)));
     let x = x.mul(rotl(key, 22).or(L::splat(1)));

@@ -3,83 +3,49 @@
 //! hierarchical ordering of pixels" (SIGGRAPH Asia), as pbrt-v4's ZSobolSampler describes it.
 //!
 //! All pixels share one Owen-scrambled Sobol' sequence (keyed by seed, dim and pixel sample, not
-//! by pixel). Pixel (x, y) owns the aligned index block `[m' 2^b, (m' + 1) 2^b)`, with
-//! `b = ceil(log2 n)` and `m'` its Morton index with every base-4 digit (a 2x2 quadrant choice)
-//! replaced by a random permutation of the four quadrants keyed by the digits above it and by
-//! (seed, dim). The permutation is nested, so every aligned 2^l x 2^l block of pixels still owns
-//! one aligned index block of 4^l 2^b indices, whose points form a (0, 2l + b, 2)-net: neighbouring
-//! pixels get complementary points, and the error is spread like blue noise over the image, while
-//! each pixel's n = 2^b points are a (0, b, 2)-net, as with `sobol`.
+//! by pixel). Pixel (x, y) owns the aligned index block `[m 2^b, (m + 1) 2^b)` of the sequence
+//! *before* its index shuffle, with `b = ceil(log2 n)` and `m` its Morton index: point k of the
+//! set of (pixel, sample, dim) is `sobol`'s keyed point (`sobol::keyed_point`: Burley's nested
+//! index shuffle `nus`, then the Owen-scrambled x and y) of index `m 2^b + (k mod 2^b)` under the
+//! key of (seed, dim, pixel sample `sample + k / 2^b`), so k >= 2^b continues in a fresh scramble.
 //!
-//! Point k of the set of (pixel, sample, dim) is index `m' 2^b + P(k mod 2^b)` of the sequence
-//! scrambled for pixel sample `sample + k / 2^b` (so k >= 2^b continues in a fresh scramble), P a
-//! per-(pixel, dim) shuffle keeping every prefix [0, 2^m) (`sobol::prefix_shuffle`), which
-//! decorrelates the dims of one pixel. For
-//! the camera use `n = spp, k = s, sample = 0`. Pixel coordinates come from the set's image width
-//! ([`SetShape::pixel_xy`], `pixel = y * width + x`); with an unknown width (0) the linear pixel id
-//! itself is used as the Morton index. Coordinates use 16 bits each (images up to 65536 wide), and
-//! `m' 2^b` wraps in u32: distant pixels of images with more than 2^32 / 2^b pixels share blocks.
+//! The index shuffle is a nested scramble of the whole index (bit j flipped by a keyed function of
+//! the bits above it), so it does at once what the layout needs:
+//! - the Morton index is scrambled level by level (every base-4 digit, a 2x2 quadrant choice,
+//!   goes through a permutation of the quadrants chosen by the digits above it), and every aligned
+//!   2^l x 2^l block of pixels still owns one aligned index block of 4^l 2^b indices, whose points
+//!   form a (0, 2l + b, 2)-net: neighbouring pixels get complementary points, and the error is
+//!   spread like blue noise over the image;
+//! - a pixel's own 2^b indices are permuted by a function of its Morton bits and the dim's key,
+//!   keeping aligned blocks (so the pixel's n = 2^b points, and its first 2^j, are nets, as with
+//!   `sobol`), which decorrelates the dims of one pixel.
+//!
+//! Issue 33: until then each Morton digit took one of all 24 quadrant permutations from a hash of
+//! the digits above it, as pbrt-v4's ZSobolSampler does (one 32-bit hash per level and lane), and
+//! the pixel's indices a separate shuffle: 2.3x Sobol's cost. The base-2 nested scramble draws
+//! each digit's permutation from the 8 that keep the two quadrants of one Morton x bit together,
+//! and costs one hash for every level; a point now costs a Sobol' point plus the Morton index.
+//!
+//! For the camera use `n = spp, k = s, sample = 0`. Pixel coordinates come from the set's image
+//! width ([`SetShape::pixel_xy`], `pixel = y * width + x`); with an unknown width (0) the linear
+//! pixel id itself is used as the Morton index. Coordinates use 16 bits each (images up to 65536
+//! wide), and `m 2^b` wraps in u32: distant pixels of images with more than 2^32 / 2^b pixels share
+//! blocks.
 
 use super::hash::{combine, combine_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
-use super::sobol::{prefix_shuffle, scrambled_point};
+use super::sobol::keyed_point;
 
 const TAG_ZSOBOL: u32 = 0x50b0_1005;
 
-/// Owen-scrambled Sobol' in Morton order over pixels, with hashed quadrant permutations.
+/// Owen-scrambled Sobol' in Morton order over pixels (one nested scramble of pixel and sample bits).
 #[derive(Clone, Copy, Debug)]
 pub struct ZSobol;
 
 /// Its entry in the registry [`super::SAMPLERS`].
 pub(super) const INFO: super::SamplerInfo =
     super::SamplerInfo::new("zsobol", &["z-sobol"], "Sobol' in Morton order over pixels", &ZSobol).needs_count();
-
-/// The 24 permutations of the four quadrants, lexicographic: entry `4 p + d` is digit d under
-/// permutation p.
-const PERMS: [u32; 96] = {
-    let (mut t, mut i, mut a) = ([0u32; 96], 0, 0);
-    while a < 4 {
-        let mut b = 0;
-        while b < 4 {
-            let mut c = 0;
-            while c < 4 {
-                if a != b && a != c && b != c {
-                    let d = 6 - a - b - c; // the remaining quadrant
-                    t[4 * i] = a;
-                    t[4 * i + 1] = b;
-                    t[4 * i + 2] = c;
-                    t[4 * i + 3] = d;
-                    i += 1;
-                }
-                c += 1;
-            }
-            b += 1;
-        }
-        a += 1;
-    }
-    t
-};
-
-/// [`PERMS`] packed for [`perm4`]: permutation p is byte `p % 4` of word `p / 4`, digit d's image
-/// in bits 2d..2d+1 of that byte (words 6 and 7 unused).
-const PACKED: [u32; 8] = {
-    let mut t = [0u32; 8];
-    let mut i = 0;
-    while i < 96 {
-        let (p, d) = (i / 4, i % 4);
-        t[p / 4] |= PERMS[i] << (8 * (p % 4) + 2 * d);
-        i += 1;
-    }
-    t
-};
-
-/// `PERMS[4 p + d]` per lane (p < 24, d < 4) without a per-lane memory look-up: one 8-entry lane
-/// look-up of [`PACKED`] and a per-lane shift.
-#[inline]
-fn perm4<L: Lanes>(p: L, d: L) -> L {
-    p.shr(2).lookup8(PACKED).shr_var(p.and(L::splat(3)).shl(3).or(d.shl(1))).and(L::splat(3))
-}
 
 /// log2 of the per-pixel index block: ceil(log2 n), n >= 1.
 fn block_bits(set: &SetShape) -> u32 {
@@ -96,9 +62,9 @@ fn part1by1<L: Lanes>(x: L) -> L {
     x
 }
 
-/// The permuted Morton index `m'` of `pixel`, shifted to its block: `m' 2^b` (wrapping).
+/// The Morton index `m` of `pixel`, shifted to its block: `m 2^b` (wrapping).
 #[inline]
-fn block_start<L: Lanes>(set: &SetShape, pixel: L, dim: u32, seed: u64) -> L {
+fn block_start<L: Lanes>(set: &SetShape, pixel: L) -> L {
     let b = block_bits(set);
     if b >= 32 {
         return L::splat(0);
@@ -109,59 +75,45 @@ fn block_start<L: Lanes>(set: &SetShape, pixel: L, dim: u32, seed: u64) -> L {
         let (x, y) = set.pixel_xy(pixel);
         part1by1(x).or(part1by1(y).shl(1))
     };
-    // Only the digits that survive the shift by b matter.
-    let levels = (33 - b) / 2;
-    let key_1 = combine_key(TAG_ZSOBOL, seed, dim);
-    let key = L::splat(key_1);
-    // Levels at and above the highest digit of every lane's m have digit 0 and no digit above:
-    // their prefix, permutation and output digit are the same for every lane (computed once, in
-    // scalar code; in an image the top levels are all such).
-    let top = m.max_lane();
-    let (mut uniform, mut out) = (0u32, L::splat(0));
-    for l in (0..levels).rev() {
-        let above = levels - 1 - l;
-        if top >> (2 * l) == 0 {
-            let perm = combine(key_1, 1u32 << (2 * above)).mulhi(24);
-            uniform |= PERMS[4 * perm as usize] << (2 * l);
-            continue;
-        }
-        // Higher digits plus a marker bit: unique per (level, prefix).
-        let prefix = m.shr(2 * l + 2).and(L::splat((1 << (2 * above)) - 1)).or(L::splat(1 << (2 * above)));
-        let perm = combine(key, prefix).mulhi(L::splat(24));
-        let digit = m.shr(2 * l).and(L::splat(3));
-        out = out.or(perm4(perm, digit).shl(2 * l));
-    }
-    out.or(L::splat(uniform)).shl(b)
+    m.shl(b)
 }
 
-/// Point `k` of the stream whose block starts at `start`.
+/// The scramble key of pixel sample `sample` in dimension `dim` (every pixel's).
 #[inline]
-fn block_point<L: Lanes>(set: &SetShape, start: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
+fn sample_key<L: Lanes>(sample: L, dim: u32, seed: u64) -> L {
+    combine(L::splat(combine_key(TAG_ZSOBOL, seed, dim)), sample)
+}
+
+/// `(k mod 2^b, k / 2^b)`.
+#[inline]
+fn split_k<L: Lanes>(set: &SetShape, k: L) -> (L, L) {
     let b = block_bits(set);
-    let (low, high) = if b >= 32 { (k, L::splat(0)) } else { (k.and(L::splat((1 << b) - 1)), k.shr(b)) };
-    let key = combine(L::splat(combine_key(TAG_ZSOBOL, seed, dim)), sample.add(high));
-    // The pixel's own indices shuffled per (pixel, dim), keeping every prefix [0, 2^m) (so the
-    // pixel's first 2^m points stay a net): otherwise every dim of a pixel draws the same index
-    // and their top digits are tied (a light choice follows the light point).
-    let low = prefix_shuffle(low, combine(key, start.or(L::splat(1 << 31))));
-    let (x, y) = scrambled_point(start.or(low), key);
-    (x.unit24(), y.unit24())
+    if b >= 32 {
+        (k, L::splat(0))
+    } else {
+        (k.and(L::splat((1 << b) - 1)), k.shr(b))
+    }
 }
 
 impl Layout for ZSobol {
     #[inline]
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
-        block_point(set, block_start(set, pixel, dim, seed), sample, dim, k, seed)
+        let (low, high) = split_k(set, k);
+        keyed_point(sample_key(sample.add(high), dim, seed), block_start(set, pixel).or(low))
     }
 
+    /// The block start in `prefix` and the key of pixel sample `sample` in `base` (that of points
+    /// k < 2^b).
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        StreamKey { prefix: block_start(set, pixel, dim, seed), base: L::splat(0), sample, dim, seed }
+        StreamKey { prefix: block_start(set, pixel), base: sample_key(sample, dim, seed), sample, dim, seed }
     }
 
     #[inline]
     fn stream_point<L: Lanes>(&self, set: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
-        block_point(set, s.prefix, s.sample, s.dim, L::splat(k), s.seed)
+        let (low, high) = split_k(set, k);
+        let key = if high == 0 { s.base } else { sample_key(s.sample.add(L::splat(high)), s.dim, s.seed) };
+        keyed_point(key, s.prefix.or(L::splat(low)))
     }
 }
 
@@ -172,29 +124,6 @@ mod tests {
 
     fn zsobol(n: u32, width: u32) -> PointSet {
         PointSet::for_image(SamplerKind::parse("zsobol").expect("registered"), n, width)
-    }
-
-    #[test]
-    fn packed_permutations_equal_the_table() {
-        use crate::simd::U8;
-        for p in 0..24u32 {
-            for d in 0..4u32 {
-                assert_eq!(super::perm4(p, d), super::PERMS[(4 * p + d) as usize], "p {p} d {d}");
-            }
-            let d8 = U8::new([0, 1, 2, 3, 3, 2, 1, 0]);
-            let got = super::perm4(U8::splat(p), d8).to_array();
-            let want = d8.to_array().map(|d| super::PERMS[(4 * p + d) as usize]);
-            assert_eq!(got, want, "p {p}");
-        }
-    }
-
-    #[test]
-    fn permutations_are_all_distinct() {
-        let mut perms: Vec<_> = super::PERMS.chunks(4).collect();
-        assert!(perms.iter().all(|p| (0..4).all(|d| p.contains(&d))));
-        perms.sort_unstable();
-        perms.dedup();
-        assert_eq!(perms.len(), 24);
     }
 
     #[test]
