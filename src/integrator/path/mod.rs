@@ -633,12 +633,17 @@ fn origin(sh: &SurfaceHit8, from: From, wi: Vec3x8) -> Vec3x8 {
     }
 }
 
-/// The `shade` lanes whose registry BSDF has a transmission lobe (per-lane kinds of the kernel's
-/// set `L::Bsdfs`).
+/// The `shade` lanes whose registry BSDF transmits and has a lobe a next event can find (diffuse
+/// or glossy; per-lane kinds of the kernel's set `L::Bsdfs`): the smooth dielectrics' and the
+/// null lobe's lanes would only trace shadow rays of value 0.
 #[inline]
 fn transmitting_lanes<L: LobeSet>(mat: &crate::bsdf::Material8, shade: Mask8) -> Mask8 {
+    use lobe_flags::{DIFFUSE, GLOSSY, TRANSMISSION};
     let kinds = mat.bsdf.kind.to_array();
-    let t = kinds.map(|k| <L::Bsdfs as BsdfSet>::flags_of(k) & lobe_flags::TRANSMISSION != 0);
+    let t = kinds.map(|k| {
+        let f = <L::Bsdfs as BsdfSet>::flags_of(k);
+        f & TRANSMISSION != 0 && f & (DIFFUSE | GLOSSY) != 0
+    });
     shade & crate::simd::mask_from_bools(t)
 }
 
