@@ -70,7 +70,7 @@ fn render(d: &SceneDesc, spp: u32, nee: Nee, sampler: &str, seed: u64) -> Image 
 fn agree(name: &str, a: &Image, b: &Image) {
     let (mut zpix, mut zblock, mut zsum, mut ratio) = (0f64, 0f64, 0f64, [0f64; 3]);
     let w = 20;
-    for c in 0..3 {
+    for (c, ratio) in ratio.iter_mut().enumerate() {
         let (mut d, mut v, mut sa, mut sb) = (0.0, 0.0, 0.0, 0.0);
         let mut blocks = vec![(0.0, 0.0); (w / 4) * (w / 4)];
         for i in 0..a.0.len() {
@@ -88,7 +88,7 @@ fn agree(name: &str, a: &Image, b: &Image) {
             }
         }
         zsum = zsum.max(d.abs() / v.sqrt());
-        ratio[c] = sa / sb;
+        *ratio = sa / sb;
     }
     let z = format!("pixel |z| {zpix:.2}, 4x4 block |z| {zblock:.2}, image |z| {zsum:.2}, ratio {ratio:.4?}");
     eprintln!("{name}: {z}");
@@ -140,7 +140,7 @@ fn point_light_behind_glass_is_seen_through_it() {
     let mut area = base;
     let r = 0.04f32;
     // (Black: hits on a light are not shaded, and its own material would only matter there.)
-    let mut black = area.materials[area.spheres[0].material as usize].clone();
+    let mut black = area.materials[area.spheres[0].material as usize];
     black.bsdf = strata::bsdf::BsdfParams::COURSE;
     area.materials.push(black);
     let m = area.materials.len() as u32 - 1;
