@@ -10,6 +10,10 @@
 //!   (a shadow ray to infinity).
 //! - Delta lights: [`Shading::delta_events`] (each light once, weight 1; [`delta_tfar`]).
 //!
+//! Both light the side of the viewer, and on the lanes [`Shading::with_below`] names (a BSDF that
+//! transmits, in the path tracer) the other side too: `cos` is then |cos(th_i)| and the caller
+//! starts the shadow ray below the surface (where the direction goes below the geometric normal).
+//!
 //! What an integrator makes of a term stays in its file: `direct` sums groups of samples and
 //! scales them once, the path tracer weighs with MIS and its throughput. Their products are
 //! ordered differently, and both keep their images bit for bit.
@@ -36,6 +40,9 @@ pub struct Shading<'a> {
     pub wo: Vec3x8,
     /// the strategy whose pdf [`Shading::eval`] returns
     pub strategy: ImportanceSampling,
+    /// lanes whose BSDF transmits: next events light them from below the surface too (none
+    /// unless [`Shading::with_below`] says so)
+    pub below: Mask8,
 }
 
 /// Where an area light's next event points: [`towards`].
@@ -61,7 +68,26 @@ impl<'a> Shading<'a> {
     #[inline]
     pub fn new(sh: &'a SurfaceHit8, frame: &'a Frame8, strategy: ImportanceSampling) -> Self {
         let wo = frame.to_local(sh.wo);
-        Self { sh, frame, wo, strategy }
+        Self { sh, frame, wo, strategy, below: F8::ZERO }
+    }
+
+    /// The same shading points, lit from below the surface too on the lanes `below` (where the
+    /// BSDF transmits): environment and delta next events there take directions on either side.
+    #[inline]
+    pub fn with_below(self, below: Mask8) -> Self {
+        Self { below, ..self }
+    }
+
+    /// The lanes lit from the local direction `wi_l` (world `wi`): above the shading surface and
+    /// leaving the geometric one ([`leaves`]), or, on the [`Shading::below`] lanes, below both.
+    #[inline]
+    fn sides(&self, wi_l: Vec3x8, wi: Vec3x8) -> Mask8 {
+        let above = wi_l.z.simd_gt(F8::ZERO) & self.leaves(wi);
+        if self.below.none() {
+            return above;
+        }
+        let under = !self.sh.smooth | self.sh.ng.dot(wi).simd_lt(F8::ZERO);
+        above | (self.below & wi_l.z.simd_lt(F8::ZERO) & under)
     }
 
     /// [`leaves`] at these shading points.
@@ -79,7 +105,8 @@ impl<'a> Shading<'a> {
 
     /// The environment's next event for the direction `e` (from [`env_sample`]) at the lanes
     /// `shade` with throughput `beta`: the lit lanes (in front of the shading and geometric
-    /// surfaces, pdf > 0), the world direction and `beta f L cos / pdf w`, with the weight `w`
+    /// surfaces, or behind both on [`Shading::below`] lanes; pdf > 0), the world direction and
+    /// `beta f L |cos| / pdf w`, with the weight `w`
     /// from `weight(pdf_bsdf)`; None where no lane is lit. Its shadow ray goes to infinity.
     #[inline]
     pub fn env_event<L: LobeSet>(
@@ -89,18 +116,19 @@ impl<'a> Shading<'a> {
         shade: Mask8,
         weight: impl FnOnce(F8, Mask8) -> F8,
     ) -> Option<(Mask8, Vec3x8, Vec3x8)> {
-        let lit = shade & e.wi_l.z.simd_gt(F8::ZERO) & e.pdf.simd_gt(F8::ZERO) & self.leaves(e.wi);
+        let lit = shade & e.pdf.simd_gt(F8::ZERO) & self.sides(e.wi_l, e.wi);
         if lit.none() {
             return None;
         }
         let (f, pdf_b) = self.eval::<L>(e.wi_l, lit);
-        let g = lit.select(e.wi_l.z / e.pdf * weight(pdf_b, lit), F8::ZERO);
+        let g = lit.select(e.wi_l.z.abs() / e.pdf * weight(pdf_b, lit), F8::ZERO);
         Some((lit, e.wi, beta.mul_elem(f).mul_elem(e.le).scale(g)))
     }
 
     /// The delta lights' next events at the lanes `shade` with throughput `beta`: each light
     /// once, weight 1 (no BSDF sample can reach a delta light). Calls `push` with (lit lanes,
-    /// unit direction, shadow-ray end, `beta f li cos`) per light that lights a lane.
+    /// unit direction, shadow-ray end, `beta f li |cos|`) per light that lights a lane (from
+    /// below too on [`Shading::below`] lanes).
     #[inline]
     pub fn delta_events<L: LobeSet>(
         &self,
@@ -115,12 +143,12 @@ impl<'a> Shading<'a> {
                 light.sample_x8(self.sh.p, shade)
             };
             let wi_l = self.frame.to_local(wi);
-            let lit = ok & wi_l.z.simd_gt(F8::ZERO) & self.leaves(wi);
+            let lit = ok & self.sides(wi_l, wi);
             if lit.none() {
                 continue;
             }
             let f = self.eval::<L>(wi_l, lit).0;
-            let c = beta.mul_elem(f).mul_elem(li).scale(lit.select(wi_l.z, F8::ZERO));
+            let c = beta.mul_elem(f).mul_elem(li).scale(lit.select(wi_l.z.abs(), F8::ZERO));
             push(lit, wi, delta_tfar(scene, light, dist), c);
         }
     }

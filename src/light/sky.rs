@@ -6,7 +6,8 @@
 //! shading normal, pdf `1 / (2 pi)` per solid angle, traced as a shadow ray to infinity. The
 //! estimate `L f cos / pdf` is weighted with the power heuristic against the BSDF's pdf of the
 //! same direction, and a BSDF-sampled ray that escapes is weighted against `1 / (2 pi)` (its
-//! direction lies in that hemisphere: the path tracer continues only above the shading normal).
+//! direction lies in that hemisphere, or, after a transmitting BSDF, in the one below, where the
+//! path tracer mirrors the sample as a second next event of the same pdf).
 //! Because it is not one of the lights the selection chooses from, every `--light-selection`
 //! mode treats it alike. Camera rays that escape see `L` directly (the background).
 

@@ -21,6 +21,7 @@ mod layering;
 mod light_selection;
 mod light_warp;
 mod mitsuba_corpus;
+mod nee_below;
 mod normals;
 mod obj;
 mod obj_wild;

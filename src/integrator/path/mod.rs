@@ -21,7 +21,9 @@
 
 use super::context::{masked, shading_frame, TileCtx};
 use super::estimator::Estimator;
-use super::light_term::{area_sample, env_sample, point_shadow, towards, AreaChoice, PointTerm, Shading, SkySampling};
+use super::light_term::{
+    area_sample, env_sample, point_shadow, towards, AreaChoice, EnvSample, PointTerm, Shading, SkySampling,
+};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
 use super::stats::RayKind;
@@ -389,10 +391,13 @@ impl Bounce<'_> {
         }
         let (pixel, s, beta) = (vx.pixel, vx.s, vx.beta);
         let (frame, mat) = (shading_frame::<L>(scene, sh), &sh.mat);
-        let at = Shading::new(sh, &frame, it.path.strategy);
-        let (frame, wo) = (at.frame, at.wo);
         // Registry BSDFs that transmit: directions may cross the surface (compile-time).
         let transmits = <L::Bsdfs as BsdfSet>::FLAGS & lobe_flags::TRANSMISSION != 0;
+        // The environment's and the delta lights' next events light transmitting lanes from
+        // below too (the area lights' below; see `push`).
+        let below = if transmits { transmitting_lanes::<L>(mat, shade) } else { F8::ZERO };
+        let at = Shading::new(sh, &frame, it.path.strategy).with_below(below);
+        let (frame, wo) = (at.frame, at.wo);
         let eps = scene.offset_eps(sh.p);
         // Offsets along the geometric normal (the shading one may point into the surface).
         let o = sh.ng.mul_add(eps, sh.p);
@@ -411,11 +416,13 @@ impl Bounce<'_> {
         let picks = it.light_selection.picks_one() && n_lights > 1;
         let own_choice = picks && it.light_choice == LightChoice::Dimension;
 
+        // Shadow rays of directions below the geometric surface start below it.
+        let from = (o, if transmits && below.any() { Some(o_below) } else { None });
         if nee_here {
-            self.env_next_event::<L>(vx, &at, o, shade);
+            self.env_next_event::<L>(vx, &at, from, shade);
         }
         if delta_here {
-            self.delta_next_events::<L>(vx, &at, o, shade);
+            self.delta_next_events::<L>(vx, &at, from, shade);
         }
         if nee_here && n_lights > 0 {
             let u_choice = if own_choice {
@@ -568,21 +575,25 @@ impl Bounce<'_> {
 
 impl Bounce<'_> {
     /// The delta lights' next events at the shaded lanes `shade` of `vx`
-    /// ([`Shading::delta_events`]), pushed as shadow rays from `o` (kept out of line: scenes
-    /// without delta lights never run it).
+    /// ([`Shading::delta_events`], from below too on `at.below` lanes), pushed as shadow rays
+    /// from `from` (kept out of line: scenes without delta lights never run it).
     #[inline(never)]
-    fn delta_next_events<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, o: Vec3x8, shade: Mask8) {
+    fn delta_next_events<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, from: From, shade: Mask8) {
         let shadow = &mut *self.shadow;
         at.delta_events::<L>(self.scene, vx.beta, shade, |lit, wi, tfar, c| {
-            push_shadow(shadow, vx, o, wi, tfar, c, lit)
+            push_shadow(shadow, vx, origin(vx.sh, from, wi), wi, tfar, c, lit)
         });
     }
 
     /// The environment's next event at the shaded lanes `shade` of `vx` (the sky's own
     /// distribution or the envmap's, [`Shading::env_event`]), MIS-weighted against the BSDF and
-    /// pushed as a shadow ray to infinity from `o`.
+    /// pushed as a shadow ray to infinity from `from`. The sky's samples cover the hemisphere
+    /// above the shading normal; on `at.below` lanes (a transmitting BSDF) the same sample
+    /// mirrored below is a second next event, of the same pdf `1 / (2 pi)` in its hemisphere, so
+    /// an escaped ray's weight against `Sky::PDF` holds on either side. The envmap's cover the
+    /// sphere.
     #[inline]
-    fn env_next_event<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, o: Vec3x8, shade: Mask8) {
+    fn env_next_event<L: LobeSet>(&mut self, vx: &Vertex, at: &Shading, from: From, shade: Mask8) {
         let Some(dim) = self.dsky.as_ref() else { return };
         let uw = self.smp.table_point(dim, true, Phase::SamplerPath, vx.pixel, vx.s);
         let Some(e) = env_sample(self.scene, SkySampling::Sky, at.frame, uw, shade) else { return };
@@ -592,9 +603,46 @@ impl Bounce<'_> {
             None if mis => power_heuristic_x8(e.pdf, pdf_b, lit),
             None => F8::ONE,
         };
-        let Some((lit, wi, c)) = at.env_event::<L>(&e, vx.beta, shade, weight) else { return };
-        push_shadow(self.shadow, vx, o, wi, F8::splat(f32::INFINITY), c, lit);
+        if let Some((lit, wi, c)) = at.env_event::<L>(&e, vx.beta, shade, weight) {
+            push_shadow(self.shadow, vx, origin(vx.sh, from, wi), wi, F8::splat(f32::INFINITY), c, lit);
+        }
+        let below = shade & at.below;
+        if self.scene.sky.is_some() && below.any() {
+            let wi_l = Vec3x8::new(e.wi_l.x, e.wi_l.y, -e.wi_l.z);
+            let m = EnvSample { wi: at.frame.to_world(wi_l), wi_l, pdf: e.pdf, le: e.le };
+            if let Some((lit, wi, c)) = at.env_event::<L>(&m, vx.beta, below, weight) {
+                push_shadow(self.shadow, vx, origin(vx.sh, from, wi), wi, F8::splat(f32::INFINITY), c, lit);
+            }
+        }
     }
+}
+
+/// Where a next event's shadow rays start: above the surface, and (on kernels with transmitting
+/// lanes) below it.
+type From = (Vec3x8, Option<Vec3x8>);
+
+/// The shadow-ray origins of the hits `sh` for directions `wi`: below the surface where `wi` goes
+/// below the geometric normal and `from` has a point there, else above.
+#[inline]
+fn origin(sh: &SurfaceHit8, from: From, wi: Vec3x8) -> Vec3x8 {
+    match from {
+        (o, Some(o_below)) => Vec3x8::select(sh.ng.dot(wi).simd_lt(F8::ZERO), o_below, o),
+        (o, None) => o,
+    }
+}
+
+/// The `shade` lanes whose registry BSDF transmits and has a lobe a next event can find (diffuse
+/// or glossy; per-lane kinds of the kernel's set `L::Bsdfs`): the smooth dielectrics' and the
+/// null lobe's lanes would only trace shadow rays of value 0.
+#[inline]
+fn transmitting_lanes<L: LobeSet>(mat: &crate::bsdf::Material8, shade: Mask8) -> Mask8 {
+    use lobe_flags::{DIFFUSE, GLOSSY, TRANSMISSION};
+    let kinds = mat.bsdf.kind.to_array();
+    let t = kinds.map(|k| {
+        let f = <L::Bsdfs as BsdfSet>::flags_of(k);
+        f & TRANSMISSION != 0 && f & (DIFFUSE | GLOSSY) != 0
+    });
+    shade & crate::simd::mask_from_bools(t)
 }
 
 /// A next event's shadow rays from `o` along `wi` up to `tfar`, adding `c` to the pixel samples
