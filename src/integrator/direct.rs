@@ -422,11 +422,11 @@ fn sample_batch<L: LobeSet>(
         if lit.none() {
             continue;
         }
-        if let Some(m) = &mis {
+        if let Some(mis) = &mis {
             // The light sample's solid-angle pdf: d^2 / (cos_l A inv_pmf), A the light's area
             // (or `light::warp`'s 1 / pdf per area).
             let p_e = d2 / (ls.area * cos_l * ls.inv_pmf);
-            f = f.scale(m.light(p_e, pdf_b, lit));
+            f = f.scale(mis.light(p_e, pdf_b, lit));
         }
         batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
         // Shadow packet from the offset point towards the light sample, stopping short.
@@ -462,6 +462,7 @@ impl Batch {
 
     /// Traces the packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the lanes of
     /// packet j whose shadow ray reached the light.
+    #[inline]
     pub(super) fn trace(&mut self, tracer: &mut Tracer, acc: &mut [Vec3x8]) {
         let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
         for (j, (ray, lit)) in self.shadow.iter_mut().enumerate() {
