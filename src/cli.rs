@@ -373,6 +373,11 @@ pub(crate) struct RenderArgs {
     /// Light samples per light, at least 1 (default: the scene's lightsamples).
     #[arg(long, help_heading = LIGHTS, value_parser = parse_positive::<u32>)]
     pub(crate) light_samples: Option<u32>,
+    /// direct: BSDF samples per shading point, combined with the light samples by the power
+    /// heuristic as Mitsuba's direct does; 0 samples the lights alone (default: the scene's,
+    /// Mitsuba's bsdf_samples; 0 for .test and OBJ scenes).
+    #[arg(long, help_heading = LIGHTS, value_parser = parse_count::<u32>)]
+    pub(crate) bsdf_samples: Option<u32>,
     // Light selection; the help lists the rule registry.
     #[arg(long, help_heading = LIGHTS, value_name = "NAME", help = format!(
         "Light selection of next-event estimation (direct and the path tracer): {}. Default: all for \
@@ -496,6 +501,7 @@ impl RenderArgs {
             light_choice: self.light_choice,
             light_warp: self.light_warp,
             light_samples: self.light_samples,
+            bsdf_samples: self.bsdf_samples,
             pixel_sampler: self.pixel_sampler,
             out: self.out,
             stats: self.stats,

@@ -159,6 +159,8 @@ pub fn identity(file_hash: &str, scene: &Scene, it: &Integrator, time_budget: bo
         ("pixel_sampler", json!(it.pixel_set.kind().name())),
         ("light_sampler", json!(it.light_set.kind().name())),
         ("light_samples", json!(it.light_set.n())),
+        ("bsdf_samples", json!(it.direct.bsdf_samples)),
+        ("emitter_sampling", json!(it.direct.emitter_sampling)),
         ("sampler", json!(it.path_set.set().kind().name())),
         ("light_choice", json!(it.light_choice.name())),
         ("light_warp", json!(it.light_warp.name())),

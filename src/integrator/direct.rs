@@ -1,4 +1,9 @@
-//! `direct` (hw2): direct lighting from every area light by light sampling with shadow rays.
+//! `direct` (hw2, and Mitsuba 3's `direct`): direct lighting by light sampling with shadow rays
+//! and, when `Integrator::direct` asks for them, BSDF samples (`direct_bsdf.rs`: every lobe,
+//! delta and transmission included), the two weighted by the power heuristic of their pdfs times
+//! their sample counts, as Mitsuba's `direct` ([`Mis`]). `.test` and OBJ scenes draw no BSDF
+//! sample unless `--bsdf-samples` asks (their light-sampling code and bits are unchanged); XML
+//! scenes take Mitsuba's `emitter_samples`/`bsdf_samples` (default one of each).
 //!
 //! The emitters are visited in one loop, one sampling group at a time: each quad light is its own
 //! group (sampler dimension `DIM_LIGHT_BASE + index`, a point uniform in area), and the emissive
@@ -24,17 +29,20 @@ use super::primary::{self, Wave};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
 use crate::accel::Ray8;
-use crate::bsdf::LobeSet;
+use crate::bsdf::{BsdfSet, LobeSet};
 use crate::light::emitters::{Emitter, LightSample8};
 use crate::light::select::LightChoice;
 use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::{PathDim, Stream};
+use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
 use crate::scene::desc::{ImportanceSampling, IntegratorKind};
 use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 
+#[path = "direct_bsdf.rs"]
+mod bsdf_samples;
 #[path = "direct_env.rs"]
 mod env;
 
@@ -56,6 +64,7 @@ pub struct Direct;
 pub struct DirectScratch {
     wave: Wave,
     buf: Buffers,
+    bsdf: bsdf_samples::BsdfBuffers,
 }
 
 /// Per-thread buffers of `direct`'s light sampling, reused across samples and tiles.
@@ -78,7 +87,8 @@ pub(super) struct Lanes {
 
 impl Estimator for Direct {
     const KIND: IntegratorKind = IntegratorKind::Direct;
-    const DIMS: &'static [Dim] = &[CAMERA, LIGHT_POINT, LIGHT_CHOICE, env::ENVIRONMENT];
+    const DIMS: &'static [Dim] =
+        &[CAMERA, LIGHT_POINT, LIGHT_CHOICE, env::ENVIRONMENT, bsdf_samples::BSDF_DIRECTION, bsdf_samples::BSDF_LOBE];
     type Scratch = DirectScratch;
 
     fn tile<L: LobeSet>(
@@ -88,8 +98,8 @@ impl Estimator for Direct {
         samples: std::ops::Range<u32>,
         out: &mut Vec<Vec3x8>,
     ) {
-        let DirectScratch { wave, buf } = sc;
-        primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, s, out));
+        let DirectScratch { wave, buf, bsdf } = sc;
+        primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, bsdf, s, out));
     }
 }
 
@@ -138,26 +148,70 @@ fn groups(scene: &Scene) -> impl Iterator<Item = Group<'_>> {
     quads.chain((scene.emitters.n_triangles() > 0).then_some(Group::Triangles))
 }
 
-/// Adds direct lighting at the camera hits `hits` of the tile for pixel sample `s` to `out`.
+/// The strategy `direct` samples and weighs the course's materials with when it draws BSDF
+/// samples (the course's BRDF sampling: cosine for diffuse, the Phong lobe for specular; registry
+/// BSDFs sample their own lobes whatever it is). Light sampling alone evaluates under cosine.
+pub(super) const MIS_STRATEGY: ImportanceSampling = ImportanceSampling::Brdf;
+
+/// Mitsuba's `direct` weights: the power heuristic of the two strategies' pdfs, each times its
+/// sample count (`n_e` light samples, `n_b` BSDF samples per shading point).
+#[derive(Clone, Copy)]
+pub(super) struct Mis {
+    n_e: F8,
+    n_b: F8,
+    inv_b: F8,
+}
+
+impl Mis {
+    /// The weights of `n_e` light samples (0: no emitter sampling) and `n_b` BSDF samples.
+    pub(super) fn new(n_e: u32, n_b: u32) -> Self {
+        Self { n_e: F8::splat(n_e as f32), n_b: F8::splat(n_b as f32), inv_b: F8::splat(1.0 / n_b.max(1) as f32) }
+    }
+
+    /// A light sample's weight (the 1 / N of its average apart): its pdf `p_e` against the BSDF's
+    /// `p_b` for the same direction.
+    #[inline]
+    pub(super) fn light(&self, p_e: F8, p_b: F8, active: Mask8) -> F8 {
+        power_heuristic_x8(p_e * self.n_e, p_b * self.n_b, active)
+    }
+
+    /// A BSDF sample's weight, its 1 / n_b included: `p_b` against light sampling's `p_e`.
+    #[inline]
+    pub(super) fn bsdf(&self, p_b: F8, p_e: F8, active: Mask8) -> F8 {
+        power_heuristic_x8(p_b * self.n_b, p_e * self.n_e, active) * self.inv_b
+    }
+}
+
+/// Adds direct lighting at the camera hits `hits` of the tile for pixel sample `s` to `out`: the
+/// light samples (unless the scene turned emitter sampling off), then the BSDF samples (if any),
+/// weighted against each other when both are drawn.
 fn shade<L: LobeSet>(
     it: &Integrator,
     ctx: &mut TileCtx,
     hits: &[SurfaceHit8],
     sc: &mut Buffers,
+    bsdf: &mut bsdf_samples::BsdfBuffers,
     s: u32,
     out: &mut [Vec3x8],
 ) {
     shading_lanes(ctx.scene, hits, &mut sc.lanes);
-    // No area light (only lights outside the selection): nothing to choose from.
-    if !ctx.scene.emitters.is_empty() {
-        if it.light_selection.picks_one() {
-            shade_one::<L>(it, ctx, hits, sc, s, out);
-        } else {
-            shade_all::<L>(it, ctx, hits, sc, s, out);
+    let d = it.direct;
+    let mis = d.mis().then(|| Mis::new(it.light_set.n(), d.bsdf_samples));
+    if d.emitter_sampling {
+        // No area light (only lights outside the selection): nothing to choose from.
+        if !ctx.scene.emitters.is_empty() {
+            if it.light_selection.picks_one() {
+                shade_one::<L>(it, ctx, hits, sc, s, out, mis);
+            } else {
+                shade_all::<L>(it, ctx, hits, sc, s, out, mis);
+            }
+        }
+        if ctx.scene.sky.is_some() || ctx.scene.envmap.is_some() || !ctx.scene.delta.is_empty() {
+            env::shade_outside::<L>(it, ctx, hits, &sc.lanes, s, out, mis);
         }
     }
-    if ctx.scene.sky.is_some() || ctx.scene.envmap.is_some() || !ctx.scene.delta.is_empty() {
-        env::shade_outside::<L>(it, ctx, hits, &sc.lanes, s, out);
+    if d.bsdf_samples > 0 {
+        bsdf_samples::shade::<L>(it, ctx, hits, &sc.lanes, bsdf, s, out);
     }
 }
 
@@ -169,6 +223,7 @@ fn shade_all<L: LobeSet>(
     sc: &mut Buffers,
     s: u32,
     out: &mut [Vec3x8],
+    mis: Option<Mis>,
 ) {
     let TileCtx { scene, pks, tracer, samples: smp } = ctx;
     let n_light = it.light_set.n();
@@ -207,7 +262,7 @@ fn shade_all<L: LobeSet>(
                 Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
             };
             let target = if let Group::Quad(_) = group { &mut acc[..] } else { &mut *out };
-            sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, target);
+            sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, target, mis);
         }
         if let Group::Quad(light) = group {
             let area = if warped { F8::ONE } else { F8::splat(light.area) };
@@ -260,6 +315,7 @@ fn shade_one<L: LobeSet>(
     sc: &mut Buffers,
     s: u32,
     out: &mut [Vec3x8],
+    mis: Option<Mis>,
 ) {
     let TileCtx { scene, pks, tracer, samples: smp } = ctx;
     let n_light = it.light_set.n();
@@ -312,14 +368,15 @@ fn shade_one<L: LobeSet>(
             let g = g * ls.area * ls.inv_pmf * inv_n;
             masked(f.mul_elem(ls.radiance).scale(g), lit)
         };
-        sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, out);
+        sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, out, mis);
     }
 }
 
 /// Light sample k of every shading packet of the tile: its unit-square point (`point(packet,
 /// shading packet)`), a light point from it (`sample(hits, shading lanes, packet, shading packet,
 /// point)`), the light term ([`towards`], the BSDF value) and what it adds if the shadow ray is
-/// clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`), traced as one batch into `target`.
+/// clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`, f times the sample's MIS weight
+/// against the BSDF samples when `mis` is given), traced as one batch into `target`.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn sample_batch<L: LobeSet>(
@@ -332,7 +389,9 @@ fn sample_batch<L: LobeSet>(
     mut sample: impl FnMut(&SurfaceHit8, Mask8, usize, u32, (F8, F8)) -> (LightSample8, Mask8),
     weigh: impl Fn(&LightSample8, Vec3x8, F8, Mask8) -> Vec3x8,
     target: &mut [Vec3x8],
+    mis: Option<Mis>,
 ) {
+    let strategy = if mis.is_some() { MIS_STRATEGY } else { ImportanceSampling::Cosine };
     batch.clear();
     // Per shading packet: the point, the light point, the light term and the shadow packet, in
     // one pass (the sampler and emitter calls are leaf spans).
@@ -346,13 +405,30 @@ fn sample_batch<L: LobeSet>(
         let (ls, ok) = sample(sh, shade, i, j, uv);
         j += 1;
         // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-        let PointTerm { wi, inv_d, cos_i, cos_l, lit, .. } = towards(sh, &ls, ok);
+        let PointTerm { wi, d2, inv_d, cos_i, cos_l, lit } = towards(sh, &ls, ok);
         if lit.none() {
             continue;
         }
         let frame = shading_frame::<L>(scene, sh);
-        let at = Shading::new(sh, &frame, ImportanceSampling::Cosine);
-        let f = at.eval::<L>(at.frame.to_local(wi), lit).0;
+        let mat = &sh.mat;
+        let at = Shading::new(sh, &frame, strategy);
+        let (mut f, pdf_b) = at.eval::<L>(at.frame.to_local(wi), lit);
+        // No shadow ray where a registry BSDF has no value (delta lobes only: Mitsuba samples
+        // no emitter there).
+        let lit = if <L::Bsdfs as BsdfSet>::BITS != 0 {
+            lit & !(mat.general(lit) & f.max_elem().simd_le(F8::ZERO))
+        } else {
+            lit
+        };
+        if lit.none() {
+            continue;
+        }
+        if let Some(mis) = &mis {
+            // The light sample's solid-angle pdf: d^2 / (cos_l A inv_pmf), A the light's area
+            // (or `light::warp`'s 1 / pdf per area).
+            let p_e = d2 / (ls.area * cos_l * ls.inv_pmf);
+            f = f.scale(mis.light(p_e, pdf_b, lit));
+        }
         batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
         // Shadow packet from the offset point towards the light sample, stopping short.
         let o = sh.ng.mul_add(lanes.eps[i], sh.p);
@@ -387,6 +463,7 @@ impl Batch {
 
     /// Traces the packets back to back and adds `contrib[j]` to `acc[owner[j]]` on the lanes of
     /// packet j whose shadow ray reached the light.
+    #[inline]
     pub(super) fn trace(&mut self, tracer: &mut Tracer, acc: &mut [Vec3x8]) {
         let _p = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
         for (j, (ray, lit)) in self.shadow.iter_mut().enumerate() {

@@ -19,14 +19,17 @@
 //! ordered differently, and both keep their images bit for bit.
 
 use super::settings::Integrator;
+use crate::accel::RayHit8;
 use crate::bsdf::LobeSet;
 use crate::light::delta::DeltaLight;
 use crate::light::emitters::LightSample8;
+use crate::light::warp::LightWarp;
 use crate::profile::{leaf, Phase};
 use crate::scene::build::Scene;
 use crate::scene::desc::ImportanceSampling;
 use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Frame8, Mask8, Vec3x8, F8};
+use glam::Vec3;
 
 /// A packet of shading points as next events see it: the hits (with their material, `sh.mat`),
 /// their shading frame and the direction to the viewer in it, built once per packet.
@@ -287,4 +290,35 @@ pub fn env_sample(
         }
         (None, None) => None,
     }
+}
+
+/// Solid-angle pdf of a next event at a light hit (the path tracer's at a vertex, `direct`'s at
+/// a BSDF sample's hit) for a light chosen with probability `pmf` (per lane):
+/// pmf d^2 / (A cos_l), or pmf / S where `--light-warp solid-angle` samples the light by its solid
+/// angle S seen from the ray's origin (`Emitters::solid_angle_x8`); zero where `is_light` is off
+/// or `pmf` is 0.
+#[inline]
+pub fn light_pdf_at_hit_pmf(
+    it: &Integrator,
+    scene: &Scene,
+    sh: &SurfaceHit8,
+    rh: &RayHit8,
+    is_light: Mask8,
+    pmf: F8,
+) -> F8 {
+    let ids = sh.light.to_array();
+    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
+    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
+    // (A sphere light's normal is the hit's: `normal_at`.)
+    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal_at(sh.p.lane(i)))));
+    let t = F8::new(rh.ray.tfar);
+    let cos_l = ln.dot(sh.wo);
+    let mut p = pmf * t * t / (area * cos_l);
+    if it.light_warp == LightWarp::SolidAngle {
+        let r = &rh.ray;
+        let origin = Vec3x8::new(F8::new(r.org_x), F8::new(r.org_y), F8::new(r.org_z));
+        let (omega, warped) = scene.emitters.solid_angle_x8(sh.light, origin, is_light);
+        p = warped.select(pmf / omega, p);
+    }
+    is_light.select(p, F8::ZERO)
 }

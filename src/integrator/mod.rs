@@ -26,6 +26,7 @@ use std::any::Any;
 pub mod analytic;
 pub mod context;
 pub mod direct;
+pub mod direct_settings;
 pub mod estimator;
 pub mod kernel;
 pub mod light_term;

@@ -3,6 +3,7 @@
 //! integrator reads them through [`Integrator`]; [`Integrator::radiance_tile`] (in `mod.rs`)
 //! dispatches to the registered estimator.
 
+use super::direct_settings::DirectSettings;
 use super::kernel::Kernel;
 use super::path::settings::PathSettings;
 use crate::camera::{Camera, FirstSample};
@@ -65,6 +66,8 @@ pub struct Integrator {
     pub path_set: GridTable,
     /// the path tracer's own settings (NEE, roulette, strategy, clamp)
     pub path: PathSettings,
+    /// `direct`'s own settings (BSDF samples, emitter sampling)
+    pub direct: DirectSettings,
     /// `raytracer` and path tracer: maximum bounces (-1 = unbounded)
     pub max_depth: i32,
     /// the kernel that runs (specialized for the scene's features, or [`Kernel::GENERAL`])
@@ -103,6 +106,7 @@ impl Integrator {
             light_table: sets.light_table,
             path_set: sets.path,
             path: PathSettings::of(d),
+            direct: DirectSettings::of(d),
             max_depth: d.max_depth,
             kernel: Kernel::for_scene(scene),
             first_sample: FirstSample::Jittered,

@@ -247,6 +247,13 @@ pub struct SceneDesc {
     pub max_depth: i32,
     /// light samples per light for `direct` (default 1)
     pub light_samples: u32,
+    /// `direct`: BSDF samples per shading point, combined with the light samples by MIS
+    /// (Mitsuba's `bsdf_samples`; default 0: `.test` and OBJ scenes sample the lights alone).
+    /// Hashed only when not 0.
+    pub bsdf_samples: u32,
+    /// `direct`: whether it samples the emitters at all (false: Mitsuba's `emitter_samples` 0,
+    /// BSDF sampling alone; `light_samples` then stays 1). Hashed only when off.
+    pub emitter_sampling: bool,
     /// `lightstratify on`
     pub light_stratify: bool,
     /// `lightselection all|uniform|power|spatial` (a strata extension; None: the session's default,
@@ -430,6 +437,13 @@ impl SceneDesc {
             h.word(0x7272_6400);
             h.word(self.rr_depth);
         }
+        if self.bsdf_samples != 0 {
+            h.word(0x6273_6466);
+            h.word(self.bsdf_samples);
+        }
+        if !self.emitter_sampling {
+            h.word(0x656d_6f66);
+        }
         if self.sensor.is_some() || self.filter != PixelFilter::Box {
             let _ = std::fmt::Write::write_fmt(&mut h, format_args!("{:?}", (self.sensor, self.filter)));
         }
@@ -579,6 +593,8 @@ impl Default for SceneDesc {
             integrator: IntegratorKind::RayTracer,
             max_depth: 5,
             light_samples: 1,
+            bsdf_samples: 0,
+            emitter_sampling: true,
             light_stratify: false,
             light_selection: None,
             nee: Nee::Off,

@@ -39,6 +39,9 @@ pub struct RenderOptions {
     pub light_warp: Option<crate::light::warp::LightWarp>,
     /// light samples per light (default: the scene's `lightsamples`)
     pub light_samples: Option<u32>,
+    /// `direct`: BSDF samples per shading point, MIS-weighted with the light samples (default:
+    /// the scene's, Mitsuba's `bsdf_samples`; 0 for `.test` and OBJ scenes)
+    pub bsdf_samples: Option<u32>,
     /// pixel sample layout (default stratified)
     pub pixel_sampler: Option<SamplerKind>,
     /// output stem: writes OUT.exr and OUT.png (default: the scene's `output` name)

@@ -148,6 +148,13 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     if spp > opts.limits.max_spp {
         return Err(over("spp", spp.to_string(), opts.limits.max_spp.into(), "", "max_spp"));
     }
+    if let Some(n) = opts.bsdf_samples.filter(|&n| n > opts.limits.max_light_samples) {
+        return Err(over("bsdf-samples", n.to_string(), opts.limits.max_light_samples.into(), "", "max_light_samples"));
+    }
+    if opts.bsdf_samples == Some(0) && !desc.emitter_sampling {
+        // (The scene samples no emitter: BSDF samples are all it has.)
+        return Err(SessionError::Zero { flag: "bsdf-samples" });
+    }
     if let Some(n) = opts.light_samples.filter(|&n| n > opts.limits.max_light_samples) {
         return Err(over(
             "light-samples",
@@ -189,6 +196,9 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
         light: opts.light_sampler,
     };
     let mut integrator = Integrator::new(&scene, spp, opts.seed, samplers, opts.light_samples);
+    if let Some(n) = opts.bsdf_samples {
+        integrator.direct.bsdf_samples = n;
+    }
     integrator.light_choice = opts.light_choice.unwrap_or(crate::light::select::LightChoice::Reuse);
     // Scenes with sphere lights (Mitsuba's) sample by solid angle unless told otherwise, as
     // Mitsuba samples spheres; others keep area sampling (the course's convention).
@@ -248,6 +258,9 @@ fn check_flags_apply(opts: &RenderOptions, scene: &Scene, it: &Integrator) -> Re
         if scene.emitters.len() < 2 {
             return refuse("--light-choice", "the scene has fewer than two area lights: there is no choice".into());
         }
+    }
+    if opts.bsdf_samples.is_some() && it.kind != IntegratorKind::Direct {
+        return refuse("--bsdf-samples", format!("only direct draws BSDF samples per shading point, not {name}"));
     }
     // (`--light-samples` is accepted everywhere: scripts pass it over whole scene sets, and the
     // `.test` keyword it overrides is there whatever the integrator.)

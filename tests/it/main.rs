@@ -8,6 +8,7 @@ mod checkpoint;
 mod cli;
 mod compare_checks;
 mod convergence;
+mod direct_bsdf;
 mod direct_lighting;
 mod docs;
 mod experiments;

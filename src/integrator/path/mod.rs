@@ -22,7 +22,8 @@
 use super::context::{masked, shading_frame, TileCtx};
 use super::estimator::Estimator;
 use super::light_term::{
-    area_sample, env_sample, point_shadow, towards, AreaChoice, EnvSample, PointTerm, Shading, SkySampling,
+    area_sample, env_sample, light_pdf_at_hit_pmf, point_shadow, towards, AreaChoice, EnvSample, PointTerm, Shading,
+    SkySampling,
 };
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
@@ -33,7 +34,6 @@ use crate::bsdf::{BsdfSet, LobeSet};
 use crate::light::emitters::LightSample8;
 use crate::light::select::LightChoice;
 use crate::light::sky::Sky;
-use crate::light::warp::LightWarp;
 use crate::profile::Phase;
 use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
@@ -42,7 +42,6 @@ use crate::scene::desc::IntegratorKind;
 use crate::scene::desc::{ImportanceSampling, Nee};
 use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
-use glam::Vec3;
 use wave::{add_lanes, bits, Columns, Pack};
 
 pub mod settings;
@@ -653,36 +652,6 @@ fn push_shadow(shadow: &mut Columns<SHADOW_COLS>, vx: &Vertex, o: Vec3x8, wi: Ve
     let row = [bits(vx.slot), o.x, o.y, o.z, wi.x, wi.y, wi.z, tfar, c.x, c.y, c.z];
     shadow.write(S_SLOT, &pack, &row);
     shadow.advance(&pack);
-}
-
-/// Solid-angle pdf of NEE at a light hit for a light chosen with probability `pmf` (per lane):
-/// pmf d^2 / (A cos_l), or pmf / S where `--light-warp solid-angle` samples the light by its solid
-/// angle S seen from the ray's origin (`Emitters::solid_angle_x8`); zero where `is_light` is off
-/// or `pmf` is 0.
-#[inline]
-fn light_pdf_at_hit_pmf(
-    it: &Integrator,
-    scene: &Scene,
-    sh: &crate::scene::gather::SurfaceHit8,
-    rh: &RayHit8,
-    is_light: Mask8,
-    pmf: F8,
-) -> F8 {
-    let ids = sh.light.to_array();
-    let pick = |i: usize| scene.emitters.list.get(ids[i] as usize);
-    let area = F8::new(std::array::from_fn(|i| pick(i).map_or(1.0, |l| l.area)));
-    // (A sphere light's normal is the hit's: `normal_at`.)
-    let ln = Vec3x8::from_lanes(std::array::from_fn(|i| pick(i).map_or(Vec3::Z, |l| l.normal_at(sh.p.lane(i)))));
-    let t = F8::new(rh.ray.tfar);
-    let cos_l = ln.dot(sh.wo);
-    let mut p = pmf * t * t / (area * cos_l);
-    if it.light_warp == LightWarp::SolidAngle {
-        let r = &rh.ray;
-        let origin = Vec3x8::new(F8::new(r.org_x), F8::new(r.org_y), F8::new(r.org_z));
-        let (omega, warped) = scene.emitters.solid_angle_x8(sh.light, origin, is_light);
-        p = warped.select(pmf / omega, p);
-    }
-    is_light.select(p, F8::ZERO)
 }
 
 /// Point `j` of `n` on one light for `all`: a Fibonacci-like rank-1 lattice rotated by `(u, w)`
