@@ -42,7 +42,6 @@ impl Bsdf for Conductor {
             color: [eta, k, Vec3::ONE],
             scalar: [0.0; 4],
             opacity: 1.0,
-        nested: None,
         };
         vec![
             row(Vec3::new(0.2, 0.92, 1.1), Vec3::new(3.9, 2.45, 2.14)),
@@ -55,5 +54,5 @@ impl Bsdf for Conductor {
 
 /// A conductor row: eta, k and specular reflectance.
 pub fn params(eta: Vec3, k: Vec3, specular: Vec3) -> BsdfParams {
-    BsdfParams { kind: Conductor::ID, twosided: false, color: [eta, k, specular], scalar: [0.0; 4], opacity: 1.0, nested: None }
+    BsdfParams { kind: Conductor::ID, twosided: false, color: [eta, k, specular], scalar: [0.0; 4], opacity: 1.0 }
 }

@@ -51,5 +51,5 @@ impl Bsdf for Dielectric {
 
 /// A dielectric row: relative index, specular reflectance and transmittance.
 pub fn params(eta: f32, reflectance: Vec3, transmittance: Vec3) -> BsdfParams {
-    BsdfParams { kind: Dielectric::ID, twosided: false, color: [reflectance, transmittance, Vec3::ZERO], scalar: [eta, 0.0, 0.0, 0.0], opacity: 1.0, nested: None }
+    BsdfParams { kind: Dielectric::ID, twosided: false, color: [reflectance, transmittance, Vec3::ZERO], scalar: [eta, 0.0, 0.0, 0.0], opacity: 1.0 }
 }

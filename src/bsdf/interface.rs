@@ -99,25 +99,16 @@ pub struct BsdfParams {
     /// Mitsuba's `mask` around the BSDF: the probability in [0, 1] that a hit scatters (1:
     /// opaque, the BSDF alone); with 1 - opacity the ray passes unchanged (`bsdf::mask`)
     pub opacity: f32,
-    /// the two rows a `blendbsdf` row blends (`bsdf::blendbsdf`; interned once per distinct
-    /// pair), `None` for every other kind
-    pub nested: Option<&'static [BsdfParams; 2]>,
 }
 
 impl BsdfParams {
     /// The course's material (two-sided, slots unused).
-    pub const COURSE: Self = Self {
-        kind: COURSE,
-        twosided: true,
-        color: [Vec3::ZERO; COLORS],
-        scalar: [0.0; SCALARS],
-        opacity: 1.0,
-        nested: None,
-    };
+    pub const COURSE: Self =
+        Self { kind: COURSE, twosided: true, color: [Vec3::ZERO; COLORS], scalar: [0.0; SCALARS], opacity: 1.0 };
 
     /// A one-sided, opaque row of BSDF `kind` with the given slots.
     pub const fn new(kind: u32, color: [Vec3; COLORS], scalar: [f32; SCALARS]) -> Self {
-        Self { kind, twosided: false, color, scalar, opacity: 1.0, nested: None }
+        Self { kind, twosided: false, color, scalar, opacity: 1.0 }
     }
 }
 
@@ -141,8 +132,6 @@ pub struct Params8 {
     pub scalar: [F8; SCALARS],
     /// [`BsdfParams::opacity`] per lane
     pub opacity: F8,
-    /// [`BsdfParams::nested`] per lane (read by `blendbsdf` only)
-    pub nested: [Option<&'static [BsdfParams; 2]>; 8],
 }
 
 impl Params8 {
@@ -153,7 +142,6 @@ impl Params8 {
         color: [Vec3x8::ZERO; COLORS],
         scalar: [F8::ZERO; SCALARS],
         opacity: F8::ONE,
-        nested: [None; 8],
     };
 
     /// All zero: what a kernel that compiles no registry BSDF carries (it reads no slot, and the
@@ -165,7 +153,6 @@ impl Params8 {
         color: [Vec3x8::ZERO; COLORS],
         scalar: [F8::ZERO; SCALARS],
         opacity: F8::ZERO,
-        nested: [None; 8],
     };
 
     /// One row in every lane.
@@ -177,7 +164,6 @@ impl Params8 {
             color: p.color.map(Vec3x8::splat),
             scalar: p.scalar.map(F8::splat),
             opacity: F8::splat(p.opacity),
-            nested: [p.nested; 8],
         }
     }
 
@@ -189,7 +175,6 @@ impl Params8 {
             color: std::array::from_fn(|c| Vec3x8::from_lanes(p.map(|p| p.color[c]))),
             scalar: std::array::from_fn(|c| F8::new(p.map(|p| p.scalar[c]))),
             opacity: F8::new(p.map(|p| p.opacity)),
-            nested: p.map(|p| p.nested),
         }
     }
 

@@ -118,7 +118,6 @@ pub fn params(diffuse: Vec3, specular: Vec3, eta: f32, nonlinear: bool) -> BsdfP
         color: [diffuse, specular, Vec3::ZERO],
         scalar: [eta, diffuse_fresnel(1.0 / eta), w, if nonlinear { 1.0 } else { 0.0 }],
         opacity: 1.0,
-        nested: None,
     }
 }
 

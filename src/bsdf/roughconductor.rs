@@ -114,6 +114,5 @@ pub fn params(
         color: [eta, k, specular],
         scalar: [alpha_u, alpha_v, kind.code(sample_visible), 0.0],
         opacity: 1.0,
-        nested: None,
     }
 }

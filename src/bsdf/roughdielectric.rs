@@ -144,7 +144,6 @@ pub fn params(
         color: [reflectance, transmittance, Vec3::ZERO],
         scalar: [eta, alpha_u, alpha_v, kind.code(sample_visible)],
         opacity: 1.0,
-        nested: None,
     }
 }
 

@@ -233,7 +233,6 @@ pub fn params(
         color: [diffuse, specular, Vec3::new(id as f32, if nonlinear { 1.0 } else { 0.0 }, 0.0)],
         scalar: [eta, alpha, kind.code(sample_visible), w],
         opacity: 1.0,
-        nested: None,
     }
 }
 

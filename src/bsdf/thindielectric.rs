@@ -58,6 +58,5 @@ pub fn params(eta: f32, reflectance: Vec3, transmittance: Vec3) -> BsdfParams {
         color: [reflectance, transmittance, Vec3::ZERO],
         scalar: [eta, 0.0, 0.0, 0.0],
         opacity: 1.0,
-        nested: None,
     }
 }
