@@ -27,7 +27,7 @@ impl<'a> Tracer<'a> {
 
     /// Closest hit of the `active` lanes of `rh` (a camera or bounce packet; camera packets carry
     /// Embree's coherent flag). Returns the lanes traced.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&mut self, rh: &mut RayHit8, kind: RayKind, active: Mask8) -> Mask8 {
         debug_assert!(kind != RayKind::Shadow, "shadow rays go through `occluded`");
         if let Some(l) = self.log.as_deref_mut() {
@@ -43,7 +43,7 @@ impl<'a> Tracer<'a> {
 
     /// [`Tracer::intersect`] over a batch of packets traced back to back; each mask becomes the
     /// lanes traced.
-    #[inline]
+    #[inline(always)]
     pub fn intersect_all(&mut self, packets: &mut [(RayHit8, Mask8)], kind: RayKind) {
         let _p = crate::profile::scope(crate::profile::Phase::EmbreeIntersect);
         for (rh, active) in packets.iter_mut() {
@@ -52,7 +52,7 @@ impl<'a> Tracer<'a> {
     }
 
     /// Occlusion of the `active` lanes of the shadow packet `ray`: the lanes that are blocked.
-    #[inline]
+    #[inline(always)]
     pub fn occluded(&mut self, ray: &mut Ray8, active: Mask8) -> Mask8 {
         if let Some(l) = self.log.as_deref_mut() {
             l.shadow.push((*ray, active));
@@ -85,13 +85,13 @@ pub struct TileCtx<'a> {
 
 impl TileCtx<'_> {
     /// Closest hit of a camera or bounce packet, counted and logged ([`Tracer::intersect`]).
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&mut self, rh: &mut RayHit8, kind: RayKind, active: Mask8) -> Mask8 {
         self.tracer.intersect(rh, kind, active)
     }
 
     /// Occlusion of a shadow packet, counted and logged ([`Tracer::occluded`]).
-    #[inline]
+    #[inline(always)]
     pub fn occluded(&mut self, ray: &mut Ray8, active: Mask8) -> Mask8 {
         self.tracer.occluded(ray, active)
     }
