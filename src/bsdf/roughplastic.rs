@@ -11,10 +11,12 @@
 //! (1 - t(wo)) w, the cosine lobe to t(wo) (1 - w), w = mean(specular) / (mean(diffuse) +
 //! mean(specular)). Isotropic, one-sided.
 //!
-//! Slots: `color[0]` diff / (pi eta^2), `color[1]` specular reflectance, `color[2].x` the id of
-//! the transmittance table (a process-wide list, one per distinct (distribution, alpha, eta)),
-//! `scalar[0]` eta = int_ior / ext_ior, `scalar[1]` alpha, `scalar[2]` the distribution's
-//! [`Distribution::code`], `scalar[3]` w.
+//! Slots: `color[0]` the diffuse reflectance d, `color[1]` the specular reflectance (both may
+//! come from textures per hit: the renormalization of d is done at shading, as Mitsuba's),
+//! `color[2].x` the id of the transmittance table (a process-wide list, one per distinct
+//! (distribution, alpha, eta)), `color[2].y` 1 for `nonlinear` (0 otherwise), `scalar[0]` eta =
+//! int_ior / ext_ior, `scalar[1]` alpha, `scalar[2]` the distribution's [`Distribution::code`],
+//! `scalar[3]` w (from the reflectances' means, as Mitsuba's from the textures' means).
 
 use super::fresnel::dielectric_x8;
 use super::interface::{flags, flags_where, Bsdf, BsdfParams, Params8, Sample8};
@@ -103,6 +105,22 @@ fn transmittance(id: F8, mu: F8) -> F8 {
     }))
 }
 
+/// The diffuse term diff / (pi eta^2) per lane: the base reflectance `color[0]` renormalized for
+/// the light the coating's inside reflects back (module docs).
+#[inline]
+fn diffuse_term(p: &Params8) -> Vec3x8 {
+    let internal = {
+        let tables = TABLES.read().unwrap_or_else(|e| e.into_inner());
+        let ids = p.color[2].x.to_array();
+        F8::new(std::array::from_fn(|i| tables.get(ids[i] as usize).map_or(0.0, |t| t.internal)))
+    };
+    let nonlinear = p.color[2].y.simd_gt(F8::ZERO);
+    let scale = F8::splat(std::f32::consts::FRAC_1_PI) / (p.scalar[0] * p.scalar[0]);
+    let renorm = |c: F8| c / (F8::ONE - nonlinear.select(c, F8::ONE) * internal) * scale;
+    let d = p.color[0];
+    Vec3x8::new(renorm(d.x), renorm(d.y), renorm(d.z))
+}
+
 /// (specular probability, transmittance at wo) per lane.
 #[inline]
 fn lobe_choice(p: &Params8, wo: Vec3x8) -> (F8, F8) {
@@ -135,7 +153,7 @@ impl Bsdf for RoughPlastic {
         let (prob_s, t_o) = lobe_choice(p, wo);
         let t_i = transmittance(p.color[2].x, wi.z);
         let spec = p.color[1].scale(fres * fs);
-        let diff = p.color[0].scale(t_o * t_i);
+        let diff = diffuse_term(p).scale(t_o * t_i);
         let f = Vec3x8::select(up, spec + diff, Vec3x8::ZERO);
         let pdf = prob_s * ps_dir + (F8::ONE - prob_s) * cosine_hemisphere_pdf_x8(wi, up);
         (f, up.select(pdf, F8::ZERO))
@@ -207,15 +225,12 @@ pub fn params(
             list.len() - 1
         })
     });
-    let internal = TABLES.read().unwrap_or_else(|e| e.into_inner())[id].internal;
-    let renorm = |c: f32| if nonlinear { c / (1.0 - c * internal) } else { c / (1.0 - internal) };
-    let diff = Vec3::new(renorm(diffuse.x), renorm(diffuse.y), renorm(diffuse.z)) * (std::f32::consts::FRAC_1_PI / (eta * eta));
     let (dm, sm) = (diffuse.element_sum() / 3.0, specular.element_sum() / 3.0);
     let w = if dm + sm > 0.0 { sm / (dm + sm) } else { 0.0 };
     BsdfParams {
         kind: RoughPlastic::ID,
         twosided: false,
-        color: [diff, specular, Vec3::new(id as f32, 0.0, 0.0)],
+        color: [diffuse, specular, Vec3::new(id as f32, if nonlinear { 1.0 } else { 0.0 }, 0.0)],
         scalar: [eta, alpha, kind.code(sample_visible), w],
         opacity: 1.0,
     }

@@ -85,13 +85,13 @@ pub struct TileCtx<'a> {
 
 impl TileCtx<'_> {
     /// Closest hit of a camera or bounce packet, counted and logged ([`Tracer::intersect`]).
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&mut self, rh: &mut RayHit8, kind: RayKind, active: Mask8) -> Mask8 {
         self.tracer.intersect(rh, kind, active)
     }
 
     /// Occlusion of a shadow packet, counted and logged ([`Tracer::occluded`]).
-    #[inline]
+    #[inline(always)]
     pub fn occluded(&mut self, ray: &mut Ray8, active: Mask8) -> Mask8 {
         self.tracer.occluded(ray, active)
     }

@@ -4,7 +4,7 @@
 
 use super::desc::{EnvironmentDesc, IntegratorKind, SceneDesc};
 use super::sensor::Projection;
-use crate::bsdf::interface::{flags, BsdfSet};
+use crate::bsdf::interface::flags;
 use crate::light::desc::DeltaLightDesc;
 use crate::sampling::filter::PixelFilter;
 
@@ -35,8 +35,12 @@ pub fn refusal(desc: &SceneDesc) -> Option<&'static str> {
     if desc.materials.iter().any(|m| m.emission != glam::Vec3::ZERO) {
         return Some("emissive materials (only area, point, spot and projector emitters start light paths)");
     }
-    let transmits = |kind: u32| crate::bsdf::AllBsdfs::flags_of(kind) & flags::TRANSMISSION != 0;
-    if desc.materials.iter().any(|m| transmits(m.bsdf.kind)) {
+    let transmits = |m: &crate::bsdf::BsdfParams| {
+        m.kind != crate::bsdf::interface::COURSE
+            && crate::bsdf::blendbsdf::row_flags(&crate::bsdf::BsdfParams { opacity: 1.0, ..*m }) & flags::TRANSMISSION
+                != 0
+    };
+    if desc.materials.iter().any(|m| transmits(&m.bsdf)) {
         return Some("BSDFs that transmit (the adjoint of refraction's radiance scaling is not written)");
     }
     if !desc.emissive_spheres.is_empty() {

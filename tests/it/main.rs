@@ -21,6 +21,7 @@ mod kernels;
 mod layering;
 mod light_selection;
 mod light_warp;
+mod materials_mitsuba;
 mod mitsuba_corpus;
 mod nee_below;
 mod normals;

@@ -1,7 +1,7 @@
 //! `<bsdf type="roughconductor">`: a rough metal (`bsdf::roughconductor`). `distribution`
 //! (`beckmann` default, `ggx`), `alpha` (0.1) or `alpha_u` and `alpha_v` (anisotropic),
 //! `sample_visible` (true), `material` or `eta`/`k` as `conductor` (default `none`: a perfect
-//! mirror), `specular_reflectance` (1). Roughness and reflectance may be textures (evaluated per
+//! mirror), `specular_reflectance` (1). Roughness, eta, k and reflectance may be textures (evaluated per
 //! hit into the row's slots). One-sided unless in a `twosided`.
 
 use super::{Build, Plugin, Run};
@@ -63,7 +63,7 @@ pub fn microfacet<'e>(
 fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<Material, SceneError> {
     p.ignore("id");
     let (kind, au, av, visible) = microfacet(b, p, true, Some([Slot::Scalar(0), Slot::Scalar(1)]))?;
-    let (eta, k) = super::conductor::eta_k(p)?;
+    let (eta, k) = super::conductor::eta_k(b, p)?;
     let specular = b.color_param(p, "specular_reflectance", Vec3::ONE, Slot::Color(2))?;
     Ok(super::diffuse::registry_material(crate::bsdf::roughconductor::params(kind, au, av, visible, eta, k, specular)))
 }
