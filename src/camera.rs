@@ -5,8 +5,9 @@
 //! Layer: above `scene` and `sampler`, below `integrator` and `render` (both import it).
 
 use crate::sampler::{PointSet, SamplerKind, Stream};
-use crate::scene::build::{Camera as Lens, Pinhole8};
 use crate::sampling::filter::FilterWarp;
+use crate::scene::build::Camera as Lens;
+use crate::scene::pinhole::Pinhole8;
 use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
 
 /// Sampler dimension of the camera (pixel) jitter.
@@ -127,7 +128,8 @@ impl<'a> Camera<'a> {
     pub fn new(lens: &'a Lens, pixel_set: &'a PointSet, seed: u64, first_sample: FirstSample) -> Self {
         let centre = first_sample == FirstSample::Centre && pixel_set.kind() != SamplerKind::GRID_CENTER;
         let swap = (centre && pixel_set.kind() == SamplerKind::STRATIFIED).then(|| centre_stratum(pixel_set.n()));
-        let pinhole = (lens.filter.is_none() && lens.lens == crate::scene::build::Lens::Pinhole).then(|| lens.pinhole());
+        let pinhole =
+            (lens.filter.is_none() && lens.lens == crate::scene::build::Lens::Pinhole).then(|| lens.pinhole());
         Self { lens, pixel_set, seed, first_sample, centre, swap, pinhole }
     }
 }

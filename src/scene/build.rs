@@ -18,6 +18,7 @@
 use crate::accel::{self, INVALID_ID};
 use crate::light::emitters::{Emitter, Emitters};
 use crate::scene::desc::{CameraDesc, FilmCrop, Material, Projection, SceneDesc, SensorDesc};
+use crate::scene::pinhole::Pinhole8;
 use crate::simd::{Vec3x8, F8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
@@ -200,16 +201,7 @@ impl Camera {
     /// The pinhole's per-image constants, splatted once for many packets ([`Pinhole8::dirs8`]
     /// is [`Camera::dirs8`] bit for bit).
     pub fn pinhole(&self) -> Pinhole8 {
-        let (w, h) = (self.width as f32, self.height as f32);
-        Pinhole8 {
-            eye: Vec3x8::splat(self.eye),
-            forward: Vec3x8::splat(self.look * self.plane_dist),
-            right: Vec3x8::splat(self.right),
-            up: Vec3x8::splat(self.up),
-            x_scale: F8::splat(2.0 / w),
-            y_scale: F8::splat(2.0 / h),
-            aspect: F8::splat(w / h),
-        }
+        Pinhole8::new(self.eye, self.look * self.plane_dist, self.right, self.up, self.width, self.height)
     }
 
     /// Scalar twin of [`Camera::dirs8`].
@@ -218,35 +210,6 @@ impl Camera {
         let sx = (x * (2.0 / w) - 1.0) * (w / h);
         let sy = 1.0 - y * (2.0 / h);
         (self.look * self.plane_dist + self.right * sx + self.up * sy).normalize_or_zero()
-    }
-}
-
-/// The `.test` pinhole's constants for 8 lanes ([`Camera::pinhole`]): what every packet's
-/// directions share, splatted once.
-#[derive(Clone, Copy, Debug)]
-pub struct Pinhole8 {
-    /// the eye, every ray's origin
-    pub eye: Vec3x8,
-    /// the view direction times the image plane's distance
-    forward: Vec3x8,
-    right: Vec3x8,
-    up: Vec3x8,
-    /// 2 / width
-    x_scale: F8,
-    /// 2 / height
-    y_scale: F8,
-    /// width / height
-    aspect: F8,
-}
-
-impl Pinhole8 {
-    /// [`Camera::dirs8`]: unit directions through image positions (x, y) in pixels, y down.
-    #[inline(always)]
-    pub fn dirs8(&self, x: F8, y: F8) -> Vec3x8 {
-        let sx = (x * self.x_scale - F8::ONE) * self.aspect;
-        let sy = F8::ONE - y * self.y_scale;
-        let d = self.forward + self.right.scale(sx) + self.up.scale(sy);
-        d.normalize_or_zero()
     }
 }
 
