@@ -6,6 +6,8 @@
 
 use crate::sampler::{PointSet, SamplerKind, Stream};
 use crate::sampling::filter::FilterWarp;
+use crate::scene::build::Camera as Lens;
+use crate::scene::pinhole::Pinhole8;
 use crate::simd::{mask_from_bools, u8_to_f8, Mask8, Vec3x8, F8, U8};
 
 /// Sampler dimension of the camera (pixel) jitter.
@@ -72,6 +74,12 @@ pub struct Camera<'a> {
     pub seed: u64,
     /// where pixel sample 0 goes
     pub first_sample: FirstSample,
+    /// sample 0 goes through the pixel centre (`FirstSample::Centre`, not `grid-center`)
+    centre: bool,
+    /// with the centre and the stratified layout: the stratum holding the centre (`centre_stratum`)
+    swap: Option<u32>,
+    /// the `.test` camera (pinhole, box filter): its constants, splatted once
+    pinhole: Option<Pinhole8>,
 }
 
 /// Where pixel sample 0 goes (`--first-sample`).
@@ -106,16 +114,23 @@ impl FirstSample {
     }
 }
 
-/// Stratum of sample `s` of an n-point stratified set when sample 0 is at the centre: the stratum
-/// holding (0.5, 0.5) (cell (nx/2, ny/2) of `strata_shape(n)`) is sample 0's, so its own sample
-/// takes stratum 0; every other sample keeps its stratum.
-fn centre_swap(s: u32, n: u32) -> u32 {
+/// The stratum of an n-point stratified set that holds (0.5, 0.5) (cell (nx/2, ny/2) of
+/// `strata_shape(n)`): when sample 0 is at the centre, it is sample 0's, so its own sample takes
+/// stratum 0; every other sample keeps its stratum.
+fn centre_stratum(n: u32) -> u32 {
     let (nx, ny) = crate::sampler::strata_shape(n);
-    let c = (ny / 2) * nx + nx / 2;
-    if s % n == c {
-        0
-    } else {
-        s
+    (ny / 2) * nx + nx / 2
+}
+
+impl<'a> Camera<'a> {
+    /// The camera of lens `lens` drawing its pixel jitter from `pixel_set` (with `seed`), pixel
+    /// sample 0 placed by `first_sample`; what every packet shares is found here once.
+    pub fn new(lens: &'a Lens, pixel_set: &'a PointSet, seed: u64, first_sample: FirstSample) -> Self {
+        let centre = first_sample == FirstSample::Centre && pixel_set.kind() != SamplerKind::GRID_CENTER;
+        let swap = (centre && pixel_set.kind() == SamplerKind::STRATIFIED).then(|| centre_stratum(pixel_set.n()));
+        let pinhole =
+            (lens.filter.is_none() && lens.lens == crate::scene::build::Lens::Pinhole).then(|| lens.pinhole());
+        Self { lens, pixel_set, seed, first_sample, centre, swap, pinhole }
     }
 }
 
@@ -138,26 +153,21 @@ impl Camera<'_> {
 
     /// Whether pixel sample `s` draws from the pixel sampler (sample 0 through the centre does not).
     pub fn draws(&self, s: u32) -> bool {
-        !(self.centre() && s == 0)
-    }
-
-    /// Sample 0 goes through the pixel centre.
-    #[inline]
-    fn centre(&self) -> bool {
-        self.first_sample == FirstSample::Centre && self.pixel_set.kind() != SamplerKind::GRID_CENTER
+        !(self.centre && s == 0)
     }
 
     /// The point k of the pixel set that pixel sample `s` draws (the same for every packet), or
     /// None when it draws none (sample 0 through the pixel centre).
     #[inline]
     pub fn pixel_k(&self, s: u32) -> Option<u32> {
-        let centre = self.centre();
-        if centre && s == 0 {
+        if self.centre && s == 0 {
             return None;
         }
         // Stratified: the sample whose stratum holds the centre takes sample 0's stratum.
-        let stratified = self.pixel_set.kind() == SamplerKind::STRATIFIED;
-        Some(if centre && stratified { centre_swap(s, self.pixel_set.n()) } else { s })
+        Some(match self.swap {
+            Some(c) if s % self.pixel_set.n() == c => 0,
+            _ => s,
+        })
     }
 
     /// The rays of packet `pk` for pixel sample `s` (origins and unit directions), with `point(k)`
@@ -165,13 +175,20 @@ impl Camera<'_> {
     /// [`Camera::stream`]); not called for a sample that does not draw ([`Camera::draws`]).
     #[inline]
     pub fn rays_with(&self, pk: &PixelPacket, s: u32, point: impl FnOnce(u32) -> (F8, F8)) -> (Vec3x8, Vec3x8) {
-        let (jx, jy) = match self.pixel_k(s) {
+        self.rays_k(pk, self.pixel_k(s), point)
+    }
+
+    /// [`Camera::rays_with`] for the point `k` = [`Camera::pixel_k`] of the pixel sample, found
+    /// once for all the packets drawing it.
+    #[inline]
+    pub fn rays_k(&self, pk: &PixelPacket, k: Option<u32>, point: impl FnOnce(u32) -> (F8, F8)) -> (Vec3x8, Vec3x8) {
+        let (jx, jy) = match k {
             None => (F8::splat(0.5), F8::splat(0.5)),
             Some(k) => point(k),
         };
         // The `.test` camera (pinhole, box filter) exactly as it always was: no other work.
-        if self.lens.filter.is_none() && self.lens.lens == crate::scene::build::Lens::Pinhole {
-            return (Vec3x8::splat(self.lens.eye), self.lens.dirs8(pk.x + jx, pk.y + jy));
+        if let Some(pinhole) = &self.pinhole {
+            return (pinhole.eye, pinhole.dirs8(pk.x + jx, pk.y + jy));
         }
         let (x, y) = match &self.lens.filter {
             None => (pk.x + jx, pk.y + jy),

@@ -10,7 +10,7 @@ pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
 use crate::film::{leaf_moments8, push_block, Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
-use crate::simd::Vec3x8;
+use crate::simd::{i32x8, Vec3x8};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -479,16 +479,17 @@ fn accumulate(
     if active == 0 {
         return;
     }
-    let (xs, ys) = (pk.x.to_array(), pk.y.to_array());
-    let j: [usize; 8] = std::array::from_fn(|i| {
-        if active & (1 << i) == 0 {
-            0
-        } else {
-            ((ys[i] as u32 - y0) * tw + (xs[i] as u32 - x0)) as usize
-        }
-    });
-    stack.clear();
-    stack.resize(depth + carries.len(), [[0.0; 8]; 6]);
+    // The pixels' indices in the tile, 8 lanes at once (their coordinates are small whole
+    // numbers; lanes outside the image are never read).
+    let (x, y) = (pk.x.fast_trunc_int(), pk.y.fast_trunc_int());
+    let j = ((y - i32x8::splat(y0 as i32)) * i32x8::splat(tw as i32) + (x - i32x8::splat(x0 as i32))).to_array();
+    let j: [usize; 8] = j.map(|j| j as usize);
+    // Every level is written before it is read (its inactive lanes are never stored), so the
+    // stack keeps its length and contents across packets (no fill).
+    let needed = depth + carries.len();
+    if stack.len() < needed {
+        stack.resize(needed, [[0.0; 8]; 6]);
+    }
     for (l, level) in stack[..depth].iter_mut().enumerate() {
         for i in (0..8).filter(|i| active & (1 << i) != 0) {
             let m = &data[l * tn + j[i]];

@@ -114,8 +114,9 @@ enum Group<'a> {
 
 impl Group<'_> {
     /// A point on the group's light(s) for the unit-square sample `uv` at the hits `sh`, and
-    /// the `active` lanes that got one.
-    #[inline]
+    /// the `active` lanes that got one. Inlined always: the caller's locals receive the 448-byte
+    /// result in place (a call copied it out).
+    #[inline(always)]
     fn sample(
         self,
         it: &Integrator,

@@ -15,7 +15,6 @@ pub struct Wave {
     rh: Vec<(RayHit8, Mask8)>,
     hits: Vec<SurfaceHit8>,
     cam_streams: Vec<Stream<U8>>,
-    one: Vec<Vec3x8>,
 }
 
 /// Radiance of pixel samples `samples` of the tile's packets into `out` (sample-major, as
@@ -36,32 +35,33 @@ pub(super) fn tile(
     if samples.clone().any(|s| ctx.samples.camera_draws(s)) {
         ctx.samples.camera_streams(ctx.pks, &mut wave.cam_streams);
     }
-    let mut one = std::mem::take(&mut wave.one);
+    let n = ctx.pks.len();
     for s in samples {
-        camera_hits(ctx, wave, s, &mut one);
-        shade(ctx, &wave.hits, s, &mut one);
-        debug_assert_eq!(one.len(), ctx.pks.len());
-        out.extend_from_slice(&one);
+        // Sample s's entries of `out`, pushed and shaded in place (no copy per sample).
+        let first = out.len();
+        camera_hits(ctx, wave, s, out);
+        debug_assert_eq!(out.len(), first + n);
+        shade(ctx, &wave.hits, s, &mut out[first..]);
     }
-    wave.one = one;
 }
 
-/// The camera hits of pixel sample `s` of every packet into `wave.hits`, their emission into
-/// `out` (one entry per packet).
+/// The camera hits of pixel sample `s` of every packet into `wave.hits`, their emission pushed
+/// onto `out` (one entry per packet).
 fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>) {
     let n = ctx.pks.len();
-    out.clear();
     // Packets and records are written in place (the buffers keep their length across samples;
     // Embree resets a packet's hit ids itself).
     wave.rh.truncate(n);
     wave.rh.resize(n, (RayHit8::default(), ctx.pks[0].active));
     wave.hits.truncate(n);
     wave.hits.resize(n, SurfaceHit8::MISS);
-    // Camera packets: coherent primary rays from 4x2 pixel blocks; the point's per-k work once.
+    // Camera packets: coherent primary rays from 4x2 pixel blocks; the point drawn and its
+    // per-k work found once for all packets.
+    let k = ctx.samples.camera_k(s);
     let at = if wave.cam_streams.is_empty() { None } else { ctx.samples.camera_point_k(s) };
     for (i, (pk, (rh, active))) in ctx.pks.iter().zip(wave.rh.iter_mut()).enumerate() {
         let (org, dir) = match wave.cam_streams.get(i) {
-            Some(stream) => ctx.samples.camera_rays_in(pk, i as u32, stream, s, at.as_ref()),
+            Some(stream) => ctx.samples.camera_rays_in(pk, i as u32, stream, k, at.as_ref()),
             None => ctx.samples.camera_rays(pk, s),
         };
         *active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
@@ -69,6 +69,7 @@ fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>
     ctx.tracer.intersect_all(&mut wave.rh, RayKind::Camera);
     // Gather: hit records to SoA shading records; emission (none seen under `hide_emitters`).
     let hide = ctx.scene.desc.hide_emitters;
+    let first = out.len();
     for ((rh, traced), sh) in wave.rh.iter().zip(wave.hits.iter_mut()) {
         ctx.scene.gather_into(rh.ray.org(), rh.ray.dir(), &Hits8::from_rayhit(rh, *traced), sh);
         out.push(if hide { Vec3x8::ZERO } else { masked(sh.emitted + sh.le, sh.valid) });
@@ -76,7 +77,7 @@ fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>
     // Camera rays that leave the scene see the environment (none in `.test` scenes).
     let scene = ctx.scene;
     if !hide && (scene.sky.is_some() || scene.envmap.is_some()) {
-        for ((rh, traced), (sh, o)) in wave.rh.iter().zip(wave.hits.iter().zip(out.iter_mut())) {
+        for ((rh, traced), (sh, o)) in wave.rh.iter().zip(wave.hits.iter().zip(out[first..].iter_mut())) {
             let missed = *traced & !sh.valid;
             if missed.none() {
                 continue;

@@ -99,18 +99,19 @@ impl<'a> Samples<'a> {
     }
 
     /// [`Samples::camera_rays`] of packet `i` of the packets of [`Samples::camera_streams`] (`pk`
-    /// that packet, `stream` its stream): the same rays, bit for bit.
-    /// `at` is [`Samples::camera_point_k`] of `s`: the per-k work done once for every packet.
+    /// that packet, `stream` its stream) for the pixel sample whose point is `k` (from
+    /// [`Samples::camera_k`]): the same rays, bit for bit. `at` is [`Samples::camera_point_k`] of
+    /// that sample: the per-k work done once for every packet.
     #[inline]
     pub fn camera_rays_in(
         &self,
         pk: &PixelPacket,
         i: u32,
         stream: &Stream<U8>,
-        s: u32,
+        k: Option<u32>,
         at: Option<&PointK>,
     ) -> (Vec3x8, Vec3x8) {
-        self.camera.rays_with(pk, s, |k| {
+        self.camera.rays_k(pk, k, |k| {
             let _p = profile::leaf(Phase::SamplerPixel);
             replay::camera_point(i, k);
             match at {
@@ -118,6 +119,13 @@ impl<'a> Samples<'a> {
                 _ => stream.point(k),
             }
         })
+    }
+
+    /// The point of the pixel set that pixel sample `s` draws (none: through the pixel centre),
+    /// the same for every packet, for [`Samples::camera_rays_in`].
+    #[inline]
+    pub fn camera_k(&self, s: u32) -> Option<u32> {
+        self.camera.pixel_k(s)
     }
 
     /// The per-k part of pixel sample `s`'s point in the camera streams (none when it draws

@@ -177,7 +177,7 @@ impl Integrator {
 
     /// The camera of this integrator on `scene` (its pixel sampler and seed).
     pub fn camera<'a>(&'a self, scene: &'a Scene) -> Camera<'a> {
-        Camera { lens: &scene.camera, pixel_set: &self.pixel_set, seed: self.seed, first_sample: self.first_sample }
+        Camera::new(&scene.camera, &self.pixel_set, self.seed, self.first_sample)
     }
 }
 

@@ -72,14 +72,19 @@ impl Counters {
     }
     /// Counts one packet of `kind` whose traced lanes are `traced`.
     pub(crate) fn packet(&mut self, kind: RayKind, traced: Mask8) {
-        let n = traced.to_bitmask().count_ones() as u64;
-        let (rays, packets) = match kind {
+        self.count(kind, u64::from(traced.to_bitmask().count_ones()), 1);
+    }
+
+    /// Counts `packets` packets of `kind` that traced `rays` lanes in all.
+    #[inline]
+    pub(crate) fn count(&mut self, kind: RayKind, rays: u64, packets: u64) {
+        let (r, p) = match kind {
             RayKind::Camera => (&mut self.camera, &mut self.camera_packets),
             RayKind::Bounce => (&mut self.bounce, &mut self.bounce_packets),
             RayKind::Shadow => (&mut self.shadow, &mut self.shadow_packets),
         };
-        *rays += n;
-        *packets += 1;
+        *r += rays;
+        *p += packets;
     }
 }
 

@@ -133,6 +133,7 @@ impl Emitter {
     /// Eight points of this light for unit-square samples `(u, v)` (uniform in area), as a light
     /// sample of this light alone (`inv_pmf` 1, index 0); bit-identical to the gathered
     /// [`Emitters::sample_x8`] of the same light.
+    #[inline]
     pub fn sample_x8(&self, u: F8, v: F8) -> LightSample8 {
         let (u0, v0) = (u, v);
         let s = Vec3x8::splat;

@@ -18,6 +18,7 @@
 use crate::accel::{self, INVALID_ID};
 use crate::light::emitters::{Emitter, Emitters};
 use crate::scene::desc::{CameraDesc, FilmCrop, Material, Projection, SceneDesc, SensorDesc};
+use crate::scene::pinhole::Pinhole8;
 use crate::simd::{Vec3x8, F8};
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
@@ -194,14 +195,13 @@ impl Camera {
     /// Unnormalized-then-normalized directions through image positions (x, y) in pixels, y down.
     #[inline]
     pub fn dirs8(&self, x: F8, y: F8) -> Vec3x8 {
-        let (w, h) = (self.width as f32, self.height as f32);
-        let aspect = w / h;
-        let sx = (x * F8::splat(2.0 / w) - F8::ONE) * F8::splat(aspect);
-        let sy = F8::ONE - y * F8::splat(2.0 / h);
-        let d = Vec3x8::splat(self.look * self.plane_dist)
-            + Vec3x8::splat(self.right).scale(sx)
-            + Vec3x8::splat(self.up).scale(sy);
-        d.normalize_or_zero()
+        self.pinhole().dirs8(x, y)
+    }
+
+    /// The pinhole's per-image constants, splatted once for many packets ([`Pinhole8::dirs8`]
+    /// is [`Camera::dirs8`] bit for bit).
+    pub fn pinhole(&self) -> Pinhole8 {
+        Pinhole8::new(self.eye, self.look * self.plane_dist, self.right, self.up, self.width, self.height)
     }
 
     /// Scalar twin of [`Camera::dirs8`].

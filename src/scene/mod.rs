@@ -9,6 +9,7 @@ pub mod mesh;
 pub mod obj;
 pub mod parse;
 pub mod perturb;
+pub mod pinhole;
 pub mod ptracer_check;
 pub mod sensor;
 pub mod texturing;
