@@ -19,6 +19,7 @@
 //! - A sample whose pdf is 0 (m on the horizon, reachable only at u on the unit square's edge) is to
 //!   be dropped by the caller.
 
+pub mod principled;
 pub(crate) mod real;
 #[cfg(test)]
 mod tests;

@@ -70,6 +70,8 @@ registry! {
     roughplastic: RoughPlastic,
     mask: Mask,
     blendbsdf: BlendBsdf,
+    principled: Principled,
+    principledthin: PrincipledThin,
 }
 
 pub use interface::{Bsdf, BsdfParams, BsdfSet, Params8, Sample8};

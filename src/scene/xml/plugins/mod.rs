@@ -27,6 +27,8 @@ mod perspective;
 mod plastic;
 mod ply;
 mod point;
+mod principled;
+mod principledthin;
 mod projector;
 mod ptracer;
 mod rectangle;
@@ -137,8 +139,8 @@ pub const PLUGINS: &[Plugin] = &[
     roughplastic::PLUGIN,
     mask::PLUGIN,
     blendbsdf::PLUGIN,
-    refused("bsdf", "principled", BSDFS),
-    refused("bsdf", "principledthin", BSDFS),
+    principled::PLUGIN,
+    principledthin::PLUGIN,
     bumpmap::PLUGIN,
     normalmap::PLUGIN,
     refused("bsdf", "null", BSDFS),
