@@ -7,9 +7,11 @@
 //! - `eval_pdf` is the nested BSDF's (f, pdf) times the opacity: next event estimation at the
 //!   vertex sees `opacity f` and weighs its MIS against `opacity pdf`;
 //! - `sample` draws the nested BSDF when `u_lobe < opacity` (then `u_lobe / opacity` picks the
-//!   nested lobe) and returns the nested sample as it is: its weight (the opacity cancels) and
-//!   **its own pdf, not scaled by the opacity** (Mitsuba's path tracer uses that pdf for the MIS
-//!   weight of the emitter the direction finds, so strata does too);
+//!   nested lobe) and returns the nested sample's direction and weight (the opacity cancels)
+//!   with the masked pdf, opacity times the nested one (Mitsuba 3.9.1's `sample` returns that
+//!   pdf, queried from the peer; it is the pdf the MIS weight of the emitter the direction finds
+//!   needs, since next events weigh against `eval_pdf`'s: with the nested pdf unscaled the two
+//!   weights sum to more than 1);
 //! - the null sample is a path vertex: Mitsuba's path tracer counts it towards `max_depth`
 //!   (`depth` grows at every valid hit), and its MIS weight at the next emitter is 1 (Null is
 //!   part of Mitsuba's Delta); shadow rays are blocked by masked surfaces (the path tracer's

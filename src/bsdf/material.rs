@@ -179,6 +179,11 @@ impl Material8 {
         let opacity = self.bsdf.opacity;
         let (nested, u_lobe) = mask::choose_x8(opacity, masked, u_lobe);
         let mut s = self.sample_nested_k::<L>(strategy, wo, u, u_lobe, active & nested);
+        // A nested sample's pdf is the masked one, opacity x nested (what `eval_pdf_k` gives and
+        // next events weigh against, as Mitsuba's `mask`); f with it on the course lanes, so that
+        // f cos / pdf (and the interface's weight) stay the nested BSDF's.
+        let o = (masked & nested).select(opacity, F8::ONE);
+        (s.f, s.pdf, s.bsdf.pdf) = (s.f.scale(o), s.pdf * o, s.bsdf.pdf * o);
         let null = active & !nested;
         s.bsdf = mask::sample_x8(opacity, null, wo, s.bsdf);
         s.wi = Vec3x8::select(null, s.bsdf.wi, s.wi);

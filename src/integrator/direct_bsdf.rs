@@ -11,14 +11,13 @@
 //! after a delta lobe (Mitsuba's `Delta` includes the null lobe: a pass-through of a mask finds
 //! the emission behind it with weight 1), where light sampling cannot reach the direction (below
 //! the shading or geometric surface: transmitted light is the BSDF samples' alone), for an
-//! emissive material (never light-sampled) and without emitter sampling. In kernels with masks,
-//! `p_b` of a nested (non-delta) sample is `eval_pdf_k`'s, the opacity times the nested pdf (the
-//! light samples' `p_b` too, so the two weights sum to 1; Mitsuba 3.9's mask returns that pdf from
-//! `sample` as well).
+//! emissive material (never light-sampled) and without emitter sampling. A mask's nested sample
+//! carries the masked pdf, the opacity times the nested one (`bsdf/mask.rs`), the `p_b` the light
+//! samples weigh against too, so the two weights sum to 1.
 
 use super::{Lanes, Mis, DIM_LIGHT_BASE, MIS_STRATEGY};
 use crate::accel::{Hits8, RayHit8};
-use crate::bsdf::interface::{bit, flags as lobe_flags, Bsdf};
+use crate::bsdf::interface::flags as lobe_flags;
 use crate::bsdf::{BsdfSet, LobeSet};
 use crate::integrator::context::{shading_frame, TileCtx};
 use crate::integrator::light_term::{light_pdf_at_hit_pmf, Shading};
@@ -131,19 +130,6 @@ pub(super) fn shade<L: LobeSet>(
             if ok.none() {
                 continue;
             }
-            // A mask's nested lobe: its sample's pdf is the nested BSDF's, while `eval_pdf_k`
-            // (the light samples' weight) scales it by the opacity, as Mitsuba 3.9's `pdf` and
-            // `sample` both do: weigh with that one, so the two weights sum to 1.
-            let pdf = if <L::Bsdfs as BsdfSet>::BITS & bit(crate::bsdf::Mask::ID) != 0 && it.direct.emitter_sampling {
-                let nested = ok & !delta;
-                if nested.any() {
-                    nested.select(at.eval::<L>(wi_l, nested).1, pdf)
-                } else {
-                    pdf
-                }
-            } else {
-                pdf
-            };
             let mut rh = RayHit8::default();
             let traced = rh.ray.set(o, wi, F8::ZERO, F8::splat(f32::INFINITY), ok);
             buf.rays.push((rh, traced));
