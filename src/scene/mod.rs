@@ -4,6 +4,7 @@ pub mod desc;
 pub mod error;
 pub mod gather;
 pub mod instances;
+pub mod lens;
 pub mod limits;
 pub mod mesh;
 pub mod obj;

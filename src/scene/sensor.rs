@@ -1,5 +1,5 @@
 //! Sensor and pixel-filter descriptions of Mitsuba 3 scenes (plain data, filled by a scene front
-//! end; `scene::build` turns them into the camera, `camera.rs` draws through the filter).
+//! end; `scene::lens` turns them into the camera, `camera.rs` draws through the filter).
 //!
 //! Mitsuba's conventions, kept as they are so that a front end copies properties one to one:
 //! - `to_world` maps camera space to world space; the camera looks along camera +z, camera +x is

@@ -201,7 +201,9 @@ pub fn prepare(opts: &RenderOptions) -> Result<(Scene, Integrator), SessionError
     }
     integrator.light_choice = opts.light_choice.unwrap_or(crate::light::select::LightChoice::Reuse);
     // Scenes with sphere lights (Mitsuba's) sample by solid angle unless told otherwise, as
-    // Mitsuba samples spheres; others keep area sampling (the course's convention).
+    // Mitsuba samples spheres; others keep area sampling: the course's convention for `.test`
+    // scenes, and on OBJ and XML quads and triangles solid angle was measured less efficient
+    // (docs/light-selection.md, "Which warp by default"; `light_warp_default_per_scene_kind`).
     integrator.light_warp = opts.light_warp.unwrap_or(if scene.emitters.any_sphere {
         crate::light::warp::LightWarp::SolidAngle
     } else {
