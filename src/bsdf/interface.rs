@@ -223,6 +223,10 @@ pub trait Bsdf: 'static {
     const NAME: &'static str;
     /// Union of its lobes' [`flags`].
     const FLAGS: u32;
+    /// The largest white-furnace albedo E[weight] the model may give (1: it gains no energy). A
+    /// model that is not energy conserving by design (Burley's diffuse retro-reflection in
+    /// `principled`) states its bound; the registry's furnace tests hold it to it.
+    const ALBEDO_BOUND: f32 = 1.0;
     /// (f without the cosine, pdf of `sample` per solid angle) at (wo, wi) on `active` lanes.
     fn eval_pdf(p: &Params8, wo: Vec3x8, wi: Vec3x8, active: Mask8) -> (Vec3x8, F8);
     /// A direction from `u_lobe` (the lobe) and `u` (the direction) on `active` lanes.
@@ -243,6 +247,8 @@ pub struct Member {
     pub flags: u32,
     /// [`Bsdf::test_params`]
     pub test_params: fn() -> Vec<BsdfParams>,
+    /// [`Bsdf::ALBEDO_BOUND`]
+    pub albedo_bound: f32,
 }
 
 /// The [`super::Lobes`] bit of a registry id (the course lobes use the low 8 bits).
@@ -334,7 +340,13 @@ impl<H: Bsdf, T: BsdfSet> BsdfSet for (H, T) {
         T::names(bits, out);
     }
     fn members(out: &mut Vec<Member>) {
-        out.push(Member { id: H::ID, name: H::NAME, flags: H::FLAGS, test_params: H::test_params });
+        out.push(Member {
+            id: H::ID,
+            name: H::NAME,
+            flags: H::FLAGS,
+            test_params: H::test_params,
+            albedo_bound: H::ALBEDO_BOUND,
+        });
         T::members(out);
     }
 }

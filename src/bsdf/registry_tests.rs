@@ -178,7 +178,7 @@ fn sample_weight_matches_eval_over_pdf() {
     }
 }
 
-/// The white furnace: E[weight] <= 1 over the sampled lobes (transmission counted in importance
+/// The white furnace: E[weight] <= 1 (a model's [`super::interface::Bsdf::ALBEDO_BOUND`]) over the sampled lobes (transmission counted in importance
 /// units, weight eta^2, so the 1/eta^2 radiance scaling does not count as a gain).
 #[test]
 fn white_furnace_gains_no_energy() {
@@ -197,7 +197,8 @@ fn white_furnace_gains_no_energy() {
                 }
                 let mean = sum / n as f64;
                 let sd = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-                assert!(mean <= 1.0 + 5.0 * sd + 1e-4, "{} row {r} wo {wo}: furnace {mean} > 1", m.name);
+                let bound = f64::from(m.albedo_bound);
+                assert!(mean <= bound + 5.0 * sd + 1e-4, "{} row {r} wo {wo}: furnace {mean} > {bound}", m.name);
             }
         }
     }
@@ -279,7 +280,7 @@ fn stiff_dirs() -> Vec<Vec3> {
 
 /// Every row (extreme indices, large k) at grazing, normal, critical-angle and back-side
 /// directions gains no energy: the white furnace E[weight] (transmission in importance units,
-/// as [`white_furnace_gains_no_energy`]) is at most 1 from every stiff direction, over 2048
+/// as [`white_furnace_gains_no_energy`]) is at most 1 (the model's `ALBEDO_BOUND`) from every stiff direction, over 2048
 /// stratified samples per direction. (A microfacet projected area that lost its `abs` on the
 /// side below the surface stays finite but gives G1 > 1 there: only this catches it.)
 #[test]
@@ -304,8 +305,9 @@ fn stiff_cases_gain_no_energy() {
                 }
                 let mean = sum / n;
                 let sd = ((sum2 / n - mean * mean).max(0.0) / n).sqrt();
-                if !(mean <= 1.0 + 5.0 * sd + 1e-4) {
-                    gains.push(format!("{} row {r} wo {wo}: furnace {mean} (sd {sd}) > 1", m.name));
+                let bound = f64::from(m.albedo_bound);
+                if !(mean <= bound + 5.0 * sd + 1e-4) {
+                    gains.push(format!("{} row {r} wo {wo}: furnace {mean} (sd {sd}) > {bound}", m.name));
                 }
             }
         }
