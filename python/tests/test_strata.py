@@ -4,6 +4,7 @@ the GIL is released during renders and Ctrl-C raises KeyboardInterrupt."""
 import _thread
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -87,11 +88,18 @@ def test_too_few_points_and_cli_errors_have_the_cli_messages(tmp_path):
 
 
 def test_keyboard_interrupt_stops_a_render(tmp_path):
+    # Python's own Ctrl-C handler, as in an interactive session: a process started in the
+    # background by a non-interactive shell inherits SIGINT ignored, and then Python installs no
+    # handler and `interrupt_main` does nothing (the render would run all its samples).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(1.0, _thread.interrupt_main)
     start = time.monotonic()
     timer.start()
-    with pytest.raises(KeyboardInterrupt, match="render interrupted after"):
-        strata.render(SCENE, spp=10_000_000, threads=1, out=tmp_path / "long")
+    try:
+        with pytest.raises(KeyboardInterrupt, match="render interrupted after"):
+            strata.render(SCENE, spp=10_000_000, threads=1, out=tmp_path / "long")
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert time.monotonic() - start < 30
     # As the CLI on SIGINT: the image and a checkpoint to resume are written.
     assert (tmp_path / "long.ckpt").is_file() and (tmp_path / "long.exr").is_file()
