@@ -32,7 +32,7 @@ use super::interface::{flags, flags_where, Bsdf, BsdfParams, Params8, Sample8};
 use super::microfacet::principled::{
     diffuse_shape, gather, ggx, inv_areas, lerp, negate_where, r0_of_eta, rcp_or_zero, reflect, row,
     sample_visible, schlick, schlick3, schlick_cos_weight, sheen_color, sides_agree, tint, visible_pdf, Entry,
-    CONSTANT, N,
+    defaults_entry, CONSTANT, N,
 };
 use super::microfacet::real::{exp, ln, sincos_2pi};
 use crate::sampling::{cosine_hemisphere_pdf_x8, sample_cosine_hemisphere_x8};
@@ -74,17 +74,7 @@ const RATE_CLEARCOAT: usize = 12;
 const RATE_DIFFUSE: usize = 13;
 
 /// The defaults, for lanes whose entry is missing.
-const DEFAULTS: Entry = Entry { values: defaults(), slots: [CONSTANT; N] };
-
-const fn defaults() -> [f32; N] {
-    let mut v = [0.0; N];
-    let mut j = 0;
-    while j < N {
-        v[j] = PARAMS[j].1;
-        j += 1;
-    }
-    v
-}
+const DEFAULTS: Entry = defaults_entry(&PARAMS);
 
 /// The principled BSDF (see the module docs).
 pub struct Principled;
@@ -290,7 +280,7 @@ impl Bsdf for Principled {
 
     fn test_params() -> Vec<BsdfParams> {
         let row = |base: Vec3, v: &[(usize, f32)]| {
-            let mut values = defaults();
+            let mut values = DEFAULTS.values;
             for &(j, x) in v {
                 values[j] = x;
             }

@@ -27,7 +27,7 @@ use super::fresnel::dielectric_x8;
 use super::interface::{flags, flags_where, Bsdf, BsdfParams, Params8, Sample8};
 use super::microfacet::principled::{
     diffuse_shape, gather, ggx, inv_areas, lerp, negate_where, r0_of_eta, rcp_or_zero, reflect, row, sample_visible,
-    schlick3, schlick_cos_weight, sheen_color, sides_agree, tint, visible_pdf, Entry, CONSTANT, N,
+    schlick3, schlick_cos_weight, sheen_color, sides_agree, tint, visible_pdf, defaults_entry, Entry, CONSTANT, N,
 };
 use crate::sampling::{cosine_hemisphere_pdf_x8, sample_cosine_hemisphere_x8};
 use crate::simd::{Mask8, Vec3x8, F8};
@@ -66,17 +66,7 @@ const RATE_DIFF_TRANS: usize = 11;
 const RATE_DIFF_REFLECT: usize = 12;
 
 /// The defaults, for lanes whose entry is missing.
-const DEFAULTS: Entry = Entry { values: defaults(), slots: [CONSTANT; N] };
-
-const fn defaults() -> [f32; N] {
-    let mut v = [0.0; N];
-    let mut j = 0;
-    while j < PARAMS.len() {
-        v[j] = PARAMS[j].1;
-        j += 1;
-    }
-    v
-}
+const DEFAULTS: Entry = defaults_entry(&PARAMS);
 
 /// The thin principled BSDF (see the module docs).
 pub struct PrincipledThin;
@@ -243,7 +233,7 @@ impl Bsdf for PrincipledThin {
 
     fn test_params() -> Vec<BsdfParams> {
         let row = |base: Vec3, v: &[(usize, f32)]| {
-            let mut values = defaults();
+            let mut values = DEFAULTS.values;
             for &(j, x) in v {
                 values[j] = x;
             }

@@ -20,6 +20,18 @@ use std::sync::RwLock;
 
 /// Scalar parameters an [`Entry`] holds.
 pub const N: usize = 14;
+
+/// The entry of a BSDF's constant defaults: `values[j]` is `params[j]`'s default (the tail past
+/// `params` stays 0), every parameter a constant. For lanes whose entry is missing.
+pub const fn defaults_entry(params: &[(&str, f32, bool)]) -> Entry {
+    let mut values = [0.0; N];
+    let mut j = 0;
+    while j < params.len() {
+        values[j] = params[j].1;
+        j += 1;
+    }
+    Entry { values, slots: [CONSTANT; N] }
+}
 /// [`Entry::slots`] of a constant parameter.
 pub const CONSTANT: u8 = u8::MAX;
 
