@@ -7,12 +7,16 @@
 //! dimension, seed), so the image is bit-identical whatever the thread count or tile schedule.
 
 pub use crate::camera::{tile_packets, PixelPacket, PACKET_H, PACKET_W};
-use crate::film::{leaf_moments8, push_block, Block, Film, Moments};
+use crate::film::{Block, Film, Moments};
 use crate::integrator::{Counters, Integrator, Scratch};
 use crate::scene::build::Scene;
-use crate::simd::{i32x8, Vec3x8};
+use crate::simd::Vec3x8;
+use accumulate::{Moments8, PassBlocks};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+
+mod accumulate;
 use std::time::Instant;
 
 /// Tile side in pixels.
@@ -136,6 +140,19 @@ pub struct TiledFilm {
     /// live blocks of `samples` (every tile's)
     blocks: Vec<Block>,
     tiles: Vec<TileResult>,
+    /// each worker thread's buffers (by rayon's worker index), kept across tiles and passes
+    workers: Vec<Mutex<Worker>>,
+}
+
+/// A worker thread's buffers, made once per worker and reused by every tile it renders (no
+/// allocation or first touch of fresh memory per tile): the integrators' scratch, the batch's
+/// radiance and the packets' block stacks.
+#[derive(Default)]
+struct Worker {
+    scratch: Scratch,
+    radiance: Vec<Vec3x8>,
+    /// `stacks[p * height + level]`: packet p's stack during a tile
+    stacks: Vec<Moments8>,
 }
 
 impl TiledFilm {
@@ -148,7 +165,8 @@ impl TiledFilm {
             .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
             .map(|(tx, ty)| TileResult::from_film(film, tx * TILE, ty * TILE))
             .collect();
-        let tiled = TiledFilm { width: w, height: h, samples: film.samples(), blocks: film.blocks().to_vec(), tiles };
+        let blocks = film.blocks().to_vec();
+        let tiled = TiledFilm { width: w, height: h, samples: film.samples(), blocks, tiles, workers: Vec::new() };
         (tiled, overhead_stats(t, t0))
     }
 
@@ -165,7 +183,6 @@ impl TiledFilm {
         film.drop_block_data(); // the tiles hold the blocks: peak memory 2x the state, not 3x
         let mut data = vec![[0.0; 6]; self.blocks.len() * n];
         for tile in &self.tiles {
-            debug_assert_eq!(tile.blocks, self.blocks);
             tile.store(&mut data, self.width, n);
         }
         film.set_state(self.samples.clone(), self.blocks.clone(), data);
@@ -227,19 +244,39 @@ fn render_source(
     let tiles_x = w.div_ceil(TILE);
     let start = Instant::now();
     let process_start = cpu_time::ProcessTime::now();
+    if have.is_empty() {
+        tiled.samples = samples.start..samples.start;
+    }
+    // The pass's block steps, the same for every pixel.
+    let pass = PassBlocks::push(&mut tiled.blocks, samples.clone());
+    // One buffer set per worker for the whole render (rayon's `map_init` would make one per job
+    // split: many per render, each allocated and first touched again).
+    let threads = pool.current_num_threads();
+    if tiled.workers.len() < threads {
+        tiled.workers.resize_with(threads, Default::default);
+    }
+    let (tiles, workers) = (&mut tiled.tiles, &tiled.workers);
     type Done = (Counters, f64, [u64; crate::profile::N_PHASES], u64);
     let results: Vec<Done> = pool.install(|| {
-        tiled
-            .tiles
+        tiles
             .par_iter_mut()
-            .map_init(Scratch::default, |scratch, tile| {
+            .map(|tile| {
+                let me = rayon::current_thread_index().expect("tiles run on the pool's workers");
+                // (Only a tile that ran inside another on the same worker, which nothing does
+                // today, would find the buffers taken: it gets fresh ones. Buffers never change
+                // the values, so the image is the same whichever worker renders a tile.)
+                let (mut guard, mut spare) = (workers[me].try_lock().ok(), None);
+                let worker = match guard.as_deref_mut() {
+                    Some(w) => w,
+                    None => spare.insert(Worker::default()),
+                };
                 let t0 = cpu_time::ThreadTime::now();
                 let profiling = crate::profile::enabled();
                 let w0 = profiling.then(Instant::now);
                 crate::profile::tile_begin();
                 crate::sampler::replay::tile_begin(tile.y0 / TILE * tiles_x + tile.x0 / TILE);
                 let mut counters = Counters::default();
-                render_tile(scene, integrator, tile, samples.clone(), scratch, &mut counters, images);
+                render_tile(scene, integrator, tile, (&pass, samples.clone()), worker, &mut counters, images);
                 crate::sampler::replay::tile_end();
                 let phases = crate::profile::tile_end();
                 let wall = w0.map_or(0, |w| w.elapsed().as_nanos() as u64);
@@ -257,12 +294,6 @@ fn render_source(
             *a += b;
         }
     }
-    if have.is_empty() {
-        tiled.samples = samples.start..samples.start;
-    }
-    samples.clone().for_each(|s| {
-        push_block(&mut tiled.blocks, Block::leaf(s));
-    });
     tiled.samples.end = samples.end;
     stats.process_cpu_seconds = process_start.elapsed().as_secs_f64();
     stats
@@ -367,14 +398,13 @@ impl SplatImages {
     }
 }
 
-/// Accumulated samples of one tile: the film's dyadic blocks continued (moments level-major,
-/// `data[level * tw * th + pixel in the tile]`).
+/// Accumulated samples of one tile: the film's dyadic blocks continued (the blocks are
+/// `TiledFilm::blocks`; moments level-major, `data[level * tw * th + pixel in the tile]`).
 struct TileResult {
     x0: u32,
     y0: u32,
     tw: u32,
     th: u32,
-    blocks: Vec<Block>,
     data: Vec<Moments>,
 }
 
@@ -392,13 +422,13 @@ impl TileResult {
                 data.extend_from_slice(&src[row..row + tw as usize]);
             }
         }
-        Self { x0, y0, tw, th, blocks: film.blocks().to_vec(), data }
+        Self { x0, y0, tw, th, data }
     }
 
     /// Writes the tile's blocks into the film-wide block-major array (`n` pixels, width `w`).
     fn store(&self, data: &mut [Moments], w: u32, n: usize) {
         let tn = (self.tw * self.th) as usize;
-        for b in 0..self.blocks.len() {
+        for b in 0..self.data.len() / tn {
             for ty in 0..self.th {
                 let i = b * tn + (ty * self.tw) as usize;
                 let j = b * n + ((self.y0 + ty) * w + self.x0) as usize;
@@ -408,127 +438,90 @@ impl TileResult {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Renders the samples of `pass` (the pass's block steps, and its sample range) of one tile and
+/// accumulates them into the tile's blocks: each packet's block stack stays in `worker` through
+/// the batches, loaded from the tile before them and stored after them (see `accumulate`).
 fn render_tile(
     scene: &Scene,
     integrator: &Integrator,
     tile: &mut TileResult,
-    samples: std::ops::Range<u32>,
-    scratch: &mut Scratch,
+    (pass, samples): (&PassBlocks, std::ops::Range<u32>),
+    worker: &mut Worker,
     counters: &mut Counters,
     images: Option<&SplatImages>,
 ) {
     let (x0, y0, tw, th) = (tile.x0, tile.y0, tile.tw, tile.th);
     let (w, h) = (scene.desc.width, scene.desc.height);
     let packets = tile_packets(x0, y0, tw, th, w, h);
-    let tn = (tw * th) as usize;
-    let mut radiance = Vec::with_capacity(packets.len() * SAMPLE_BATCH as usize);
-    let mut carries = Vec::with_capacity(SAMPLE_BATCH as usize);
-    let mut stack = Vec::new();
-    let mut start = samples.start;
+    let (tn, origin) = ((tw * th) as usize, (x0, y0, tw));
+    let Worker { scratch, radiance, stacks } = worker;
+    let height = pass.height.max(1);
+    if stacks.len() < packets.len() * height {
+        stacks.resize(packets.len() * height, [[0.0; 8]; 6]);
+    }
+    let stacks = &mut stacks[..packets.len() * height];
+    {
+        let _acc = crate::profile::scope(crate::profile::Phase::Accumulate);
+        for (pk, st) in packets.iter().zip(stacks.chunks_exact_mut(height)) {
+            accumulate::load(&mut st[..pass.depth], &tile.data, tn, pk, origin);
+        }
+    }
+    let (mut top, mut start) = (pass.depth, samples.start);
     while start < samples.end {
         // A batch of samples is one wavefront (full packets for the path tracer); samples are
         // still accumulated in increasing order.
         let batch = start..samples.end.min(start + SAMPLE_BATCH);
         match images {
-            None => integrator.radiance_tile(scene, &packets, batch.clone(), &mut radiance, scratch, counters, None),
-            Some(im) => im.fill(&packets, batch.clone(), &mut radiance),
+            None => integrator.radiance_tile(scene, &packets, batch.clone(), radiance, scratch, counters, None),
+            Some(im) => im.fill(&packets, batch.clone(), radiance),
         }
         let _acc = crate::profile::scope(crate::profile::Phase::Accumulate);
-        // The block structure is the same for every pixel: one binary-counter step per sample.
-        let depth = tile.blocks.len();
-        carries.clear();
-        carries.extend(batch.clone().map(|s| push_block(&mut tile.blocks, Block::leaf(s))));
-        let levels = depth.max(tile.blocks.len());
-        if tile.data.len() < levels * tn {
-            tile.data.resize(levels * tn, [0.0; 6]);
+        let k = (start - samples.start) as usize;
+        let carries = &pass.carries[k..k + batch.len()];
+        for (p, (pk, st)) in packets.iter().zip(stacks.chunks_exact_mut(height)).enumerate() {
+            let active = pk.active.to_bitmask();
+            accumulate::add_batch(st, top, carries, (&radiance[p..], packets.len()), active, counters);
         }
-        for (p, pk) in packets.iter().enumerate() {
-            let per_pixel = (&radiance[p..], packets.len());
-            accumulate(&mut tile.data, tn, depth, &carries, pk, (x0, y0, tw), per_pixel, &mut stack, counters);
-        }
-        tile.data.truncate(tile.blocks.len() * tn);
+        top = accumulate::top_after(top, carries);
         start = batch.end;
     }
-}
-
-/// The moments of one dyadic level for the 8 lanes of a packet: `[moment][lane]`.
-type Moments8 = [[f64; 8]; 6];
-
-/// Adds a batch of samples of packet `pk` to the dyadic stacks of its pixels in the tile
-/// `(x0, y0, tw)`: `radiance.0[k * radiance.1]` is the packet's value at sample k of the batch;
-/// `depth` live levels of `tn` pixels each before the batch; sample k is a leaf combined with the
-/// top `carries[k]` blocks, as [`push_block`] did to the block list. The 8 pixels' stacks are run
-/// through the batch together in `stack` (lane-wise, the same f64 additions in the same order as
-/// one sample at a time: the values are bit-identical) and written back once. A non-finite lane
-/// value is counted and replaced by zero so no NaN or Inf ever reaches the image.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn accumulate(
-    data: &mut [Moments],
-    tn: usize,
-    depth: usize,
-    carries: &[usize],
-    pk: &PixelPacket,
-    (x0, y0, tw): (u32, u32, u32),
-    (radiance, stride): (&[Vec3x8], usize),
-    stack: &mut Vec<Moments8>,
-    counters: &mut Counters,
-) {
-    let active = pk.active.to_bitmask();
-    if active == 0 {
-        return;
-    }
-    // The pixels' indices in the tile, 8 lanes at once (their coordinates are small whole
-    // numbers; lanes outside the image are never read).
-    let (x, y) = (pk.x.fast_trunc_int(), pk.y.fast_trunc_int());
-    let j = ((y - i32x8::splat(y0 as i32)) * i32x8::splat(tw as i32) + (x - i32x8::splat(x0 as i32))).to_array();
-    let j: [usize; 8] = j.map(|j| j as usize);
-    // Every level is written before it is read (its inactive lanes are never stored), so the
-    // stack keeps its length and contents across packets (no fill).
-    let needed = depth + carries.len();
-    if stack.len() < needed {
-        stack.resize(needed, [[0.0; 8]; 6]);
-    }
-    for (l, level) in stack[..depth].iter_mut().enumerate() {
-        for i in (0..8).filter(|i| active & (1 << i) != 0) {
-            let m = &data[l * tn + j[i]];
-            for q in 0..6 {
-                level[q][i] = m[q];
-            }
-        }
-    }
-    let mut top = depth;
-    for (k, &c) in carries.iter().enumerate() {
-        let l = &radiance[k * stride];
-        let finite = l.is_finite();
-        counters.nonfinite += u64::from((active & !finite.to_bitmask()).count_ones());
-        // A non-finite lane is zero in every channel.
-        let zero = crate::simd::F8::ZERO;
-        let rgb = [finite.select(l.x, zero), finite.select(l.y, zero), finite.select(l.z, zero)].map(|c| c.to_array());
-        let mut acc: Moments8 = leaf_moments8(rgb);
-        for _ in 0..c {
-            top -= 1;
-            let left = &stack[top];
-            for q in 0..6 {
-                for i in 0..8 {
-                    acc[q][i] += left[q][i];
-                }
-            }
-        }
-        stack[top] = acc;
-        top += 1;
-    }
-    for (l, level) in stack[..top].iter().enumerate() {
-        for i in (0..8).filter(|i| active & (1 << i) != 0) {
-            data[l * tn + j[i]] = std::array::from_fn(|q| level[q][i]);
-        }
+    debug_assert_eq!(top, pass.levels);
+    let _acc = crate::profile::scope(crate::profile::Phase::Accumulate);
+    tile.data.clear();
+    tile.data.resize(pass.levels * tn, [0.0; 6]);
+    for (pk, st) in packets.iter().zip(stacks.chunks_exact(height)) {
+        accumulate::store(&st[..pass.levels], &mut tile.data, tn, pk, origin);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::film::{push_block, Block};
+
+    /// The tile loop's steps for one batch as one call (what the tests below run): the stack of
+    /// `depth` levels loaded from `data`, the batch added, the levels after it stored back.
+    #[allow(clippy::too_many_arguments)]
+    fn accumulate(
+        data: &mut [Moments],
+        tn: usize,
+        depth: usize,
+        carries: &[usize],
+        pk: &PixelPacket,
+        origin: (u32, u32, u32),
+        radiance: (&[Vec3x8], usize),
+        stack: &mut Vec<Moments8>,
+        counters: &mut Counters,
+    ) {
+        let carries: Vec<u8> = carries.iter().map(|&c| c as u8).collect();
+        stack.resize(depth + carries.len(), [[0.0; 8]; 6]);
+        accumulate::load(&mut stack[..depth], data, tn, pk, origin);
+        if pk.active.to_bitmask() != 0 {
+            accumulate::add_batch(stack, depth, &carries, radiance, pk.active.to_bitmask(), counters);
+        }
+        let top = accumulate::top_after(depth, &carries);
+        accumulate::store(&stack[..top], data, tn, pk, origin);
+    }
     use crate::simd::{Vec3x8, F8};
 
     /// Batches of samples accumulated packet-wise give the same block moments, bit for bit, as
