@@ -99,12 +99,10 @@ pub(crate) fn add_batch(
     active: u32,
     counters: &mut Counters,
 ) {
-    let mut nonfinite = 0;
-    for (l, &c) in radiance.iter().step_by(stride).zip(carries) {
-        // x - x is 0 for a finite x and NaN for an infinite or NaN one: a lane is finite in every
-        // channel where the sum of the three is 0.
-        let finite = ((l.x - l.x) + (l.y - l.y) + (l.z - l.z)).simd_eq(F8::ZERO);
-        nonfinite += (active & !finite.to_bitmask()).count_ones();
+    for (k, &c) in carries.iter().enumerate() {
+        let l = &radiance[k * stride];
+        let finite = l.is_finite();
+        counters.nonfinite += u64::from((active & !finite.to_bitmask()).count_ones());
         // A non-finite lane is zero in every channel.
         let zero = F8::ZERO;
         let rgb = [finite.select(l.x, zero), finite.select(l.y, zero), finite.select(l.z, zero)].map(|c| c.to_array());
@@ -121,7 +119,6 @@ pub(crate) fn add_batch(
         stack[top] = acc;
         top += 1;
     }
-    counters.nonfinite += u64::from(nonfinite);
 }
 
 /// Live blocks after a batch with `carries` on a stack of `top`.
