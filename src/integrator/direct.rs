@@ -99,7 +99,96 @@ impl Estimator for Direct {
         out: &mut Vec<Vec3x8>,
     ) {
         let DirectScratch { wave, buf, bsdf } = sc;
+        if each_packet(it, ctx.scene) {
+            // The light sampling of pixel sample s, set up once per sample.
+            let mut at: Option<(u32, OneLight)> = None;
+            return primary::tile_each(ctx, wave, samples, out, |ctx, sh, i, s, o| {
+                let one = match &at {
+                    Some((t, one)) if *t == s => one,
+                    _ => &at.insert((s, OneLight::new(it, &ctx.samples, s))).1,
+                };
+                shade_packet::<L>(it, ctx, one, sh, i, o);
+            });
+        }
         primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, bsdf, s, out));
+    }
+}
+
+/// Whether `direct` shades packet by packet ([`primary::tile_each`], [`shade_packet`]): light
+/// samples alone, one light each, from the light table (not per-sample streams), and nothing
+/// outside the scene's area lights; not while the sampler replay log records (it keeps the
+/// wavefront's order of draws). The same radiance as the wavefront, bit for bit.
+fn each_packet(it: &Integrator, scene: &Scene) -> bool {
+    let d = it.direct;
+    d.emitter_sampling
+        && d.bsdf_samples == 0
+        && it.light_selection.picks_one()
+        && !it.light_streams()
+        && !scene.emitters.is_empty()
+        && scene.sky.is_none()
+        && scene.envmap.is_none()
+        && scene.delta.is_empty()
+        && !crate::sampler::replay::recording()
+}
+
+/// [`shade_one`]'s per-sample constants for [`shade_packet`].
+struct OneLight {
+    one_light: bool,
+    own_choice: bool,
+    table: LightTable,
+    choice_table: LightTable,
+    inv_n: F8,
+}
+
+impl OneLight {
+    fn new(it: &Integrator, smp: &Samples, s: u32) -> Self {
+        let one_light = it.light_sampler.certain();
+        Self {
+            one_light,
+            own_choice: !one_light && it.light_choice == LightChoice::Dimension,
+            table: LightTable::new(it, smp, LIGHT_POINT.first, s),
+            choice_table: LightTable::new(it, smp, LIGHT_CHOICE.first, s),
+            inv_n: F8::splat(1.0 / it.light_set.n() as f32),
+        }
+    }
+}
+
+/// [`shade_one`] (light table, no MIS) at the hits `sh` of packet `i`, added to its radiance `o`:
+/// each light sample's shadow ray traced at once.
+#[inline(always)]
+fn shade_packet<L: LobeSet>(
+    it: &Integrator,
+    ctx: &mut TileCtx,
+    c: &OneLight,
+    sh: &SurfaceHit8,
+    i: usize,
+    o: &mut Vec3x8,
+) {
+    let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)));
+    if shade.none() {
+        return;
+    }
+    let TileCtx { scene, pks, tracer, samples: smp } = ctx;
+    let eps = scene.offset_eps(sh.p);
+    let pixel = pks[i].pixel;
+    for k in 0..it.light_set.n() {
+        let uv = c.table.point(smp, pixel, k);
+        let choice = if c.one_light {
+            AreaChoice::Certain
+        } else if c.own_choice {
+            AreaChoice::Drawn(c.choice_table.point(smp, pixel, k).0)
+        } else {
+            AreaChoice::Reuse
+        };
+        let (ls, ok) = area_sample(it, scene, sh, shade, choice, uv);
+        let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| {
+            let g = g * ls.area * ls.inv_pmf * c.inv_n;
+            masked(f.mul_elem(ls.radiance).scale(g), lit)
+        };
+        if let Some((contrib, (mut ray, lit))) = light_event::<L>(scene, sh, eps, &ls, ok, weigh, None) {
+            let occluded = tracer.occluded(&mut ray, lit);
+            *o += masked(contrib, lit & !occluded);
+        }
     }
 }
 
@@ -392,7 +481,6 @@ fn sample_batch<L: LobeSet>(
     target: &mut [Vec3x8],
     mis: Option<Mis>,
 ) {
-    let strategy = if mis.is_some() { MIS_STRATEGY } else { ImportanceSampling::Cosine };
     batch.clear();
     // Per shading packet: the point, the light point, the light term and the shadow packet, in
     // one pass (the sampler and emitter calls are leaf spans).
@@ -405,38 +493,56 @@ fn sample_batch<L: LobeSet>(
         let uv = point(i, j);
         let (ls, ok) = sample(sh, shade, i, j, uv);
         j += 1;
-        // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-        let PointTerm { wi, d2, inv_d, cos_i, cos_l, lit } = towards(sh, &ls, ok);
-        if lit.none() {
-            continue;
+        if let Some((contrib, ray)) = light_event::<L>(scene, sh, lanes.eps[i], &ls, ok, &weigh, mis) {
+            batch.contrib.push(contrib);
+            batch.push(ray, i);
         }
-        let frame = shading_frame::<L>(scene, sh);
-        let mat = &sh.mat;
-        let at = Shading::new(sh, &frame, strategy);
-        let (mut f, pdf_b) = at.eval::<L>(at.frame.to_local(wi), lit);
-        // No shadow ray where a registry BSDF has no value (delta lobes only: Mitsuba samples
-        // no emitter there).
-        let lit = if <L::Bsdfs as BsdfSet>::BITS != 0 {
-            lit & !(mat.general(lit) & f.max_elem().simd_le(F8::ZERO))
-        } else {
-            lit
-        };
-        if lit.none() {
-            continue;
-        }
-        if let Some(mis) = &mis {
-            // The light sample's solid-angle pdf: d^2 / (cos_l A inv_pmf), A the light's area
-            // (or `light::warp`'s 1 / pdf per area).
-            let p_e = d2 / (ls.area * cos_l * ls.inv_pmf);
-            f = f.scale(mis.light(p_e, pdf_b, lit));
-        }
-        batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
-        // Shadow packet from the offset point towards the light sample, stopping short.
-        let o = sh.ng.mul_add(lanes.eps[i], sh.p);
-        let (d, tfar) = point_shadow(scene, o, ls.y, inv_d);
-        batch.push(Ray8::new(o, d, F8::ZERO, tfar, lit), i);
     }
     batch.trace(tracer, target);
+}
+
+/// The light term of the light sample `ls` (lanes `ok`) at the hits `sh`: what it adds if its
+/// shadow ray is clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`, f times its MIS weight
+/// when `mis` is given) and that shadow ray (from the hits offset by `eps`, with its lanes), or
+/// None where no lane is lit.
+#[inline(always)]
+fn light_event<L: LobeSet>(
+    scene: &Scene,
+    sh: &SurfaceHit8,
+    eps: F8,
+    ls: &LightSample8,
+    ok: Mask8,
+    weigh: impl Fn(&LightSample8, Vec3x8, F8, Mask8) -> Vec3x8,
+    mis: Option<Mis>,
+) -> Option<(Vec3x8, (Ray8, Mask8))> {
+    let strategy = if mis.is_some() { MIS_STRATEGY } else { ImportanceSampling::Cosine };
+    // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
+    let PointTerm { wi, d2, inv_d, cos_i, cos_l, lit } = towards(sh, ls, ok);
+    if lit.none() {
+        return None;
+    }
+    let frame = shading_frame::<L>(scene, sh);
+    let mat = &sh.mat;
+    let at = Shading::new(sh, &frame, strategy);
+    let (mut f, pdf_b) = at.eval::<L>(at.frame.to_local(wi), lit);
+    // No shadow ray where a registry BSDF has no value (delta lobes only: Mitsuba samples
+    // no emitter there).
+    let lit =
+        if <L::Bsdfs as BsdfSet>::BITS != 0 { lit & !(mat.general(lit) & f.max_elem().simd_le(F8::ZERO)) } else { lit };
+    if lit.none() {
+        return None;
+    }
+    if let Some(mis) = &mis {
+        // The light sample's solid-angle pdf: d^2 / (cos_l A inv_pmf), A the light's area
+        // (or `light::warp`'s 1 / pdf per area).
+        let p_e = d2 / (ls.area * cos_l * ls.inv_pmf);
+        f = f.scale(mis.light(p_e, pdf_b, lit));
+    }
+    let contrib = weigh(ls, f, cos_i * cos_l * inv_d * inv_d, lit);
+    // Shadow packet from the offset point towards the light sample, stopping short.
+    let o = sh.ng.mul_add(eps, sh.p);
+    let (d, tfar) = point_shadow(scene, o, ls.y, inv_d);
+    Some((contrib, Ray8::new(o, d, F8::ZERO, tfar, lit)))
 }
 
 /// Shadow packets of a batch and what each adds to its owner's radiance if unoccluded.

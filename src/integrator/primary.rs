@@ -17,6 +17,68 @@ pub struct Wave {
     cam_streams: Vec<Stream<U8>>,
 }
 
+/// [`tile`] packet by packet: each camera packet of a pixel sample is traced, gathered and shaded
+/// (`shade(ctx, hits, packet, s, radiance)`, `radiance` holding the emission) before the next, in
+/// one hit record that stays in cache, instead of a wavefront of the tile's records (2 KiB each);
+/// packets with no hit lane are not gathered or shaded. The same radiance, bit for bit, when
+/// `shade` adds to a packet what [`tile`]'s closure adds to its entry, in the same order.
+#[inline(always)]
+pub(super) fn tile_each(
+    ctx: &mut TileCtx,
+    wave: &mut Wave,
+    samples: std::ops::Range<u32>,
+    out: &mut Vec<Vec3x8>,
+    mut shade: impl FnMut(&mut TileCtx, &SurfaceHit8, usize, u32, &mut Vec3x8),
+) {
+    out.clear();
+    wave.cam_streams.clear();
+    if samples.clone().any(|s| ctx.samples.camera_draws(s)) {
+        ctx.samples.camera_streams(ctx.pks, &mut wave.cam_streams);
+    }
+    // One packet and one record, reused (the record is written whole by the gather).
+    wave.rh.truncate(1);
+    wave.rh.resize(1, (RayHit8::default(), F8::ZERO));
+    wave.hits.truncate(1);
+    wave.hits.resize(1, SurfaceHit8::MISS);
+    let (rh, sh) = (&mut wave.rh[0].0, &mut wave.hits[0]);
+    let scene = ctx.scene;
+    let hide = scene.desc.hide_emitters;
+    let outside = !hide && (scene.sky.is_some() || scene.envmap.is_some());
+    for s in samples {
+        let k = ctx.samples.camera_k(s);
+        let at = if wave.cam_streams.is_empty() { None } else { ctx.samples.camera_point_k(s) };
+        for (i, pk) in ctx.pks.iter().enumerate() {
+            let (org, dir) = match wave.cam_streams.get(i) {
+                Some(stream) => ctx.samples.camera_rays_in(pk, i as u32, stream, k, at.as_ref()),
+                None => ctx.samples.camera_rays(pk, s),
+            };
+            let active = rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
+            let traced = ctx.tracer.intersect(rh, RayKind::Camera, active);
+            let hits = Hits8::from_rayhit(rh, traced);
+            let mut o = Vec3x8::ZERO;
+            if hits.hit.any() {
+                scene.gather_into(rh.ray.org(), rh.ray.dir(), &hits, sh);
+                if !hide {
+                    o = masked(sh.emitted + sh.le, sh.valid);
+                }
+            }
+            // Camera rays that leave the scene see the environment (none in `.test` scenes).
+            let missed = traced & !hits.hit;
+            if outside && missed.any() {
+                o += match (&scene.sky, &scene.envmap) {
+                    (Some(sky), _) => masked(Vec3x8::splat(sky.radiance), missed),
+                    (None, Some(env)) => env.radiance_pdf_x8(rh.ray.dir(), missed).0,
+                    (None, None) => Vec3x8::ZERO,
+                };
+            }
+            if hits.hit.any() {
+                shade(ctx, sh, i, s, &mut o);
+            }
+            out.push(o);
+        }
+    }
+}
+
 /// Radiance of pixel samples `samples` of the tile's packets into `out` (sample-major, as
 /// `Estimator::tile`): emission at the camera hits plus what `shade(ctx, hits, s, radiance)`
 /// adds to `radiance` (one entry per packet, holding the emission) at the hits of sample `s`.
