@@ -44,9 +44,6 @@ pub trait Lanes: Copy {
     fn unit24(self) -> Self::F;
     /// `f` applied to every lane (table look-ups).
     fn map(self, f: impl Fn(u32) -> u32) -> Self;
-    /// The 32 bits of every lane reversed (`u32::reverse_bits`; 8 lanes: LLVM's vector
-    /// bit reversal, a byte shuffle and two nibble look-ups instead of five mask-and-shift steps).
-    fn reverse_bits(self) -> Self;
     /// High word of the 64-bit product.
     fn mulhi(self, o: Self) -> Self {
         self.mul_wide(o).1
@@ -126,9 +123,6 @@ impl Lanes for u32 {
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         f(self)
     }
-    fn reverse_bits(self) -> Self {
-        u32::reverse_bits(self)
-    }
     fn sign_mask(self) -> Self {
         ((self as i32) >> 31) as u32
     }
@@ -207,10 +201,6 @@ impl Lanes for U8 {
     #[inline]
     fn map(self, f: impl Fn(u32) -> u32) -> Self {
         U8::new(self.to_array().map(f))
-    }
-    #[inline]
-    fn reverse_bits(self) -> Self {
-        U8::new(self.to_array().map(u32::reverse_bits))
     }
     #[inline]
     fn lt_mask(self, o: Self) -> Self {

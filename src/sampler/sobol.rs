@@ -189,7 +189,11 @@ pub(super) fn owen24<L: Lanes>(x: L, key: L) -> L {
 /// Reverses the 32 bits of every lane.
 #[inline]
 pub(super) fn reverse_bits<L: Lanes>(x: L) -> L {
-    x.reverse_bits()
+    let mut x = x.shr(16).or(x.shl(16));
+    for (s, m) in [(8, 0x00ff_00ff), (4, 0x0f0f_0f0f), (2, 0x3333_3333), (1, 0x5555_5555)] {
+        x = x.shr(s).and(L::splat(m)).or(x.and(L::splat(m)).shl(s));
+    }
+    x
 }
 
 // ------------------------------------------------------------------------------------------------
