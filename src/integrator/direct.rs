@@ -28,7 +28,7 @@ use super::light_term::{area_sample, point_shadow, towards, AreaChoice, PointTer
 use super::primary::{self, Wave};
 use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
-use crate::accel::{Hits8, Ray8, RayHit8};
+use crate::accel::Ray8;
 use crate::bsdf::{BsdfSet, LobeSet};
 use crate::light::emitters::{Emitter, LightSample8};
 use crate::light::select::LightChoice;
@@ -43,6 +43,8 @@ use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 #[path = "direct_bsdf.rs"]
 mod bsdf_samples;
+#[path = "direct_each.rs"]
+mod each;
 #[path = "direct_env.rs"]
 mod env;
 
@@ -101,111 +103,10 @@ impl Estimator for Direct {
         out: &mut Vec<Vec3x8>,
     ) {
         let DirectScratch { wave, buf, bsdf } = sc;
-        if each_packet(it, ctx.scene) {
-            let mut each = Each::<L> { it, buf, one: None, lobes: std::marker::PhantomData };
-            return primary::tile_each(ctx, wave, samples, out, &mut each);
+        if each::each_packet(it, ctx.scene) {
+            return primary::tile_each(ctx, wave, samples, out, &mut each::Each::<L>::new(it, buf));
         }
         primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, bsdf, s, out));
-    }
-}
-
-/// Whether `direct` shades packet by packet ([`primary::tile_each`], [`shade_packet`]): light
-/// samples alone, one light each, from the light table (not per-sample streams), and nothing
-/// outside the scene's area lights; not while the sampler replay log records (it keeps the
-/// wavefront's order of draws). The same radiance as the wavefront, bit for bit.
-fn each_packet(it: &Integrator, scene: &Scene) -> bool {
-    let d = it.direct;
-    d.emitter_sampling
-        && d.bsdf_samples == 0
-        && it.light_selection.picks_one()
-        && !it.light_streams()
-        && !scene.emitters.is_empty()
-        && scene.sky.is_none()
-        && scene.envmap.is_none()
-        && scene.delta.is_empty()
-        && !crate::sampler::replay::recording()
-}
-
-/// [`shade_one`] packet by packet ([`primary::EachPacket`]): the light points of pixel sample s
-/// drawn for every packet with a hit lane before any is shaded (back to back, as the wavefront
-/// draws them), then each packet's light samples at its hits, their shadow rays traced together
-/// at the end of the sample.
-struct Each<'a, L> {
-    it: &'a Integrator,
-    buf: &'a mut Buffers,
-    /// pixel sample s's constants
-    one: Option<OneLight>,
-    lobes: std::marker::PhantomData<L>,
-}
-
-/// [`shade_one`]'s per-sample constants.
-struct OneLight {
-    one_light: bool,
-    own_choice: bool,
-    choice_table: LightTable,
-    inv_n: F8,
-}
-
-impl<L: LobeSet> primary::EachPacket for Each<'_, L> {
-    fn begin(&mut self, ctx: &mut TileCtx, s: u32, packets: &[(RayHit8, Mask8)]) {
-        let it = self.it;
-        let smp = &ctx.samples;
-        let one_light = it.light_sampler.certain();
-        let table = LightTable::new(it, smp, LIGHT_POINT.first, s);
-        self.one = Some(OneLight {
-            one_light,
-            own_choice: !one_light && it.light_choice == LightChoice::Dimension,
-            choice_table: LightTable::new(it, smp, LIGHT_CHOICE.first, s),
-            inv_n: F8::splat(1.0 / it.light_set.n() as f32),
-        });
-        // The light points of every packet that hit something (a point is a pure function of its
-        // pixel and index: drawing it for a packet that turns out to shade nothing changes no
-        // other).
-        let n = it.light_set.n();
-        let uv = &mut self.buf.uv;
-        uv.clear();
-        for ((rh, traced), pk) in packets.iter().zip(ctx.pks) {
-            let hit = Hits8::from_rayhit(rh, *traced).hit.any();
-            for k in 0..n {
-                uv.push(if hit { table.point(smp, pk.pixel, k) } else { (F8::ZERO, F8::ZERO) });
-            }
-        }
-        self.buf.batch.clear();
-    }
-
-    #[inline(always)]
-    fn shade(&mut self, ctx: &mut TileCtx, sh: &SurfaceHit8, i: usize, _: &mut Vec3x8) {
-        let shade = sh.valid & F8::from_bits(sh.light.simd_eq(U8::splat(u32::MAX)));
-        if shade.none() {
-            return;
-        }
-        let (it, Some(c)) = (self.it, &self.one) else { return };
-        let TileCtx { scene, pks, samples: smp, .. } = ctx;
-        let eps = scene.offset_eps(sh.p);
-        let n = it.light_set.n() as usize;
-        for k in 0..n {
-            let uv = self.buf.uv[i * n + k];
-            let choice = if c.one_light {
-                AreaChoice::Certain
-            } else if c.own_choice {
-                AreaChoice::Drawn(c.choice_table.point(smp, pks[i].pixel, k as u32).0)
-            } else {
-                AreaChoice::Reuse
-            };
-            let (ls, ok) = area_sample(it, scene, sh, shade, choice, uv);
-            let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| {
-                let g = g * ls.area * ls.inv_pmf * c.inv_n;
-                masked(f.mul_elem(ls.radiance).scale(g), lit)
-            };
-            if let Some((contrib, ray)) = light_event::<L>(scene, sh, eps, &ls, ok, weigh, None) {
-                self.buf.batch.contrib.push(contrib);
-                self.buf.batch.push(ray, i);
-            }
-        }
-    }
-
-    fn end(&mut self, ctx: &mut TileCtx, out: &mut [Vec3x8]) {
-        self.buf.batch.trace(&mut ctx.tracer, out);
     }
 }
 
