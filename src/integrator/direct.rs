@@ -43,6 +43,8 @@ use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 #[path = "direct_bsdf.rs"]
 mod bsdf_samples;
+#[path = "direct_each.rs"]
+mod each;
 #[path = "direct_env.rs"]
 mod env;
 
@@ -76,6 +78,8 @@ struct Buffers {
     streams: Vec<Stream<U8>>,
     /// one light per sample, `--light-choice dimension`: the light-choice streams
     choice_streams: Vec<Stream<U8>>,
+    /// packet by packet ([`Each`]): the light points of the sample's packets, N per packet
+    uv: Vec<(F8, F8)>,
 }
 
 /// Per camera packet of the tile: the lanes to shade and the shadow-ray origin offsets.
@@ -99,6 +103,9 @@ impl Estimator for Direct {
         out: &mut Vec<Vec3x8>,
     ) {
         let DirectScratch { wave, buf, bsdf } = sc;
+        if each::each_packet(it, ctx.scene) {
+            return primary::tile_each(ctx, wave, samples, out, &mut each::Each::<L>::new(it, buf));
+        }
         primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, bsdf, s, out));
     }
 }
@@ -392,7 +399,6 @@ fn sample_batch<L: LobeSet>(
     target: &mut [Vec3x8],
     mis: Option<Mis>,
 ) {
-    let strategy = if mis.is_some() { MIS_STRATEGY } else { ImportanceSampling::Cosine };
     batch.clear();
     // Per shading packet: the point, the light point, the light term and the shadow packet, in
     // one pass (the sampler and emitter calls are leaf spans).
@@ -405,38 +411,56 @@ fn sample_batch<L: LobeSet>(
         let uv = point(i, j);
         let (ls, ok) = sample(sh, shade, i, j, uv);
         j += 1;
-        // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
-        let PointTerm { wi, d2, inv_d, cos_i, cos_l, lit } = towards(sh, &ls, ok);
-        if lit.none() {
-            continue;
+        if let Some((contrib, ray)) = light_event::<L>(scene, sh, lanes.eps[i], &ls, ok, &weigh, mis) {
+            batch.contrib.push(contrib);
+            batch.push(ray, i);
         }
-        let frame = shading_frame::<L>(scene, sh);
-        let mat = &sh.mat;
-        let at = Shading::new(sh, &frame, strategy);
-        let (mut f, pdf_b) = at.eval::<L>(at.frame.to_local(wi), lit);
-        // No shadow ray where a registry BSDF has no value (delta lobes only: Mitsuba samples
-        // no emitter there).
-        let lit = if <L::Bsdfs as BsdfSet>::BITS != 0 {
-            lit & !(mat.general(lit) & f.max_elem().simd_le(F8::ZERO))
-        } else {
-            lit
-        };
-        if lit.none() {
-            continue;
-        }
-        if let Some(mis) = &mis {
-            // The light sample's solid-angle pdf: d^2 / (cos_l A inv_pmf), A the light's area
-            // (or `light::warp`'s 1 / pdf per area).
-            let p_e = d2 / (ls.area * cos_l * ls.inv_pmf);
-            f = f.scale(mis.light(p_e, pdf_b, lit));
-        }
-        batch.contrib.push(weigh(&ls, f, cos_i * cos_l * inv_d * inv_d, lit));
-        // Shadow packet from the offset point towards the light sample, stopping short.
-        let o = sh.ng.mul_add(lanes.eps[i], sh.p);
-        let (d, tfar) = point_shadow(scene, o, ls.y, inv_d);
-        batch.push(Ray8::new(o, d, F8::ZERO, tfar, lit), i);
     }
     batch.trace(tracer, target);
+}
+
+/// The light term of the light sample `ls` (lanes `ok`) at the hits `sh`: what it adds if its
+/// shadow ray is clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`, f times its MIS weight
+/// when `mis` is given) and that shadow ray (from the hits offset by `eps`, with its lanes), or
+/// None where no lane is lit.
+#[inline(always)]
+fn light_event<L: LobeSet>(
+    scene: &Scene,
+    sh: &SurfaceHit8,
+    eps: F8,
+    ls: &LightSample8,
+    ok: Mask8,
+    weigh: impl Fn(&LightSample8, Vec3x8, F8, Mask8) -> Vec3x8,
+    mis: Option<Mis>,
+) -> Option<(Vec3x8, (Ray8, Mask8))> {
+    let strategy = if mis.is_some() { MIS_STRATEGY } else { ImportanceSampling::Cosine };
+    // Shade before visibility: f cos_i cos_l / d^2, kept if the shadow ray is clear.
+    let PointTerm { wi, d2, inv_d, cos_i, cos_l, lit } = towards(sh, ls, ok);
+    if lit.none() {
+        return None;
+    }
+    let frame = shading_frame::<L>(scene, sh);
+    let mat = &sh.mat;
+    let at = Shading::new(sh, &frame, strategy);
+    let (mut f, pdf_b) = at.eval::<L>(at.frame.to_local(wi), lit);
+    // No shadow ray where a registry BSDF has no value (delta lobes only: Mitsuba samples
+    // no emitter there).
+    let lit =
+        if <L::Bsdfs as BsdfSet>::BITS != 0 { lit & !(mat.general(lit) & f.max_elem().simd_le(F8::ZERO)) } else { lit };
+    if lit.none() {
+        return None;
+    }
+    if let Some(mis) = &mis {
+        // The light sample's solid-angle pdf: d^2 / (cos_l A inv_pmf), A the light's area
+        // (or `light::warp`'s 1 / pdf per area).
+        let p_e = d2 / (ls.area * cos_l * ls.inv_pmf);
+        f = f.scale(mis.light(p_e, pdf_b, lit));
+    }
+    let contrib = weigh(ls, f, cos_i * cos_l * inv_d * inv_d, lit);
+    // Shadow packet from the offset point towards the light sample, stopping short.
+    let o = sh.ng.mul_add(eps, sh.p);
+    let (d, tfar) = point_shadow(scene, o, ls.y, inv_d);
+    Some((contrib, Ray8::new(o, d, F8::ZERO, tfar, lit)))
 }
 
 /// Shadow packets of a batch and what each adds to its owner's radiance if unoccluded.

