@@ -44,6 +44,8 @@
 //! at the f32 bound, nearly) tangent, starting on the surface, coming from so far away that
 //! u |o'| is comparable to 1 (1e6 radii), or with a degenerate/non-finite direction land in f64.
 //! NaN anywhere makes every comparison false and sends the lane to f64, which rejects it.
+//! A packet whose valid lanes are all certain misses by a cheaper, larger bound (`certain_misses`:
+//! no square root) returns before steps 2-4's square roots and divisions, with the same answer.
 
 // Index loops over small fixed matrices (the Jacobi rotations) read as the maths does.
 #![allow(clippy::needless_range_loop)]
@@ -260,8 +262,15 @@ fn max_abs(v: Vec3x8) -> F8 {
 }
 
 /// The f32 SIMD pass over the `valid` lanes (see the module doc for the bound).
-#[inline]
+#[inline(always)]
 pub(super) fn fast8(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, valid: Mask8) -> Fast8 {
+    fast8_with(e, org, dir, tnear, tfar, valid, true)
+}
+
+/// [`fast8`], with (`early`) or without the early return of a packet whose valid lanes are all
+/// [`certain_misses`] (the same answer either way; the tests compare the two).
+#[inline(always)]
+fn fast8_with(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, valid: Mask8, early: bool) -> Fast8 {
     let none = F8::ZERO;
     if !e.usable {
         return Fast8 { hit: none, t: none, unsure: valid };
@@ -288,6 +297,9 @@ pub(super) fn fast8(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, val
     let f = d.mul_add(b, o);
     let ff = f.dot(f);
     let disc = F8::ONE - ff;
+    if early && (valid & !certain_misses(e_o, e_d, a, inv_a, oo, ff, disc)).none() {
+        return Fast8 { hit: none, t: none, unsure: none };
+    }
     let (dlen, olen, flen) = (a.sqrt(), oo.sqrt(), ff.sqrt());
     let eta = e_d / dlen;
     // Along-ray error of the closest approach (object units), and radial error of f.
@@ -327,16 +339,48 @@ pub(super) fn fast8(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, val
     Fast8 { hit, t: hit.select(t, none), unsure }
 }
 
+/// Lanes that [`fast8`]'s bound answers as certain misses (`ok` and `disc < -e_disc`), found by
+/// a cheaper, larger bound with no square root or division of its own (a packet whose lanes all
+/// miss returns before the bound's 3 square roots and 2 divisions; most packets that reach a
+/// small sphere's callback miss it). With F = |f|, O = |o'|, eta as in [`fast8`] and eps = 2^-10,
+/// `2 F e_r <= eps F^2 + e_r^2 / eps` (AM-GM), `e_r^2 <= 3 (e_o^2 + 1.21 O^2 eta^2 + u^2 F^2)`,
+/// `e_b^2 <= 2 e_o^2 + 4 O^2 (4 eta^2 + 49 u^2)` and `2u F e_b <= u (F^2 + e_b^2)`, so
+/// `e_disc <= (eps + 5u) F^2 + (1 + 1/eps) e_r^2 + (1 + u) e_b^2 + 4u`; evaluated with
+/// `O^2 = o'.o'`, `F^2 = f.f`, `eta^2 = e_d^2 / a` and doubled, it stays above the f32 `e_disc`
+/// (whose own roundings are a few u relative). `e_d^2 <= 0.99e-6 a` gives eta <= 1e-3 and
+/// `o'.o' < 1e35` gives |o'| < 1e18, so these lanes are `ok`. NaN anywhere fails a comparison:
+/// such a lane is not a certain miss here, and [`fast8`] decides it as before.
+#[inline(always)]
+fn certain_misses(e_o: F8, e_d: F8, a: F8, inv_a: F8, oo: F8, ff: F8, disc: F8) -> Mask8 {
+    let s = |v: f32| F8::splat(v);
+    let ed2 = e_d * e_d;
+    let eta2 = ed2 * inv_a;
+    let eo2 = e_o * e_o;
+    let e_r2 = s(3.0) * (eo2 + s(1.21) * oo * eta2 + s(U * U) * ff);
+    let e_b2 = s(2.0) * eo2 + s(4.0) * oo * (s(4.0) * eta2 + s(49.0 * U * U));
+    const EPS: f32 = 1.0 / 1024.0;
+    let bound = ff * s(EPS + 5.0 * U) + s(1.0 + 1.0 / EPS) * e_r2 + s(1.0 + U) * e_b2 + s(4.0 * U);
+    let ok = ed2.simd_le(s(0.99e-6) * a) & oo.simd_lt(s(1e35)) & a.simd_gt(s(1e-30)) & a.simd_lt(s(1e30));
+    ok & disc.simd_lt(-(s(2.0) * bound))
+}
+
 /// Intersects the ellipsoid with the `live` lanes of an 8-ray packet (Embree's fields as SoA
 /// vectors): f32 SIMD ([`fast8`]), with f64 ([`Ellipsoid::hit`]) for the lanes it leaves unsure.
 /// Returns the lanes hit inside (tnear, tfar) and their distances (0 in the other lanes).
-#[inline]
+#[inline(always)]
 pub(super) fn hits8(e: &Ellipsoid, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, live: Mask8) -> (Mask8, F8) {
     let r = fast8(&e.fast, org, dir, tnear, tfar, live);
     let unsure = r.unsure.to_bitmask();
     if unsure == 0 {
         return (r.hit, r.t);
     }
+    hits8_f64(e, org, dir, tnear, tfar, r, unsure)
+}
+
+/// [`hits8`]'s f64 pass over the lanes `unsure` (bits) that [`fast8`] left (out of line: rare).
+#[cold]
+#[inline(never)]
+fn hits8_f64(e: &Ellipsoid, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, r: Fast8, unsure: u32) -> (Mask8, F8) {
     let (mut hit, mut t) = (r.hit.to_bitmask(), r.t.to_array());
     let mut bits = unsure;
     while bits != 0 {

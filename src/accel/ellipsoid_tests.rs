@@ -307,3 +307,90 @@ fn degenerate_rays_never_report_nan() {
         assert!(got[i].is_none_or(|t| t.is_finite()), "lane {i}");
     }
 }
+
+/// The early return of all-miss packets ([`certain_misses`]) changes no answer: for spheres and
+/// ellipsoids of many scales and positions, with rays missing by a wide margin, grazing the
+/// silhouette (tangent +- 2^-k), from far away, from inside and with non-finite or degenerate
+/// directions, every lane it calls a certain miss is a miss of the full bound (neither hit nor
+/// unsure), and `fast8` with and without the early return agree bit for bit. It must also fire
+/// (most all-miss packets return early), or it would be dead weight.
+#[test]
+fn early_all_miss_return_changes_no_answer() {
+    let mut rng = Rng(11);
+    let (mut packets, mut early, mut missing) = (0, 0, 0);
+    let v3 = |p: &bench::Packet, f: usize| Vec3x8::new(F8::new(p[f]), F8::new(p[f + 1]), F8::new(p[f + 2]));
+    for k in 0..24 {
+        let c = Vec3::new(rng.sym(), rng.sym(), rng.sym()) * [1.0, 50.0, 1e4][k % 3];
+        let scale = [0.3f32, 1e-3, 40.0, 1.0][k % 4];
+        let axes = Vec3::new(0.2 + rng.unit(), 0.2 + rng.unit(), 0.2 + rng.unit()) * scale;
+        let m = if k % 2 == 0 { sphere(c, axes.x) } else { ellipsoid(c, axes) };
+        let e = Ellipsoid::new(&m).expect("invertible");
+        let rad = axes.max_element();
+        for j in 0..4000 {
+            let rays: Vec<Ray> = (0..8)
+                .map(|i| {
+                    // One kind of ray in two packets of three (all-miss packets are common).
+                    let o = c + rng.dir() * (rad * [3.0, 1e3, 0.5, 1.0 + 1e-6][j % 4]);
+                    let d = match (j / 4 + if j % 3 == 0 { i } else { 0 }) % 5 {
+                        // anywhere (mostly misses)
+                        0 | 1 => rng.dir(),
+                        // grazing the bounding sphere of the ellipsoid
+                        2 => {
+                            (c + rng.dir() * rad * (1.0 + (rng.sym() * 2f32.powi(-((j % 24) as i32)))) - o).normalize()
+                        }
+                        // at the centre, unnormalized
+                        3 => (c - o) * (0.01 + 10.0 * rng.unit()),
+                        _ => [Vec3::ZERO, Vec3::splat(f32::NAN), Vec3::new(1e-30, 0.0, 0.0), rng.dir()][j % 4],
+                    };
+                    Ray { o, d, tn: 0.0, tf: f32::INFINITY }
+                })
+                .collect();
+            let p = fields(&rays);
+            let (org, dir, tn, tf) = (v3(&p, 0), v3(&p, 4), F8::new(p[3]), F8::new(p[8]));
+            let valid = crate::simd::mask_all();
+            let full = fast8_with(&e.fast, org, dir, tn, tf, valid, false);
+            let fast = fast8_with(&e.fast, org, dir, tn, tf, valid, true);
+            assert_eq!(
+                (full.hit.to_bitmask(), full.unsure.to_bitmask(), full.t.to_array().map(f32::to_bits)),
+                (fast.hit.to_bitmask(), fast.unsure.to_bitmask(), fast.t.to_array().map(f32::to_bits)),
+                "packet {j} of shape {k}"
+            );
+            // The certain misses by themselves, lane by lane, whatever the rest of the packet.
+            let sure = sure_lanes(&e.fast, org, dir) & valid;
+            assert_eq!(sure.to_bitmask() & (full.hit | full.unsure).to_bitmask(), 0, "packet {j} of shape {k}");
+            packets += 1;
+            if (full.hit | full.unsure).none() {
+                missing += 1;
+                early += usize::from((valid & !sure).none());
+            }
+        }
+    }
+    eprintln!("{packets} packets, {missing} all-miss, {early} returned early");
+    assert!(missing > 1000 && early * 4 > missing * 3, "{early} of {missing}");
+}
+
+/// [`certain_misses`] of a packet, from the same intermediate values as `fast8_with`.
+fn sure_lanes(e: &Fast, org: Vec3x8, dir: Vec3x8) -> Mask8 {
+    let s = |v: f32| F8::splat(v);
+    let dd = (org - Vec3x8::new(s(e.c_hi[0]), s(e.c_hi[1]), s(e.c_hi[2])))
+        - Vec3x8::new(s(e.c_lo[0]), s(e.c_lo[1]), s(e.c_lo[2]));
+    let (o, d) = match e.inv_r {
+        Some(ir) => (dd * s(ir), dir * s(ir)),
+        None => {
+            let m = |v: Vec3x8| {
+                let row = |r: &[f32; 3]| s(r[0]).mul_add(v.x, s(r[1]).mul_add(v.y, s(r[2]) * v.z));
+                Vec3x8::new(row(&e.b[0]), row(&e.b[1]), row(&e.b[2]))
+            };
+            (m(dd), m(dir))
+        }
+    };
+    let e_o = s(e.k_o).mul_add(max_abs(dd), s(e.eps_c));
+    let e_d = s(e.k_d) * max_abs(dir);
+    let a = d.dot(d);
+    let oo = o.dot(o);
+    let inv_a = F8::ONE / a;
+    let b = -o.dot(d) * inv_a;
+    let f = d.mul_add(b, o);
+    let ff = f.dot(f);
+    certain_misses(e_o, e_d, a, inv_a, oo, ff, F8::ONE - ff)
+}

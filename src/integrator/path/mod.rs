@@ -39,7 +39,7 @@ use crate::sampler::PathDim;
 use crate::sampling::power_heuristic_x8;
 use crate::scene::build::Scene;
 use crate::scene::desc::IntegratorKind;
-use crate::scene::desc::{ImportanceSampling, Nee};
+use crate::scene::desc::{BrdfKind, ImportanceSampling, Nee};
 use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use wave::{add_lanes, bits, Columns, Pack};
@@ -52,6 +52,10 @@ pub use sky::DIM_SKY_BASE;
 
 /// First sampler dimension of the path tracer's vertices.
 pub const DIM_PATH_BASE: u32 = 64;
+/// Camera packets of one wave of the path wavefront (whole samples of a tile's packets; at least
+/// one sample): 1024 paths, enough to keep bounce packets full, few enough for the wave's
+/// buffers (about 2.5 KB a packet) to stay in L2.
+const WAVE_PACKETS: usize = 128;
 /// Hard cap on path vertices when `maxdepth -1` (Russian roulette normally ends paths far sooner).
 pub const MAX_VERTICES_UNBOUNDED: u32 = 4096;
 // The sky's dimensions follow every vertex's own.
@@ -158,114 +162,144 @@ fn path_tile<L: LobeSet>(
     let max_v = if it.max_depth < 0 { MAX_VERTICES_UNBOUNDED } else { it.max_depth as u32 + 1 };
     // The previous vertex is kept only for a point-dependent light choice's MIS weight.
     let keep_prev = it.path.nee == Nee::Mis && it.light_sampler.depends_on_point();
-    let n_samples = samples.len();
+    let course_lobe_pick = course_lobe_pick(it, scene);
     radiance.clear();
-    radiance.resize(pks.len() * n_samples, Vec3x8::ZERO);
-    // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks); lanes
-    // outside the image travel as inactive placeholders in the first packets.
-    let n = pks.len() * n_samples;
-    paths.set_packets(n);
-    prev.set_packets(if keep_prev { n } else { 0 });
-    rh.truncate(n);
-    rh.resize(n, (RayHit8::default(), F8::ZERO));
-    let lane = U8::new([0, 1, 2, 3, 4, 5, 6, 7]);
-    for (si, s) in samples.enumerate() {
-        for (p, pk) in pks.iter().enumerate() {
-            let ci = si * pks.len() + p;
-            let (org, dir) = smp.camera_rays(pk, s);
-            let (r, active) = &mut rh[ci];
-            *active = r.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
-            let slot = U8::splat(ci as u32 * 8) + lane;
-            paths.set(SLOT, ci, pk.active.select(bits(slot), bits(U8::MAX)));
-            paths.set(PIXEL, ci, bits(pk.pixel));
-            paths.set(SAMPLE, ci, bits(U8::splat(s)));
-            for c in 0..3 {
-                paths.set(BETA + c, ci, F8::ONE);
-            }
-            paths.set(PDF, ci, F8::ZERO);
-            if keep_prev {
-                for c in 0..6 {
-                    prev.set(c, ci, if c == PREV_N + 2 { F8::ONE } else { F8::ZERO });
+    radiance.resize(pks.len() * samples.len(), Vec3x8::ZERO);
+    // Waves of at most WAVE_PACKETS camera packets (whole samples of the tile's packets), one
+    // after the other: a wave's buffers stay in the caches (and small enough for the allocator
+    // to reuse freed memory rather than map fresh pages). Every lane's path is the same in any
+    // wave (Embree traces bounce and shadow rays one by one; a pixel sample's radiance is summed
+    // vertex after vertex whatever the wave), so waves change no bit.
+    let per_wave = (WAVE_PACKETS / pks.len().max(1)).max(1) as u32;
+    let mut first = samples.start;
+    while first < samples.end {
+        let wave = first..samples.end.min(first + per_wave);
+        first = wave.end;
+        // Camera paths: the tile's packets, kept as they are (coherent, 4x2 pixel blocks); lanes
+        // outside the image travel as inactive placeholders in the first packets.
+        let n = pks.len() * wave.len();
+        paths.set_packets(n);
+        prev.set_packets(if keep_prev { n } else { 0 });
+        // The next bounce has at most n packets of paths: room for them now, not by doubling.
+        next.reserve_packets(n);
+        // Packet buffers only grow (a bounce uses a prefix): no default packets written per batch.
+        if rh.len() < n {
+            rh.resize(n, (RayHit8::default(), F8::ZERO));
+        }
+        let lane = U8::new([0, 1, 2, 3, 4, 5, 6, 7]);
+        for (sj, s) in wave.clone().enumerate() {
+            for (p, pk) in pks.iter().enumerate() {
+                let ci = sj * pks.len() + p;
+                let (org, dir) = smp.camera_rays(pk, s);
+                let (r, active) = &mut rh[ci];
+                *active = r.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), pk.active);
+                // The pixel sample's place in the tile's radiance (sample-major over `samples`).
+                let slot = U8::splat(((s - samples.start) as usize * pks.len() + p) as u32 * 8) + lane;
+                paths.set(SLOT, ci, pk.active.select(bits(slot), bits(U8::MAX)));
+                paths.set(PIXEL, ci, bits(pk.pixel));
+                paths.set(SAMPLE, ci, bits(U8::splat(s)));
+                for c in 0..3 {
+                    paths.set(BETA + c, ci, F8::ONE);
+                }
+                paths.set(PDF, ci, F8::ZERO);
+                if keep_prev {
+                    for c in 0..6 {
+                        prev.set(c, ci, if c == PREV_N + 2 { F8::ONE } else { F8::ZERO });
+                    }
                 }
             }
         }
-    }
-    let mut v = 1u32;
-    while paths.len() > 0 && v <= max_v {
-        let n_packets = paths.packets();
-        if v > 1 {
-            // Full packets of 8 live paths, written in place (Embree resets a packet's hit
-            // ids itself).
-            rh.truncate(n_packets);
-            rh.resize(n_packets, (RayHit8::default(), F8::ZERO));
-            for (ci, (r, active)) in rh.iter_mut().enumerate() {
-                let live = F8::from_bits(!paths.get_u(SLOT, ci).simd_eq(U8::MAX));
-                let (o, d) = (paths.get3(O, ci), paths.get3(D, ci));
-                *active = r.ray.set(o, d, F8::ZERO, F8::splat(f32::INFINITY), live);
+        let mut v = 1u32;
+        while paths.len() > 0 && v <= max_v {
+            let n_packets = paths.packets();
+            let rh = &mut rh[..n_packets];
+            if v > 1 {
+                // Full packets of 8 live paths, written in place (Embree resets a packet's hit
+                // ids itself).
+                for (ci, (r, active)) in rh.iter_mut().enumerate() {
+                    let live = F8::from_bits(!paths.get_u(SLOT, ci).simd_eq(U8::MAX));
+                    let (o, d) = (paths.get3(O, ci), paths.get3(D, ci));
+                    *active = r.ray.set(o, d, F8::ZERO, F8::splat(f32::INFINITY), live);
+                }
             }
-        }
-        tracer.intersect_all(rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
-        next.clear();
-        next_prev.clear();
-        shadow.clear();
-        let dims = LIGHT_POINT.at(v - 1);
-        // Dims 0 and 1 (light point, light choice) are light dimensions, 2 and 3 the others.
-        let dk: [PathDim; 4] = std::array::from_fn(|j| smp.table_dim(j < 2, it.spp, dims + j as u32));
-        let has_env = scene.sky.is_some() || scene.envmap.is_some();
-        let dsky = has_env.then(|| smp.table_dim(true, it.spp, SKY.at(v - 1)));
-        let mut b = Bounce { it, smp, scene, v, max_v, dk: &dk, dsky, keep_prev, next, next_prev, shadow };
-        for (ci, (r, traced)) in rh.iter().enumerate() {
-            // A packet without a traced lane hits nothing: no emission, no continuation.
-            if traced.none() {
-                continue;
-            }
-            scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
-            // Under `hide_emitters` camera rays (v = 1) see no emitter.
-            let missed = if v == 1 && scene.desc.hide_emitters { Mask8::default() } else { *traced & !sh.valid };
-            if has_env && missed.any() {
-                let (slot, beta) = (paths.get_u(SLOT, ci), paths.get3(BETA, ci));
-                escaped::<L>(it, scene, v, r.ray.dir(), paths.get(PDF, ci), missed, |le| {
-                    add_lanes(radiance, slot, beta.mul_elem(le), missed)
-                });
-            }
-            if sh.valid.none() {
-                continue;
-            }
-            let vx = Vertex {
-                sh,
-                rh: r,
-                slot: paths.get_u(SLOT, ci),
-                pixel: paths.get_u(PIXEL, ci),
-                s: paths.get_u(SAMPLE, ci),
-                beta: paths.get3(BETA, ci),
+            tracer.intersect_all(rh, if v == 1 { RayKind::Camera } else { RayKind::Bounce });
+            next.clear();
+            next_prev.clear();
+            shadow.clear();
+            let dims = LIGHT_POINT.at(v - 1);
+            // Dims 0 and 1 (light point, light choice) are light dimensions, 2 and 3 the others.
+            let dk: [PathDim; 4] = std::array::from_fn(|j| smp.table_dim(j < 2, it.spp, dims + j as u32));
+            let has_env = scene.sky.is_some() || scene.envmap.is_some();
+            let dsky = has_env.then(|| smp.table_dim(true, it.spp, SKY.at(v - 1)));
+            let mut b = Bounce {
+                it,
+                smp,
+                scene,
+                v,
+                max_v,
+                dk: &dk,
+                dsky,
+                keep_prev,
+                course_lobe_pick,
+                next,
+                next_prev,
+                shadow,
             };
-            let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
-            if v > 1 || !scene.desc.hide_emitters {
-                let le = b.emission::<L>(&vx, paths.get(PDF, ci), pp, pn);
-                add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
+            for (ci, (r, traced)) in rh.iter().enumerate() {
+                // A packet without a traced lane hits nothing: no emission, no continuation.
+                if traced.none() {
+                    continue;
+                }
+                scene.gather_into(r.ray.org(), r.ray.dir(), &Hits8::from_rayhit(r, *traced), sh);
+                // Under `hide_emitters` camera rays (v = 1) see no emitter.
+                let missed = if v == 1 && scene.desc.hide_emitters { Mask8::default() } else { *traced & !sh.valid };
+                if has_env && missed.any() {
+                    let (slot, beta) = (paths.get_u(SLOT, ci), paths.get3(BETA, ci));
+                    escaped::<L>(it, scene, v, r.ray.dir(), paths.get(PDF, ci), missed, |le| {
+                        add_lanes(radiance, slot, beta.mul_elem(le), missed)
+                    });
+                }
+                if sh.valid.none() {
+                    continue;
+                }
+                let vx = Vertex {
+                    sh,
+                    rh: r,
+                    slot: paths.get_u(SLOT, ci),
+                    pixel: paths.get_u(PIXEL, ci),
+                    s: paths.get_u(SAMPLE, ci),
+                    beta: paths.get3(BETA, ci),
+                };
+                let (pp, pn) = if keep_prev { (prev.get3(PREV_P, ci), prev.get3(PREV_N, ci)) } else { (Z, Z) };
+                if v > 1 || !scene.desc.hide_emitters {
+                    let le = b.emission::<L>(&vx, paths.get(PDF, ci), pp, pn);
+                    add_lanes(radiance, vx.slot, vx.beta.mul_elem(le), vx.sh.valid);
+                }
+                b.shade::<L>(&vx);
             }
-            b.shade::<L>(&vx);
+            // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
+            shadow.fill_tail(S_SLOT, bits(U8::MAX));
+            let n_shadow = shadow.packets();
+            if shadow_rays.len() < n_shadow {
+                shadow_rays.resize(n_shadow, (Ray8::default(), F8::ZERO));
+            }
+            let shadow_rays = &mut shadow_rays[..n_shadow];
+            for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
+                let active = F8::from_bits(!shadow.get_u(S_SLOT, j).simd_eq(U8::MAX));
+                let (o, d) = (shadow.get3(S_O, j), shadow.get3(S_D, j));
+                *lit = ray.set(o, d, F8::ZERO, shadow.get(S_TFAR, j), active);
+            }
+            let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
+            for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
+                let occluded = tracer.occluded(ray, *lit);
+                add_lanes(radiance, shadow.get_u(S_SLOT, j), shadow.get3(S_C, j), *lit & !occluded);
+            }
+            drop(occluded_batch);
+            next.fill_tail(SLOT, bits(U8::MAX));
+            std::mem::swap(paths, next);
+            std::mem::swap(prev, next_prev);
+            v += 1;
         }
-        // Shadow packets of this bounce: full packets of 8 lanes, traced back to back.
-        shadow.fill_tail(S_SLOT, bits(U8::MAX));
-        let n_shadow = shadow.packets();
-        shadow_rays.truncate(n_shadow);
-        shadow_rays.resize(n_shadow, (Ray8::default(), F8::ZERO));
-        for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
-            let active = F8::from_bits(!shadow.get_u(S_SLOT, j).simd_eq(U8::MAX));
-            let (o, d) = (shadow.get3(S_O, j), shadow.get3(S_D, j));
-            *lit = ray.set(o, d, F8::ZERO, shadow.get(S_TFAR, j), active);
-        }
-        let occluded_batch = crate::profile::scope(crate::profile::Phase::EmbreeOccluded);
-        for (j, (ray, lit)) in shadow_rays.iter_mut().enumerate() {
-            let occluded = tracer.occluded(ray, *lit);
-            add_lanes(radiance, shadow.get_u(S_SLOT, j), shadow.get3(S_C, j), *lit & !occluded);
-        }
-        drop(occluded_batch);
-        next.fill_tail(SLOT, bits(U8::MAX));
-        std::mem::swap(paths, next);
-        std::mem::swap(prev, next_prev);
-        v += 1;
     }
     // Opt-in clamp (biased): scale a sample so its largest channel is at most `clamp`;
     // non-finite samples are left as they are, for the film to count and drop.
@@ -308,6 +342,16 @@ fn escaped<L: LobeSet>(
     }
 }
 
+/// Whether the course's BRDF mixture of some material can pick its specular lobe: under
+/// `importancesampling brdf`, with a material whose specular probability (`Material8::
+/// specular_probability`) is not exactly 0 (GGX, or a non-zero `specular`). Otherwise every lane's
+/// pick `u_lobe < t` is false whatever `u_lobe`, and the dimension is not drawn (skipping it
+/// changes no other, so no bit of the image).
+fn course_lobe_pick(it: &Integrator, scene: &Scene) -> bool {
+    it.path.strategy == ImportanceSampling::Brdf
+        && scene.materials.iter().any(|m| m.brdf == BrdfKind::Ggx || m.specular != glam::Vec3::ZERO)
+}
+
 /// +z in every lane.
 const Z: Vec3x8 = Vec3x8 { x: F8::ZERO, y: F8::ZERO, z: F8::ONE };
 
@@ -323,6 +367,8 @@ struct Bounce<'a> {
     /// the sky's dimension of this vertex (with a sky)
     dsky: Option<PathDim>,
     keep_prev: bool,
+    /// whether the course's BRDF mixture can pick its specular lobe ([`course_lobe_pick`])
+    course_lobe_pick: bool,
     next: &'a mut Columns<PATH_COLS>,
     next_prev: &'a mut Columns<6>,
     shadow: &'a mut Columns<SHADOW_COLS>,
@@ -519,7 +565,7 @@ impl Bounce<'_> {
         if bounce_here {
             // (Russian roulette, lobe choice): drawn only where one of them is used.
             // Registry BSDFs pick their lobe whatever the strategy.
-            let lobe_pick = it.path.strategy == ImportanceSampling::Brdf || <L::Bsdfs as BsdfSet>::BITS != 0;
+            let lobe_pick = self.course_lobe_pick || <L::Bsdfs as BsdfSet>::BITS != 0;
             let (u_rr, u_lobe) = if it.path.russian_roulette || lobe_pick {
                 self.smp.table_point(&self.dk[3], false, Phase::SamplerPath, pixel, s)
             } else {

@@ -96,6 +96,11 @@ impl<const K: usize> Columns<K> {
         self.len = 8 * n;
     }
 
+    /// Makes room for `n` packets (and the spill of a write past them) ahead of the writes.
+    pub(super) fn reserve_packets(&mut self, n: usize) {
+        self.grow(n + 1);
+    }
+
     /// Makes room for at least `packets` packets.
     #[cold]
     fn grow(&mut self, packets: usize) {
