@@ -209,7 +209,7 @@ pub fn area_sample(
             // `place_one_x8` and `Emitters::warp_x8`, without their per-lane look-ups).
             let e = &scene.emitters.list[0];
             let mut ls = e.sample_x8(u, w);
-            e.warp_x8(it.light_warp, &mut ls, sh.p, shade);
+            scene.emitters.warp_one_x8(0, it.light_warp, &mut ls, sh.p, shade);
             return (ls, shade);
         }
         AreaChoice::Reuse => it.light_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, shade, (u, w)),

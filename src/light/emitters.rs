@@ -195,6 +195,69 @@ pub struct Emitters {
     pub n_quads: usize,
     /// some light is a sphere
     pub any_sphere: bool,
+    /// each light's [`WarpRow`], then an all-zero row (kind [`WarpRow::NONE`]) that lanes
+    /// without a light gather
+    pub warp_rows: Vec<WarpRow>,
+}
+
+/// Relative tolerance of `|ab . ac| / (|ab| |ac|)` for a quad light to count as a rectangle.
+const RECT_TOL: f32 = 1e-4;
+
+impl Emitter {
+    /// A quad light whose edges are orthogonal (within [`RECT_TOL`]): sampled by spherical
+    /// rectangles under `--light-warp solid-angle`.
+    pub fn is_rectangle(&self) -> bool {
+        !self.triangle && !self.sphere && self.ab.dot(self.ac).abs() <= RECT_TOL * self.ab.length() * self.ac.length()
+    }
+
+    /// This light's constants for the solid-angle warp ([`WarpRow`]), computed once.
+    pub fn warp_row(&self) -> WarpRow {
+        let mut r = [0.0; 16];
+        let mut put = |k: usize, v: Vec3| r[k..k + 3].copy_from_slice(&v.to_array());
+        put(0, self.a);
+        put(9, self.normal);
+        let kind = if self.sphere {
+            WarpRow::SPHERE
+        } else if self.triangle {
+            put(3, self.ab);
+            put(6, self.ac);
+            WarpRow::TRI
+        } else if self.is_rectangle() {
+            // The unit edges and lengths in the x8 arithmetic the warp used per lane (same bits).
+            let (ab, ac) = (Vec3x8::splat(self.ab), Vec3x8::splat(self.ac));
+            let (lx, ly) = (ab.length(), ac.length());
+            put(3, ab.scale(F8::ONE / lx).lane(0));
+            put(6, ac.scale(F8::ONE / ly).lane(0));
+            r[12] = lx.as_array()[0];
+            r[13] = ly.as_array()[0];
+            WarpRow::RECT
+        } else {
+            WarpRow::NONE
+        };
+        r[14] = self.radius;
+        r[15] = kind;
+        WarpRow(r)
+    }
+}
+
+/// One light's constants for `light::warp`, 16 f32 so that eight lanes' lights gather as rows
+/// (a transpose) rather than field by field: `[a; ex; ey; normal; lx, ly, radius, kind]`. `a` is
+/// the corner (a sphere's centre); `ex`, `ey` a rectangle's unit edges (`lx`, `ly` their lengths)
+/// or a triangle's edges `ab`, `ac`; `kind` one of [`WarpRow::RECT`], [`WarpRow::TRI`],
+/// [`WarpRow::SPHERE`] or [`WarpRow::NONE`] (a skewed quad: area sampling).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[repr(C, align(64))]
+pub struct WarpRow(pub [f32; 16]);
+
+impl WarpRow {
+    /// kind: not warped (a parallelogram that is not a rectangle)
+    pub const NONE: f32 = 0.0;
+    /// kind: rectangle (spherical rectangle)
+    pub const RECT: f32 = 1.0;
+    /// kind: triangle (spherical triangle)
+    pub const TRI: f32 = 2.0;
+    /// kind: sphere (cone of its visible cap)
+    pub const SPHERE: f32 = 3.0;
 }
 
 impl Emitters {
@@ -204,7 +267,8 @@ impl Emitters {
         let n_quads = list.len();
         list.extend(triangles);
         let any_sphere = list.iter().any(|e| e.sphere);
-        Self { list, n_quads, any_sphere }
+        let warp_rows = list.iter().map(Emitter::warp_row).chain([WarpRow::default()]).collect();
+        Self { list, n_quads, any_sphere, warp_rows }
     }
 
     /// Number of lights.

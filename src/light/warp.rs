@@ -19,11 +19,11 @@
 //! `cos_l / (d^2 area) = 1 / S` is its pdf per unit area converted to solid angle and
 //! `L f cos_i cos_l area / d^2 = L f cos_i S` its estimate.
 
-use super::emitters::{Emitter, Emitters, LightSample8};
+use super::emitters::{Emitter, Emitters, LightSample8, WarpRow};
 use crate::sampling::spherical_cap::SphericalCap8;
 use crate::sampling::spherical_rect::SphericalRect8;
 use crate::sampling::spherical_tri::SphericalTri8;
-use crate::simd::{mask_from_bools, Mask8, Vec3x8, F8, U8};
+use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 /// Smallest solid angle (sr) sampled by the warps; a light subtending less is sampled by area.
 ///
@@ -50,9 +50,6 @@ pub const OMEGA_MIN: f32 = 3e-4;
 /// own limit is the squared ratio `(r / d)^2`, which leaves f32's normal range below 1.2e-38:
 /// the threshold 1e-30 sr (`r / d` about 5.6e-16) keeps it clear of that.
 pub const SPHERE_OMEGA_MIN: f32 = 1e-30;
-
-/// Relative tolerance of `|ab . ac| / (|ab| |ac|)` for a quad light to count as a rectangle.
-const RECT_TOL: f32 = 1e-4;
 
 /// How next event estimation places a point on an area light (`--light-warp`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -88,20 +85,15 @@ impl std::str::FromStr for LightWarp {
     }
 }
 
-impl Emitter {
-    /// A quad light whose edges are orthogonal (within [`RECT_TOL`]): sampled by spherical
-    /// rectangles.
-    pub fn is_rectangle(&self) -> bool {
-        !self.triangle && !self.sphere && self.ab.dot(self.ac).abs() <= RECT_TOL * self.ab.length() * self.ac.length()
-    }
-}
-
-/// Eight lanes' lights, gathered or splatted.
+/// Eight lanes' lights ([`WarpRow`]s), splatted or gathered.
 struct Lights8 {
     a: Vec3x8,
-    ab: Vec3x8,
-    ac: Vec3x8,
+    /// a rectangle's unit edges, a triangle's edges
+    ex: Vec3x8,
+    ey: Vec3x8,
     normal: Vec3x8,
+    lx: F8,
+    ly: F8,
     radius: F8,
     tri: Mask8,
     rect: Mask8,
@@ -112,62 +104,58 @@ struct Lights8 {
 }
 
 impl Lights8 {
-    fn one(e: &Emitter) -> Self {
-        let s = Vec3x8::splat;
-        let (tri, rect, sphere) = (e.triangle, e.is_rectangle(), e.sphere);
+    /// From the 16 columns of eight [`WarpRow`]s.
+    #[inline]
+    fn from_cols(c: [F8; 16]) -> Self {
+        let v = |k: usize| Vec3x8::new(c[k], c[k + 1], c[k + 2]);
+        let (tri, rect, sphere) = (
+            c[15].simd_eq(F8::splat(WarpRow::TRI)),
+            c[15].simd_eq(F8::splat(WarpRow::RECT)),
+            c[15].simd_eq(F8::splat(WarpRow::SPHERE)),
+        );
         Self {
-            a: s(e.a),
-            ab: s(e.ab),
-            ac: s(e.ac),
-            normal: s(e.normal),
-            radius: F8::splat(e.radius),
-            tri: mask_from_bools([tri; 8]),
-            rect: mask_from_bools([rect; 8]),
-            sphere: mask_from_bools([sphere; 8]),
-            any_tri: tri,
-            any_rect: rect,
-            any_sphere: sphere,
+            a: v(0),
+            ex: v(3),
+            ey: v(6),
+            normal: v(9),
+            lx: c[12],
+            ly: c[13],
+            radius: c[14],
+            tri,
+            rect,
+            sphere,
+            any_tri: tri.any(),
+            any_rect: rect.any(),
+            any_sphere: sphere.any(),
         }
     }
 
-    fn lanes(list: &[Emitter], ids: U8, active: Mask8) -> Self {
+    #[inline]
+    fn one(row: &WarpRow) -> Self {
+        Self::from_cols(row.0.map(F8::splat))
+    }
+
+    /// The lights `ids` (rows of `rows`, whose last row is the empty one) on lanes `active`; the
+    /// other lanes get the empty row.
+    #[inline]
+    fn lanes(rows: &[WarpRow], ids: U8, active: Mask8) -> Self {
         let ids = ids.to_array();
-        if ids.iter().all(|&i| i == ids[0]) {
-            if let Some(e) = list.get(ids[0] as usize) {
-                return Self::one(e);
-            }
+        let last = rows.len() - 1;
+        if ids.iter().all(|&i| i == ids[0]) && (ids[0] as usize) < last {
+            return Self::one(&rows[ids[0] as usize]);
         }
-        let on = crate::simd::mask_to_bools(active);
-        let es: [Option<&Emitter>; 8] = std::array::from_fn(|i| list.get(ids[i] as usize).filter(|_| on[i]));
-        let tri = es.map(|e| e.is_some_and(|e| e.triangle));
-        let rect = es.map(|e| e.is_some_and(Emitter::is_rectangle));
-        let sphere = es.map(|e| e.is_some_and(|e| e.sphere));
-        let get = |f: fn(&Emitter) -> glam::Vec3| Vec3x8::from_lanes(es.map(|e| e.map_or(glam::Vec3::ZERO, f)));
-        Self {
-            a: get(|e| e.a),
-            ab: get(|e| e.ab),
-            ac: get(|e| e.ac),
-            normal: get(|e| e.normal),
-            radius: F8::new(es.map(|e| e.map_or(0.0, |e| e.radius))),
-            tri: mask_from_bools(tri),
-            rect: mask_from_bools(rect),
-            sphere: mask_from_bools(sphere),
-            any_tri: tri.contains(&true),
-            any_rect: rect.contains(&true),
-            any_sphere: sphere.contains(&true),
-        }
+        let on = active.to_bitmask();
+        let r: [&[f32; 16]; 8] =
+            std::array::from_fn(|i| &rows[if on & (1 << i) != 0 { (ids[i] as usize).min(last) } else { last }].0);
+        Self::from_cols(std::array::from_fn(|k| F8::new(std::array::from_fn(|i| r[i][k]))))
     }
 
     /// The lights seen from `p` on lanes `active`: the warps, S per lane and the lanes warped.
     fn subtend(&self, p: Vec3x8, active: Mask8) -> Subtended {
         // Only the emitting side is lit; there every point of the (planar) light has cos_l > 0.
         let front = self.normal.dot(p - self.a).simd_gt(F8::ZERO);
-        let rect = self.any_rect.then(|| {
-            let (lx, ly) = (self.ab.length(), self.ac.length());
-            let (ex, ey) = (self.ab.scale(F8::ONE / lx), self.ac.scale(F8::ONE / ly));
-            SphericalRect8::new(p, self.a, ex, ey, lx, ly)
-        });
-        let tri = self.any_tri.then(|| SphericalTri8::new(p, self.a, self.a + self.ab, self.a + self.ac));
+        let rect = self.any_rect.then(|| SphericalRect8::new(p, self.a, self.ex, self.ey, self.lx, self.ly));
+        let tri = self.any_tri.then(|| SphericalTri8::new(p, self.a, self.a + self.ex, self.a + self.ey));
         let s_rect = rect.map_or(F8::ZERO, |r| self.rect.select(r.solid_angle(), F8::ZERO));
         let s_tri = tri.map_or(F8::ZERO, |t| self.tri.select(t.solid_angle(), F8::ZERO));
         let omega = self.tri.select(s_tri, s_rect);
@@ -234,8 +222,11 @@ impl Emitter {
     /// where the warp applies (module docs), on the lanes `active`.
     #[inline]
     pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
-        if warp == LightWarp::SolidAngle && (self.triangle || self.sphere || self.is_rectangle()) {
-            rewarp(&Lights8::one(self), ls, p, active);
+        if warp == LightWarp::SolidAngle {
+            let row = self.warp_row();
+            if row.0[15] != WarpRow::NONE {
+                rewarp(&Lights8::one(&row), ls, p, active);
+            }
         }
     }
 }
@@ -246,7 +237,16 @@ impl Emitters {
     #[inline]
     pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
         if warp == LightWarp::SolidAngle && active.any() {
-            rewarp(&Lights8::lanes(&self.list, ls.light, active), ls, p, active);
+            rewarp(&Lights8::lanes(&self.warp_rows, ls.light, active), ls, p, active);
+        }
+    }
+
+    /// [`Emitter::warp_x8`] of light `i` (its [`WarpRow`] from the table rather than computed
+    /// again).
+    #[inline]
+    pub fn warp_one_x8(&self, i: usize, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
+        if warp == LightWarp::SolidAngle && self.warp_rows[i].0[15] != WarpRow::NONE {
+            rewarp(&Lights8::one(&self.warp_rows[i]), ls, p, active);
         }
     }
 
@@ -255,7 +255,7 @@ impl Emitters {
     /// a BSDF-sampled hit of a light weighs its MIS with.
     #[inline]
     pub fn solid_angle_x8(&self, ids: U8, p: Vec3x8, active: Mask8) -> (F8, Mask8) {
-        let sub = Lights8::lanes(&self.list, ids, active).subtend(p, active);
+        let sub = Lights8::lanes(&self.warp_rows, ids, active).subtend(p, active);
         (sub.omega, sub.warped)
     }
 }
