@@ -179,8 +179,10 @@ impl Camera<'_> {
     }
 
     /// [`Camera::rays_with`] for the point `k` = [`Camera::pixel_k`] of the pixel sample, found
-    /// once for all the packets drawing it.
-    #[inline]
+    /// once for all the packets drawing it. Inlined always: called from two camera loops
+    /// (`integrator::primary`), LLVM kept it out of line (110 instructions a packet more, the
+    /// rays returned through memory).
+    #[inline(always)]
     pub fn rays_k(&self, pk: &PixelPacket, k: Option<u32>, point: impl FnOnce(u32) -> (F8, F8)) -> (Vec3x8, Vec3x8) {
         let (jx, jy) = match k {
             None => (F8::splat(0.5), F8::splat(0.5)),

@@ -101,8 +101,9 @@ impl<'a> Samples<'a> {
     /// [`Samples::camera_rays`] of packet `i` of the packets of [`Samples::camera_streams`] (`pk`
     /// that packet, `stream` its stream) for the pixel sample whose point is `k` (from
     /// [`Samples::camera_k`]): the same rays, bit for bit. `at` is [`Samples::camera_point_k`] of
-    /// that sample: the per-k work done once for every packet.
-    #[inline]
+    /// that sample: the per-k work done once for every packet. Inlined always (as
+    /// `Camera::rays_k`).
+    #[inline(always)]
     pub fn camera_rays_in(
         &self,
         pk: &PixelPacket,
