@@ -151,6 +151,7 @@ impl Lights8 {
     }
 
     /// The lights seen from `p` on lanes `active`: the warps, S per lane and the lanes warped.
+    #[inline(always)]
     fn subtend(&self, p: Vec3x8, active: Mask8) -> Subtended {
         // Only the emitting side is lit; there every point of the (planar) light has cos_l > 0.
         let front = self.normal.dot(p - self.a).simd_gt(F8::ZERO);
@@ -184,6 +185,7 @@ struct Subtended {
 
 /// Places the points of `ls` again, uniformly in solid angle about `p`, on the lanes of `active`
 /// that the warp covers (see the module docs); the other lanes keep their area sample.
+#[inline(always)]
 fn rewarp(l: &Lights8, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
     let sub = l.subtend(p, active);
     if sub.warped.none() {

@@ -7,7 +7,9 @@
 //! have unit normals n0..n3; the spherical rectangle's inner angles are g_i = pi/2 + asin(n_i .
 //! n_i+1), so its area is S = sum_i asin(n_i . n_i+1), written without the 2 pi that cancels in
 //! the paper's `g0 + g1 + g2 + g3 - 2 pi` (in f32 that cancellation loses every digit of a small
-//! S). u picks the x of the point by inverting the area to the left of x (the paper's
+//! S). Each asin is an atan2 of a dot and a cross product (no clamp, no loss near +-1), and a
+//! pair's sum one atan2 of a product of complex numbers: two polynomial atan2 per shading point
+//! rather than four asin and four divisions. u picks the x of the point by inverting the area to the left of x (the paper's
 //! `au = u S + k`), v its y uniformly in the height `h = y / sqrt(x^2 + y^2 + z0^2)` along the
 //! column, which is uniform in solid angle. The density is 1 / S per unit solid angle.
 //!
@@ -54,21 +56,28 @@ impl SphericalRect8 {
         let (x0, y0) = (d.dot(ex), d.dot(ey));
         let (x1, y1) = (x0 + lx, y0 + ly);
         let z2 = z0 * z0;
-        // Lengths of the unnormalized edge-plane normals (0, z0, -y0), (-z0, 0, x1), (0, -z0, y1),
-        // (z0, 0, -x0).
-        let l0 = y0.mul_add(y0, z2).sqrt();
-        let l1 = x1.mul_add(x1, z2).sqrt();
-        let l2 = y1.mul_add(y1, z2).sqrt();
-        let l3 = x0.mul_add(x0, z2).sqrt();
-        let clamp = |c: F8| c.max(-F8::ONE).min(F8::ONE);
-        let c0 = clamp(-(y0 * x1) / (l0 * l1));
-        let c1 = clamp((x1 * y1) / (l1 * l2));
-        let c2 = clamp(-(y1 * x0) / (l2 * l3));
-        let c3 = clamp((x0 * y0) / (l3 * l0));
-        let (a0, a1, a2, a3) = (c0.asin(), c1.asin(), c2.asin(), c3.asin());
-        let s = (a0 + a1) + (a2 + a3);
+        // a_i = asin(n_i . n_i+1) = atan2(n_i . n_i+1, |n_i x n_i+1|) with the unnormalized
+        // edge-plane normals (0, z0, -y0), (-z0, 0, x1), (0, -z0, y1), (z0, 0, -x0): the dot
+        // products are -y0 x1, x1 y1, -y1 x0, x0 y0 and the cross products' lengths |z0| times
+        // the distance to the corner between the two edges (the normals' lengths cancel). A
+        // pair's sum is the argument of the product of their (cos, sin) pairs: two atan2 in all.
+        // Coordinates are scaled to about 1 first (S is scale-free) to keep the fourth powers
+        // in f32's range.
+        let inv = F8::ONE / (x0.abs() + x1.abs() + y0.abs() + y1.abs() - z0);
+        let (sx0, sx1, sy0, sy1, sz0) = (x0 * inv, x1 * inv, y0 * inv, y1 * inv, z0 * inv);
+        let (sz2, az) = (sz0 * sz0, -sz0);
+        let r = |x: F8, y: F8| az * x.mul_add(x, y.mul_add(y, sz2)).sqrt();
+        let (p0, q0) = (-(sy0 * sx1), r(sx1, sy0));
+        let (p1, q1) = (sx1 * sy1, r(sx1, sy1));
+        let (p2, q2) = (-(sy1 * sx0), r(sx0, sy1));
+        let (p3, q3) = (sx0 * sy0, r(sx0, sy0));
+        let arg = |(p, q): (F8, F8), (p2, q2): (F8, F8)| q.mul_add(p2, p * q2).atan2(q.mul_add(q2, -(p * p2)));
+        let a01 = arg((p0, q0), (p1, q1));
+        let a23 = arg((p2, q2), (p3, q3));
+        let s = a01 + a23;
         // k = 2 pi - g2 - g3.
-        let k = F8::PI - a2 - a3;
+        let k = F8::PI - a23;
+        let (l0, l2) = (y0.mul_add(y0, z2).sqrt(), y1.mul_add(y1, z2).sqrt());
         let (b0, b1) = (-y0 / l0, y1 / l2);
         Self { o, ex, ey, ez, x0, y0, z0, x1, y1, b0, b1, k, s }
     }
