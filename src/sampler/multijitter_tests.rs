@@ -128,7 +128,8 @@ fn pairing_variances(n: u32, pixels: u32, f: impl Fn([f32; 2], [f32; 2]) -> f64)
 /// here (and 1.04-1.07 at n = 64); 4000 pixels make the ratio's standard error about 3 %.
 #[test]
 fn dimensions_are_decorrelated_as_well_as_random_pairings() {
-    let cases: [(&str, fn([f32; 2], [f32; 2]) -> f64); 3] = [
+    type Pair = fn([f32; 2], [f32; 2]) -> f64;
+    let cases: [(&str, Pair); 3] = [
         ("x_a < x_b", |a, b| f64::from(u8::from(a[0] < b[0]))),
         ("x_a + y_b < 1", |a, b| f64::from(u8::from(a[0] + b[1] < 1.0))),
         ("sin", |a, b| (6.0 * f64::from(a[0]) + 5.0 * f64::from(b[0]) + 4.0 * f64::from(a[1] * b[1])).sin()),
