@@ -127,7 +127,9 @@ impl<'a> Camera<'a> {
     /// sample 0 placed by `first_sample`; what every packet shares is found here once.
     pub fn new(lens: &'a Lens, pixel_set: &'a PointSet, seed: u64, first_sample: FirstSample) -> Self {
         let centre = first_sample == FirstSample::Centre && pixel_set.kind() != SamplerKind::GRID_CENTER;
-        let swap = (centre && pixel_set.kind() == SamplerKind::STRATIFIED).then(|| centre_stratum(pixel_set.n()));
+        // Stratified and multijitter keep pixel point k in coarse cell (k % nx, k / nx).
+        let cells = [SamplerKind::STRATIFIED, SamplerKind::MULTIJITTER].contains(&pixel_set.kind());
+        let swap = (centre && cells).then(|| centre_stratum(pixel_set.n()));
         let pinhole =
             (lens.filter.is_none() && lens.lens == crate::scene::build::Lens::Pinhole).then(|| lens.pinhole());
         Self { lens, pixel_set, seed, first_sample, centre, swap, pinhole }

@@ -331,16 +331,18 @@ pub(crate) struct RenderArgs {
     // Every sampling dimension's layout; the help lists the sampler registry.
     #[arg(long, help_heading = SAMPLING, value_parser = parse_sampler, help = format!(
         "Sampler of every dimension (pixel, light point and choice, lobe, direction, roulette): {} \
-         (default stratified; --pixel-sampler and --light-sampler override their dimensions), or \
+         (default {}; --pixel-sampler and --light-sampler override their dimensions), or \
          file:PATH[?options] (a point-set file, as --light-sampler)",
-        SamplerKind::help_list()
+        SamplerKind::help_list(),
+        SamplerKind::DEFAULT.name()
     ))]
     pub(crate) sampler: Option<SamplerKind>,
     // Pixel sample layout; the help lists the sampler registry.
     #[arg(long, help_heading = SAMPLING, value_parser = parse_sampler, help = format!(
-        "Pixel sample layout over a pixel's spp samples: {} (default stratified; grid-center with --spp 1 \
+        "Pixel sample layout over a pixel's spp samples: {} (default {}; grid-center with --spp 1 \
          puts the sample at the pixel centre), or file:PATH[?options] (a point-set file, as --light-sampler)",
-        SamplerKind::help_list()
+        SamplerKind::help_list(),
+        SamplerKind::DEFAULT.name()
     ))]
     pub(crate) pixel_sampler: Option<SamplerKind>,
     /// Pixel sample 0: centre (or center; through the pixel centre like the CSE168 course code;

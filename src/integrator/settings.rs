@@ -198,7 +198,7 @@ impl Sets {
     /// The layouts `samplers` asks for (defaults filled in) for `spp` samples and `n_light` light
     /// samples per pixel sample.
     fn resolve(d: &crate::scene::desc::SceneDesc, samplers: SamplerChoice, spp: u32, n_light: u32) -> Self {
-        let base = samplers.sampler.unwrap_or(SamplerKind::STRATIFIED);
+        let base = samplers.sampler.unwrap_or(SamplerKind::DEFAULT);
         let light_default = if d.integrator.traces_paths() || d.light_stratify {
             base
         } else {

@@ -617,7 +617,8 @@ fn registry_names_are_unique_and_parse_to_their_kind() {
     spellings.sort_unstable();
     spellings.dedup();
     assert_eq!(spellings.len(), count, "a spelling is registered twice");
-    assert!(SamplerKind::help_list().starts_with("independent (random), stratified, grid-center (biased), halton"));
+    assert!(SamplerKind::help_list()
+        .starts_with("independent (random), stratified, grid-center (biased), multijitter, halton"));
 }
 
 /// Every unbiased registered layout: the points of 16384 pixels (one per pixel, k = pixel mod 16 of

@@ -105,11 +105,11 @@ pub fn check_output_file(file: &Path) -> Result<(), SessionError> {
 /// `period`, read from the registry): the pixel sampler uses indices `0..spp`, the light
 /// sampler `sample * n + k`, so `0..spp * light_samples`.
 pub fn check_sampler_periods(opts: &RenderOptions, desc: &SceneDesc, spp: u32) -> Result<(), SessionError> {
-    let base = opts.sampler.unwrap_or(SamplerKind::STRATIFIED);
+    let base = opts.sampler.unwrap_or(SamplerKind::DEFAULT);
     let pixel = opts.pixel_sampler.or(opts.sampler).unwrap_or(base);
     let n_light = opts.light_samples.unwrap_or(desc.light_samples).max(1);
     let light = opts.light_sampler.or(opts.sampler).unwrap_or(if desc.light_stratify {
-        SamplerKind::STRATIFIED
+        SamplerKind::DEFAULT
     } else {
         SamplerKind::INDEPENDENT
     });

@@ -209,9 +209,9 @@ fn resume_refuses_other_scene_options_and_broken_files() {
     let e = resume(&["--seed", "12"], None);
     assert!(e.contains("cannot resume") && e.contains("seed 11 (this render: 12)"), "{e}");
     // More spp extends a render only when its layouts are progressive; this one's default
-    // (stratified) is laid out for its count.
+    // (multijitter, before issue 33 stratified) is laid out for its count.
     let e = resume_spp(64, &[], None);
-    assert!(e.contains("cannot extend it from 32 to 64 spp") && e.contains("`stratified`"), "{e}");
+    assert!(e.contains("cannot extend it from 32 to 64 spp") && e.contains("`multijitter`"), "{e}");
     let e = resume(&["--size", "32x24"], None);
     assert!(e.contains("64x48"), "{e}");
     // The same scene with one byte changed is another scene.

@@ -1,5 +1,5 @@
 //! `<sampler>`: Mitsuba's sampler types mapped onto strata's registry (`independent`,
-//! `stratified`, `multijitter` -> pmj02, `ldsampler` and `sobol` -> sobol), and `sample_count`
+//! `stratified`, `multijitter` (strata's, correlated multi-jittered as Mitsuba's), `ldsampler` and `sobol` -> sobol), and `sample_count`
 //! (the scene's spp). `--sampler` and `--spp` override both.
 
 use super::{Build, Plugin, Run};
@@ -11,7 +11,7 @@ use crate::scene::xml::props::Props;
 pub const INDEPENDENT: Plugin = Plugin { tag: "sampler", kind: "independent", run: Run::Scene(run) };
 /// `stratified`.
 pub const STRATIFIED: Plugin = Plugin { tag: "sampler", kind: "stratified", run: Run::Scene(run) };
-/// `multijitter` (strata's pmj02).
+/// `multijitter` (strata's multijitter).
 pub const MULTIJITTER: Plugin = Plugin { tag: "sampler", kind: "multijitter", run: Run::Scene(run) };
 /// `ldsampler` (strata's sobol).
 pub const LDSAMPLER: Plugin = Plugin { tag: "sampler", kind: "ldsampler", run: Run::Scene(run) };
@@ -22,7 +22,7 @@ fn run<'e>(b: &mut Build<'e>, p: &Props<'e>) -> Result<(), SceneError> {
     let kind = match p.elem.attr("type").unwrap_or("") {
         "independent" => SamplerKind::INDEPENDENT,
         "stratified" => SamplerKind::STRATIFIED,
-        "multijitter" => SamplerKind::PMJ02,
+        "multijitter" => SamplerKind::MULTIJITTER,
         _ => SamplerKind::SOBOL,
     };
     let n = p.int("sample_count", 4)?;

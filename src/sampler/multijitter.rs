@@ -1,0 +1,109 @@
+//! `multijitter`: correlated multi-jittered points (Kensler 2013, "Correlated Multi-Jittered
+//! Sampling", Pixar Technical Memo 13-01), the default sampler.
+//!
+//! The n points of a set lie on the `nx x ny = strata_shape(n)` grid, one per cell (as
+//! `stratified`), and at the same time one per column of the n x 1 grid and one per row of the
+//! 1 x n grid (n-rooks: every 1D projection is stratified into n strata, where `stratified`'s has
+//! only nx or ny). Point `s` (after the index shuffle below) sits in cell `(c, r) = (s % nx,
+//! s / nx)`; inside its cell, its x lies in the sub-column `sy(r)` of the cell's ny sub-columns
+//! and its y in the sub-row `sx(c)` of its nx sub-rows, where `sy` and `sx` are keyed
+//! permutations of the rows and of the columns. As x's fine stratum `c ny + sy(r)` depends on
+//! the row only through one permutation shared by every column (the "correlated" shuffle), the
+//! fine strata of neighbouring cells are offset alike, which keeps the 2D pattern even; each fine
+//! stratum is then jittered uniformly. In 24-bit fixed point, x lies in `grid::cell_span` of fine
+//! cell `c ny + sy(r)` of the n-cell axis, y in that of `r nx + sx(c)`: exact, as `stratified`'s.
+//!
+//! Padding (decorrelation between dimensions): every (pixel, sample, dim, seed) hashes its own key,
+//! which keys the three permutations (`permute::permute_lanes`, with a uniform rotation per key)
+//! and the jitter, and the point index k itself goes through a keyed permutation of 0..n first.
+//! So the dimensions of one pixel are stratified independently of one another (sample k falls in
+//! an unrelated cell of each), and every point is uniform over the square whatever the others.
+//! Dimension 0, the camera's (`camera::DIM_CAMERA`), skips the index permutation (every other
+//! dimension is shuffled against it, which is all padding needs): point k stays in coarse cell
+//! `(k % nx, k / nx)`, as `stratified`'s, so `--first-sample centre` swaps sample 0 with the
+//! sample of the centre's cell as it does for `stratified` (`camera::centre_stratum`); inside
+//! that cell the point is uniform (its fine cell is drawn by the keyed permutations), so the
+//! swap's bias is `stratified`'s.
+//!
+//! The set needs its count n in advance (`needs_count`: equal-time runs refuse it by name, and a
+//! default becomes `sobol`); k >= n wraps modulo n.
+
+use super::divisor::Divisor;
+use super::grid::{cell_span, jittered, FIXED_ONE};
+use super::hash::{hash, mix, stream_key};
+use super::lanes::Lanes;
+use super::layout::{Layout, SetShape, StreamKey};
+use super::permute::permute_lanes;
+
+const TAG_MULTIJITTER: u32 = 0x51a7_0006;
+/// Key offsets of the index shuffle and of the two sub-stratum permutations.
+const KEY_INDEX: u32 = 0x51633e2d;
+const KEY_COLUMNS: u32 = 0x68bc21eb;
+const KEY_ROWS: u32 = 0x02e5be93;
+
+/// Correlated multi-jittered points (Kensler 2013), padded per (pixel, sample, dim).
+#[derive(Clone, Copy, Debug)]
+pub struct MultiJitter;
+
+/// Its registry entry (see [`super::SAMPLERS`]).
+pub(super) const INFO: super::SamplerInfo = super::SamplerInfo::new(
+    "multijitter",
+    &["cmj", "correlated-multijitter"],
+    "correlated multi-jittered points (Kensler 2013): strata cells and n-rooks",
+    &MultiJitter,
+)
+.needs_count();
+
+/// The fixed-point span of fine cell `c` of the n-cell axis: by shifts when n is a power of two
+/// (the common spp; bit-identical to `grid::cell_span`, whose cells are then exact), else by
+/// `grid::cell_span`'s long division.
+#[inline]
+fn fine_span<L: Lanes>(c: L, n: Divisor) -> (L, L) {
+    let d = n.d;
+    if d.is_power_of_two() && d <= FIXED_ONE {
+        let shift = 24 - d.trailing_zeros();
+        let lo = c.shl(shift);
+        return (lo, lo.add(L::splat(1 << shift)));
+    }
+    cell_span(c, n)
+}
+
+/// The camera's dimension (`camera::DIM_CAMERA`), whose point k keeps its coarse cell.
+const DIM_CAMERA: u32 = 0;
+
+/// Point k of the set keyed by `key` (the per-(pixel, sample, dim, seed) hash) of dimension `dim`.
+#[inline]
+fn keyed_point<L: Lanes>(set: &SetShape, key: L, dim: u32, k: L) -> (L::F, L::F) {
+    let grid = set.grid();
+    let k = if k.max_lane() < grid.n.d { k } else { grid.n.rem(k) };
+    let s = if dim == DIM_CAMERA { k } else { permute_lanes(k, grid.n.d, key.xor(L::splat(KEY_INDEX))) };
+    let (r, c) = grid.nx.div_rem(s);
+    let sx = permute_lanes(c, grid.nx.d, key.xor(L::splat(KEY_COLUMNS)));
+    let sy = permute_lanes(r, grid.ny.d, key.xor(L::splat(KEY_ROWS)));
+    let fx = c.mul(L::splat(grid.ny.d)).add(sy);
+    let fy = r.mul(L::splat(grid.nx.d)).add(sx);
+    let h = mix(key, s);
+    (jittered(fine_span(fx, grid.n), h), jittered(fine_span(fy, grid.n), mix(h, L::splat(1))))
+}
+
+impl Layout for MultiJitter {
+    #[inline]
+    fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
+        keyed_point(set, hash(TAG_MULTIJITTER, seed, dim, [pixel, sample]), dim, k)
+    }
+
+    #[inline]
+    fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
+        let prefix = mix(mix(L::splat(stream_key(TAG_MULTIJITTER, seed, dim)), pixel), sample);
+        StreamKey { prefix, base: L::splat(0), sample, dim, seed }
+    }
+
+    #[inline]
+    fn stream_point<L: Lanes>(&self, set: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
+        keyed_point(set, s.prefix, s.dim, L::splat(k))
+    }
+}
+
+#[cfg(test)]
+#[path = "multijitter_tests.rs"]
+mod tests;
