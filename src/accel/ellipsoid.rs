@@ -267,14 +267,23 @@ pub(super) fn fast8(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, val
     fast8_with(e, org, dir, tnear, tfar, valid, true)
 }
 
-/// [`fast8`], with (`early`) or without the early return of a packet whose valid lanes are all
-/// [`certain_misses`] (the same answer either way; the tests compare the two).
+/// A packet's rays in the unit sphere's frame, as [`fast8`] and [`certain_misses`] read them:
+/// the error bounds of the origin (`e_o`, object units) and direction (`e_d`), `a = d.d` and its
+/// inverse, `oo = o.o`, the closest approach's parameter `b` and `ff = f.f` at that point.
+struct Approach {
+    e_o: F8,
+    e_d: F8,
+    a: F8,
+    inv_a: F8,
+    oo: F8,
+    b: F8,
+    ff: F8,
+}
+
+/// The [`Approach`] of rays `org + t dir` to the ellipsoid `e` (one code path for the kernel and
+/// its tests).
 #[inline(always)]
-fn fast8_with(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, valid: Mask8, early: bool) -> Fast8 {
-    let none = F8::ZERO;
-    if !e.usable {
-        return Fast8 { hit: none, t: none, unsure: valid };
-    }
+fn approach(e: &Fast, org: Vec3x8, dir: Vec3x8) -> Approach {
     let s = |v: f32| F8::splat(v);
     let dd = (org - Vec3x8::new(s(e.c_hi[0]), s(e.c_hi[1]), s(e.c_hi[2])))
         - Vec3x8::new(s(e.c_lo[0]), s(e.c_lo[1]), s(e.c_lo[2]));
@@ -296,6 +305,19 @@ fn fast8_with(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, valid: Ma
     let b = -o.dot(d) * inv_a;
     let f = d.mul_add(b, o);
     let ff = f.dot(f);
+    Approach { e_o, e_d, a, inv_a, oo, b, ff }
+}
+
+/// [`fast8`], with (`early`) or without the early return of a packet whose valid lanes are all
+/// [`certain_misses`] (the same answer either way; the tests compare the two).
+#[inline(always)]
+fn fast8_with(e: &Fast, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, valid: Mask8, early: bool) -> Fast8 {
+    let none = F8::ZERO;
+    if !e.usable {
+        return Fast8 { hit: none, t: none, unsure: valid };
+    }
+    let s = |v: f32| F8::splat(v);
+    let Approach { e_o, e_d, a, inv_a, oo, b, ff } = approach(e, org, dir);
     let disc = F8::ONE - ff;
     if early && (valid & !certain_misses(e_o, e_d, a, inv_a, oo, ff, disc)).none() {
         return Fast8 { hit: none, t: none, unsure: none };

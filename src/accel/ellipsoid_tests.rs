@@ -371,26 +371,6 @@ fn early_all_miss_return_changes_no_answer() {
 
 /// [`certain_misses`] of a packet, from the same intermediate values as `fast8_with`.
 fn sure_lanes(e: &Fast, org: Vec3x8, dir: Vec3x8) -> Mask8 {
-    let s = |v: f32| F8::splat(v);
-    let dd = (org - Vec3x8::new(s(e.c_hi[0]), s(e.c_hi[1]), s(e.c_hi[2])))
-        - Vec3x8::new(s(e.c_lo[0]), s(e.c_lo[1]), s(e.c_lo[2]));
-    let (o, d) = match e.inv_r {
-        Some(ir) => (dd * s(ir), dir * s(ir)),
-        None => {
-            let m = |v: Vec3x8| {
-                let row = |r: &[f32; 3]| s(r[0]).mul_add(v.x, s(r[1]).mul_add(v.y, s(r[2]) * v.z));
-                Vec3x8::new(row(&e.b[0]), row(&e.b[1]), row(&e.b[2]))
-            };
-            (m(dd), m(dir))
-        }
-    };
-    let e_o = s(e.k_o).mul_add(max_abs(dd), s(e.eps_c));
-    let e_d = s(e.k_d) * max_abs(dir);
-    let a = d.dot(d);
-    let oo = o.dot(o);
-    let inv_a = F8::ONE / a;
-    let b = -o.dot(d) * inv_a;
-    let f = d.mul_add(b, o);
-    let ff = f.dot(f);
+    let Approach { e_o, e_d, a, inv_a, oo, ff, .. } = approach(e, org, dir);
     certain_misses(e_o, e_d, a, inv_a, oo, ff, F8::ONE - ff)
 }
