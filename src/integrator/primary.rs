@@ -6,6 +6,7 @@ use super::context::{masked, TileCtx};
 use super::stats::RayKind;
 use crate::accel::{Hits8, RayHit8};
 use crate::sampler::Stream;
+use crate::scene::build::Scene;
 use crate::scene::gather::SurfaceHit8;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 
@@ -44,10 +45,7 @@ pub(super) fn tile_each(
     sh: &mut impl EachPacket,
 ) {
     out.clear();
-    wave.cam_streams.clear();
-    if samples.clone().any(|s| ctx.samples.camera_draws(s)) {
-        ctx.samples.camera_streams(ctx.pks, &mut wave.cam_streams);
-    }
+    camera_streams(ctx, wave, &samples);
     // One record, reused (the gather writes what the kernels read).
     wave.hits.truncate(1);
     wave.hits.resize(1, SurfaceHit8::MISS);
@@ -72,11 +70,7 @@ pub(super) fn tile_each(
             // Camera rays that leave the scene see the environment (none in `.test` scenes).
             let missed = *traced & !hits.hit;
             if outside && missed.any() {
-                o += match (&scene.sky, &scene.envmap) {
-                    (Some(sky), _) => masked(Vec3x8::splat(sky.radiance), missed),
-                    (None, Some(env)) => env.radiance_pdf_x8(rh.ray.dir(), missed).0,
-                    (None, None) => Vec3x8::ZERO,
-                };
+                o += background(scene, rh.ray.dir(), missed);
             }
             if hit {
                 sh.shade(ctx, rec, i, &mut o);
@@ -84,6 +78,27 @@ pub(super) fn tile_each(
             out.push(o);
         }
         sh.end(ctx, &mut out[first..]);
+    }
+}
+
+/// The camera's pixel-sample streams of the tile's packets into `wave.cam_streams`, hashed once
+/// for the batch `samples` (none when no sample of it draws a camera point).
+#[inline(always)]
+fn camera_streams(ctx: &TileCtx, wave: &mut Wave, samples: &std::ops::Range<u32>) {
+    wave.cam_streams.clear();
+    if samples.clone().any(|s| ctx.samples.camera_draws(s)) {
+        ctx.samples.camera_streams(ctx.pks, &mut wave.cam_streams);
+    }
+}
+
+/// What camera rays in direction `dir` that left the scene see on lanes `missed`: the sky's or the
+/// environment map's radiance (zero in scenes with neither, as in `.test` scenes).
+#[inline(always)]
+fn background(scene: &Scene, dir: Vec3x8, missed: Mask8) -> Vec3x8 {
+    match (&scene.sky, &scene.envmap) {
+        (Some(sky), _) => masked(Vec3x8::splat(sky.radiance), missed),
+        (None, Some(env)) => env.radiance_pdf_x8(dir, missed).0,
+        (None, None) => Vec3x8::ZERO,
     }
 }
 
@@ -118,11 +133,7 @@ pub(super) fn tile(
     mut shade: impl FnMut(&mut TileCtx, &[SurfaceHit8], u32, &mut [Vec3x8]),
 ) {
     out.clear();
-    // The camera's pixel-sample streams, hashed once for the batch (if a sample draws).
-    wave.cam_streams.clear();
-    if samples.clone().any(|s| ctx.samples.camera_draws(s)) {
-        ctx.samples.camera_streams(ctx.pks, &mut wave.cam_streams);
-    }
+    camera_streams(ctx, wave, &samples);
     let n = ctx.pks.len();
     for s in samples {
         // Sample s's entries of `out`, pushed and shaded in place (no copy per sample).
@@ -158,11 +169,7 @@ fn camera_hits(ctx: &mut TileCtx, wave: &mut Wave, s: u32, out: &mut Vec<Vec3x8>
             if missed.none() {
                 continue;
             }
-            *o += match (&scene.sky, &scene.envmap) {
-                (Some(sky), _) => masked(Vec3x8::splat(sky.radiance), missed),
-                (None, Some(env)) => env.radiance_pdf_x8(rh.ray.dir(), missed).0,
-                (None, None) => Vec3x8::ZERO,
-            };
+            *o += background(scene, rh.ray.dir(), missed);
         }
     }
 }
