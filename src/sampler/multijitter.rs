@@ -36,10 +36,13 @@ use super::layout::{Layout, SetShape, StreamKey};
 use super::permute::permute_lanes;
 
 const TAG_MULTIJITTER: u32 = 0x51a7_0006;
-/// Key offsets of the index shuffle and of the two sub-stratum permutations.
+/// Key offsets of the index shuffle and of the two sub-stratum permutations (hashed keys offset
+/// by constants: `permute::permute_lanes` derives its round keys from them the same way).
 const KEY_INDEX: u32 = 0x51633e2d;
 const KEY_COLUMNS: u32 = 0x68bc21eb;
 const KEY_ROWS: u32 = 0x02e5be93;
+/// Key offset of y's jitter.
+const KEY_JITTER_Y: u32 = 0x7a3f_d1c5;
 
 /// Correlated multi-jittered points (Kensler 2013), padded per (pixel, sample, dim).
 #[derive(Clone, Copy, Debug)]
@@ -82,8 +85,9 @@ fn keyed_point<L: Lanes>(set: &SetShape, key: L, dim: u32, k: L) -> (L::F, L::F)
     let sy = permute_lanes(r, grid.ny.d, key.xor(L::splat(KEY_ROWS)));
     let fx = c.mul(L::splat(grid.ny.d)).add(sy);
     let fy = r.mul(L::splat(grid.nx.d)).add(sx);
-    let h = mix(key, s);
-    (jittered(fine_span(fx, grid.n), h), jittered(fine_span(fy, grid.n), mix(h, L::splat(1))))
+    // The two jitters hash under two keys (side by side, not one hash of the other: no chain).
+    let (hx, hy) = (mix(key, s), mix(key.xor(L::splat(KEY_JITTER_Y)), s));
+    (jittered(fine_span(fx, grid.n), hx), jittered(fine_span(fy, grid.n), hy))
 }
 
 impl Layout for MultiJitter {

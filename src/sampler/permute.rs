@@ -40,8 +40,15 @@ pub fn permute(i: u32, n: u32, key: u32) -> u32 {
 /// variance it has under uniformly random pairings, with one round or two). The Feistel network
 /// is level with random pairings (`multijitter_tests.rs`). The indices must be below n (callers
 /// reduce them first).
+///
+/// `key` must be a hash (all 32 bits uniform: callers pass `mix` outputs, offset by a constant per
+/// use): round j hashes `key ^ ROUND[j] ^ half`, so the round keys cost nothing (they were one
+/// `fmix` each, and one more to whiten the key: 6 of the 10 hashes of a permutation).
 #[inline]
 pub(super) fn permute_lanes<L: Lanes>(i: L, n: u32, key: L) -> L {
+    /// Per-round key offsets: they differ in the bits above any half's width, so no two rounds
+    /// (of one key, or of keys differing by the callers' offsets) hash the same word.
+    const ROUND: [u32; 4] = [0x3c6e_f372, 0xa54f_f53a, 0x510e_527f, 0x9b05_688c];
     let n = n.max(1);
     if n == 1 {
         return L::splat(0);
@@ -49,9 +56,8 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, n: u32, key: L) -> L {
     let bits = 32 - (n - 1).leading_zeros();
     let (lo, hi) = (bits / 2, bits - bits / 2);
     let mask = |w: u32| L::splat(if w >= 32 { u32::MAX } else { (1u32 << w) - 1 });
-    let key = fmix(key.xor(L::splat(0x6a09_e667)));
     let r = rotation(key, n);
-    let keys: [L; 4] = std::array::from_fn(|j| fmix(key.add(L::splat(0x9e37_79b9u32.wrapping_mul(j as u32 + 1)))));
+    let keys = ROUND.map(|c| key.xor(L::splat(c)));
     let nn = L::splat(n);
     let (mut x, mut out, mut todo) = (i, L::splat(0), L::splat(u32::MAX));
     loop {
@@ -62,6 +68,11 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, n: u32, key: L) -> L {
             (a, b, wa, wb) = (b, a, wb, wa);
         }
         x = a.shl(wb).or(b);
+        if n.is_power_of_two() {
+            // The domain is 0..n: every lane is in range after one pass (and the rotation wraps
+            // by a mask).
+            return x.add(r).and(L::splat(n - 1));
+        }
         // First pass in range wins: lanes already done keep their value.
         let inside = x.lt_mask(nn).and(todo);
         out = out.or(x.and(inside));
