@@ -4,6 +4,7 @@
 
 use super::divisor::Divisor;
 use super::lanes::Lanes;
+use super::permute::PermDomain;
 
 /// Grid shape used for n strata: (nx, ny) with nx * ny == n, nx <= ny, nx the largest divisor of n
 /// that is <= sqrt(n). Any n; n == 0 acts as 1, giving (1, 1).
@@ -31,13 +32,16 @@ pub(super) struct Grid {
     pub(super) nx: Divisor,
     /// rows
     pub(super) ny: Divisor,
+    /// the domains of keyed permutations of 0..n, 0..nx and 0..ny (`multijitter`'s shuffles)
+    pub(super) perm: [PermDomain; 3],
 }
 
 impl Grid {
     /// The `strata_shape(n)` grid of n cells (n == 0 acts as 1).
     pub(super) fn new(n: u32) -> Self {
         let (nx, ny) = strata_shape(n);
-        Self { n: Divisor::new(n), nx: Divisor::new(nx), ny: Divisor::new(ny) }
+        let perm = [n, nx, ny].map(PermDomain::new);
+        Self { n: Divisor::new(n), nx: Divisor::new(nx), ny: Divisor::new(ny), perm }
     }
 }
 

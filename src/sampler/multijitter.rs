@@ -79,10 +79,11 @@ const DIM_CAMERA: u32 = 0;
 fn keyed_point<L: Lanes>(set: &SetShape, key: L, dim: u32, k: L) -> (L::F, L::F) {
     let grid = set.grid();
     let k = if k.max_lane() < grid.n.d { k } else { grid.n.rem(k) };
-    let s = if dim == DIM_CAMERA { k } else { permute_lanes(k, grid.n.d, key.xor(L::splat(KEY_INDEX))) };
+    let [pn, pnx, pny] = &grid.perm;
+    let s = if dim == DIM_CAMERA { k } else { permute_lanes(k, pn, key.xor(L::splat(KEY_INDEX))) };
     let (r, c) = grid.nx.div_rem(s);
-    let sx = permute_lanes(c, grid.nx.d, key.xor(L::splat(KEY_COLUMNS)));
-    let sy = permute_lanes(r, grid.ny.d, key.xor(L::splat(KEY_ROWS)));
+    let sx = permute_lanes(c, pnx, key.xor(L::splat(KEY_COLUMNS)));
+    let sy = permute_lanes(r, pny, key.xor(L::splat(KEY_ROWS)));
     let fx = c.mul(L::splat(grid.ny.d)).add(sy);
     let fy = r.mul(L::splat(grid.nx.d)).add(sx);
     // The two jitters hash under two keys (side by side, not one hash of the other: no chain).

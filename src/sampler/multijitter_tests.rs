@@ -4,7 +4,7 @@
 //! cover it too.
 
 use super::super::grid::strata_shape;
-use super::super::permute::permute;
+use super::super::permute::{permute, PermDomain};
 use super::super::{PointSet, SamplerKind};
 use super::*;
 
@@ -166,21 +166,52 @@ fn permute_lanes_is_a_permutation() {
     for n in [1u32, 2, 3, 7, 8, 16, 17, 64, 100, 256, 1000] {
         for key in [0u32, 1, 0xdead_beef, u32::MAX] {
             let mut seen = vec![false; n as usize];
+            let d = PermDomain::new(n);
             for i in 0..n {
-                let p = permute_lanes(i, n, key);
+                let p = permute_lanes(i, &d, key);
                 assert!(p < n && !seen[p as usize], "n = {n}, key {key}: {i} -> {p}");
                 seen[p as usize] = true;
                 let lanes = crate::simd::U8::new(std::array::from_fn(|j| (i + j as u32) % n));
                 let keys = crate::simd::U8::new(std::array::from_fn(|j| key.wrapping_add(j as u32)));
-                let p8 = permute_lanes(lanes, n, keys).to_array();
+                let p8 = permute_lanes(lanes, &d, keys).to_array();
                 for (j, v) in p8.into_iter().enumerate() {
-                    assert_eq!(v, permute_lanes((i + j as u32) % n, n, key.wrapping_add(j as u32)));
+                    assert_eq!(v, permute_lanes((i + j as u32) % n, &d, key.wrapping_add(j as u32)));
                 }
             }
         }
     }
-    let differs = (0..64).any(|i| permute_lanes(i, 64, 5) != permute(i, 64, 5));
+    let differs = (0..64).any(|i| permute_lanes(i, &PermDomain::new(64), 5) != permute(i, 64, 5));
     assert!(differs);
+}
+
+/// The permutation domains are tight: 0..m in Z_a x Z_b with a * b == m where m has a factor
+/// pair near its square root (no cycle walking: the x8 lanes walked in lockstep, 2-5 passes of
+/// four hashes for 10 or 100 points in power-of-two domains of 16 and 128), else with fewer than
+/// a spare cells; both halves at least 2 from m = 3 on. A domain beyond 2^31 is all of u32, and
+/// its permutation maps sampled indices into 0..m without collisions.
+#[test]
+fn permutation_domains_are_tight() {
+    for (m, want) in [(1, (1, 1)), (2, (2, 1)), (3, (2, 2)), (4, (2, 2)), (7, (4, 2)), (10, (5, 2)), (12, (4, 3))] {
+        assert_eq!(PermDomain::new(m).shape(), want, "m = {m}");
+    }
+    for m in [16u32, 25, 64, 100, 256, 1024, 4096, 3 * 5 * 7 * 11] {
+        let (a, b) = PermDomain::new(m).shape();
+        assert_eq!(a * b, m, "m = {m}: {a} x {b}");
+    }
+    for m in 3..5000u32 {
+        let (a, b) = PermDomain::new(m).shape();
+        assert!(b >= 2 && a >= b && a * b >= m && a * b - m < a, "m = {m}: {a} x {b}");
+    }
+    let m = (1u32 << 31) + 12_345;
+    assert_eq!(PermDomain::new(m).shape(), (1 << 16, 1 << 16));
+    let d = PermDomain::new(m);
+    let mut seen = std::collections::HashSet::new();
+    for i in (0..m).step_by(104_729).chain(m - 100..m) {
+        let p = permute_lanes(i, &d, 0x1234_5678 ^ i.rotate_left(7));
+        assert!(p < m, "{i} -> {p} beyond {m}");
+        let p = permute_lanes(i, &d, 0x1234_5678);
+        assert!(p < m && seen.insert(p), "{i} -> {p}: out of range or twice");
+    }
 }
 
 /// The camera's dimension keeps point k in coarse cell (k % nx, k / nx), as `stratified` does
@@ -202,3 +233,4 @@ fn camera_points_keep_their_coarse_cell() {
     });
     assert!(moved, "dimension 66 keeps the index order");
 }
+

@@ -29,57 +29,130 @@ pub fn permute(i: u32, n: u32, key: u32) -> u32 {
     }
 }
 
-/// A keyed permutation of 0..n over any [`Lanes`] (lane-uniform n, per-lane keys) that is close
-/// to a uniformly random one, unlike [`permute`]: a four-round Feistel network on the smallest
-/// power-of-two domain >= n (its bits split into two halves, each round xoring one half with a
-/// keyed `fmix` hash of the other), cycle-walked back into 0..n, then [`permute`]'s keyed uniform
-/// rotation. [`permute`]'s xorshift-multiply round is a small family for small n (128 distinct
-/// permutations of 8 elements in 200,000 keys; two rounds 768): two dimensions shuffled by it
-/// pair their indices by related permutations, which correlates the dimensions (issue 33: a
-/// function coupling two padded dimensions of a 16-point `multijitter` set had 1.17-1.18x the
-/// variance it has under uniformly random pairings, with one round or two). The Feistel network
-/// is level with random pairings (`multijitter_tests.rs`). The indices must be below n (callers
-/// reduce them first).
+/// The domain of [`permute_lanes`] for one m: 0..m embedded in Z_a x Z_b (x = l * b + r, l < a,
+/// r < b), with a * b >= m as small as a search near sqrt(m) finds (b from floor(sqrt m) down, at
+/// most 64 tries): a * b == m whenever m has a factor pair there (12 = 4 x 3, 25, 64, 100), so no
+/// cycle walking; otherwise a * b - m < a (7 in 4 x 2, 13 in 7 x 2), where a power-of-two domain
+/// (7 in 8, 10 in 16, 100 in 128) made eight lanes walk in lockstep for 2-5 passes.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PermDomain {
+    /// m, >= 1
+    m: u32,
+    /// a: the range of l
+    a: u32,
+    /// b: the range of r
+    b: Divisor,
+    /// a * b == m: no cycle walking
+    exact: bool,
+    /// a and b are powers of two: split by a shift, rounds add by XOR
+    pow2: bool,
+    /// log2 b when `pow2`
+    shift: u32,
+}
+
+impl PermDomain {
+    /// The domain of 0..m (m == 0 acts as 1).
+    pub(super) fn new(m: u32) -> Self {
+        let m = m.max(1);
+        let (a, b) = if m > 1 << 31 {
+            // Z_2^16 x Z_2^16: all of u32 (x = l * b + r stays exact in wrapping arithmetic).
+            (1 << 16, 1 << 16)
+        } else if m <= 2 {
+            (m, 1)
+        } else {
+            let root = (f64::from(m).sqrt() as u32).max(2);
+            let mut best = (m.div_ceil(2), 2u32);
+            for b in (2..=root).rev().take(64) {
+                let a = m.div_ceil(b);
+                if u64::from(a) * u64::from(b) < u64::from(best.0) * u64::from(best.1) || a * b == m {
+                    best = (a, b);
+                }
+                if a * b == m {
+                    break;
+                }
+            }
+            best
+        };
+        let exact = u64::from(a) * u64::from(b) == u64::from(m);
+        let pow2 = a.is_power_of_two() && b.is_power_of_two();
+        Self { m, a, b: Divisor::new(b), exact, pow2, shift: b.trailing_zeros() }
+    }
+
+    /// (a, b): 0..m lies in Z_a x Z_b.
+    #[cfg(test)]
+    pub(super) fn shape(&self) -> (u32, u32) {
+        (self.a, self.b.d)
+    }
+}
+
+/// A keyed permutation of 0..m (`d`'s m; lane-uniform, per-lane keys) that is close to a
+/// uniformly random one, unlike [`permute`]: a four-round alternating Feistel network on
+/// [`PermDomain`]'s Z_a x Z_b (rounds add, mod a or mod b, a keyed `fmix` hash of the other
+/// half to l, then to r, then l, then r: each round a bijection of Z_a x Z_b; XOR instead of
+/// addition when a and b are powers of two), cycle-walked back
+/// into 0..m where a * b > m, then [`permute`]'s keyed uniform rotation. [`permute`]'s
+/// xorshift-multiply round is a small family for small n (128 distinct permutations of 8
+/// elements in 200,000 keys; two rounds 768): two dimensions shuffled by it pair their indices by
+/// related permutations, which correlates the dimensions (issue 33: a function coupling two padded
+/// dimensions of a 16-point `multijitter` set had 1.17-1.18x the variance it has under uniformly
+/// random pairings, with one round or two). The Feistel network is level with random pairings
+/// (`multijitter_tests.rs`). The indices must be below m (callers reduce them first).
 ///
 /// `key` must be a hash (all 32 bits uniform: callers pass `mix` outputs, offset by a constant per
 /// use): round j hashes `key ^ ROUND[j] ^ half`, so the round keys cost nothing (they were one
 /// `fmix` each, and one more to whiten the key: 6 of the 10 hashes of a permutation).
-#[inline]
-pub(super) fn permute_lanes<L: Lanes>(i: L, n: u32, key: L) -> L {
+#[inline(always)]
+pub(super) fn permute_lanes<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
     /// Per-round key offsets: they differ in the bits above any half's width, so no two rounds
     /// (of one key, or of keys differing by the callers' offsets) hash the same word.
     const ROUND: [u32; 4] = [0x3c6e_f372, 0xa54f_f53a, 0x510e_527f, 0x9b05_688c];
-    let n = n.max(1);
+    let n = d.m;
     if n == 1 {
         return L::splat(0);
     }
-    let bits = 32 - (n - 1).leading_zeros();
-    let (lo, hi) = (bits / 2, bits - bits / 2);
-    let mask = |w: u32| L::splat(if w >= 32 { u32::MAX } else { (1u32 << w) - 1 });
     let r = rotation(key, n);
     let keys = ROUND.map(|c| key.xor(L::splat(c)));
+    let (a, b) = (L::splat(d.a), L::splat(d.b.d));
+    // (x + y) mod m for x, y < m.
+    let add_mod = |x: L, y: L, m: L| {
+        let s = x.add(y);
+        s.lt_select(m, s, s.sub(m))
+    };
     let nn = L::splat(n);
-    let (mut x, mut out, mut todo) = (i, L::splat(0), L::splat(u32::MAX));
-    loop {
-        // One Feistel pass: (a, b) of widths (hi, lo); each round a ^= F(b), then the halves swap.
-        let (mut a, mut b, mut wa, mut wb) = (x.shr(lo), x.and(mask(lo)), hi, lo);
-        for k in keys {
-            a = a.xor(fmix(k.xor(b)).and(mask(wa)));
-            (a, b, wa, wb) = (b, a, wb, wa);
-        }
-        x = a.shl(wb).or(b);
-        if n.is_power_of_two() {
-            // The domain is 0..n: every lane is in range after one pass (and the rotation wraps
-            // by a mask).
+    // (x + r) mod n for x, r < n, without overflow (n may exceed 2^31).
+    let rotate = |x: L| {
+        if d.exact && d.pow2 {
             return x.add(r).and(L::splat(n - 1));
+        }
+        let t = nn.sub(r);
+        x.lt_select(t, x.add(r), x.sub(t))
+    };
+    let (mut x, mut out, mut todo) = (i, L::splat(0), L::splat(u32::MAX));
+    // Powers of two (the common spp) split by shifts and add by XOR (bits of the hash instead of
+    // a high multiply): the same network over the group Z_2^k.
+    let pow2 = d.pow2;
+    let (ma, mb, shift) = (a.sub(L::splat(1)), b.sub(L::splat(1)), d.shift);
+    loop {
+        let (mut hi, mut lo) = if pow2 { (x.shr(shift), x.and(mb)) } else { d.b.div_rem(x) };
+        for (j, k) in keys.into_iter().enumerate() {
+            match (j % 2 == 0, pow2) {
+                (true, true) => hi = hi.xor(fmix(k.xor(lo)).and(ma)),
+                (false, true) => lo = lo.xor(fmix(k.xor(hi)).and(mb)),
+                (true, false) => hi = add_mod(hi, fmix(k.xor(lo)).mulhi(a), a),
+                (false, false) => lo = add_mod(lo, fmix(k.xor(hi)).mulhi(b), b),
+            }
+        }
+        x = if pow2 { hi.shl(shift).or(lo) } else { hi.mul(b).add(lo) };
+        if d.exact {
+            // The domain is 0..n: every lane is in range after one pass.
+            return rotate(x);
         }
         // First pass in range wins: lanes already done keep their value.
         let inside = x.lt_mask(nn).and(todo);
         out = out.or(x.and(inside));
         todo = todo.and(inside.xor(L::splat(u32::MAX)));
         if todo.max_lane() == 0 {
-            let y = out.add(r);
-            return y.lt_select(nn, y, y.sub(nn));
+            return rotate(out);
         }
     }
 }
