@@ -46,6 +46,9 @@ pub(super) struct Each<'a, L> {
     buf: &'a mut Buffers,
     /// pixel sample s's constants
     one: Option<OneLight>,
+    /// whether `buf.table_streams` holds the light point's streams of the tile's packets (made
+    /// at the batch's first sample; none for a grid layout)
+    streamed: Option<bool>,
     lobes: std::marker::PhantomData<L>,
 }
 
@@ -60,7 +63,7 @@ struct OneLight {
 impl<'a, L> Each<'a, L> {
     /// `direct` (`it`) shading with the buffers `buf`.
     pub(super) fn new(it: &'a Integrator, buf: &'a mut Buffers) -> Self {
-        Self { it, buf, one: None, lobes: std::marker::PhantomData }
+        Self { it, buf, one: None, streamed: None, lobes: std::marker::PhantomData }
     }
 }
 
@@ -79,13 +82,19 @@ impl<L: LobeSet> EachPacket for Each<'_, L> {
         // The light points of every packet that hit something (a point is a pure function of its
         // pixel and index: drawing it for a packet that turns out to shade nothing changes no
         // other).
+        // The light point's streams, hashed once per pixel for the batch's samples.
+        let Buffers { uv, table_streams, .. } = &mut *self.buf;
+        let streamed = *self.streamed.get_or_insert_with(|| table.streams(smp, ctx.pks, table_streams));
         let n = it.light_set.n();
-        let uv = &mut self.buf.uv;
         uv.clear();
-        for ((rh, traced), pk) in packets.iter().zip(ctx.pks) {
+        for (i, ((rh, traced), pk)) in packets.iter().zip(ctx.pks).enumerate() {
             let hit = Hits8::from_rayhit(rh, *traced).hit.any();
             for k in 0..n {
-                uv.push(if hit { table.point(smp, pk.pixel, k) } else { (F8::ZERO, F8::ZERO) });
+                uv.push(match (hit, streamed) {
+                    (false, _) => (F8::ZERO, F8::ZERO),
+                    (true, true) => table.stream_point(smp, pk.pixel, &table_streams[i], k),
+                    (true, false) => table.point(smp, pk.pixel, k),
+                });
             }
         }
         self.buf.batch.clear();
