@@ -108,7 +108,8 @@ impl Estimator for Direct {
     ) {
         let DirectScratch { wave, buf, bsdf } = sc;
         if each::each_packet(it, ctx.scene) {
-            return primary::tile_each(ctx, wave, samples, out, &mut each::Each::<L>::new(it, buf));
+            let mut each = each::Each::<L>::new(it, buf, samples.len());
+            return primary::tile_each(ctx, wave, samples, out, &mut each);
         }
         primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, bsdf, s, out));
     }
