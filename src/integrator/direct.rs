@@ -30,6 +30,7 @@ use super::samples::{Dim, Samples, Source, CAMERA};
 use super::settings::Integrator;
 use crate::accel::Ray8;
 use crate::bsdf::{BsdfSet, LobeSet};
+use crate::camera::PixelPacket;
 use crate::light::emitters::{Emitter, LightSample8};
 use crate::light::select::LightChoice;
 use crate::light::warp::LightWarp;
@@ -80,6 +81,9 @@ struct Buffers {
     choice_streams: Vec<Stream<U8>>,
     /// packet by packet ([`Each`]): the light points of the sample's packets, N per packet
     uv: Vec<(F8, F8)>,
+    /// packet by packet ([`Each`]): the light table's streams of the tile's packets (the light
+    /// point's dimension), made once per batch of samples
+    table_streams: Vec<Stream<U8>>,
 }
 
 /// Per camera packet of the tile: the lanes to shade and the shadow-ray origin offsets.
@@ -104,7 +108,8 @@ impl Estimator for Direct {
     ) {
         let DirectScratch { wave, buf, bsdf } = sc;
         if each::each_packet(it, ctx.scene) {
-            return primary::tile_each(ctx, wave, samples, out, &mut each::Each::<L>::new(it, buf));
+            let mut each = each::Each::<L>::new(it, buf, samples.len());
+            return primary::tile_each(ctx, wave, samples, out, &mut each);
         }
         primary::tile(ctx, wave, samples, out, |ctx, hits, s, out| shade::<L>(it, ctx, hits, buf, bsdf, s, out));
     }
@@ -311,6 +316,19 @@ impl LightTable {
     pub(super) fn point(&self, smp: &Samples, pixel: U8, k: u32) -> (F8, F8) {
         let index = U8::splat(self.first.wrapping_add(k));
         smp.table_point(&self.dim, true, Phase::SamplerLight, pixel, index)
+    }
+
+    /// The streams of this dimension for the packets `pks` into `out` (false, `out` empty, for a
+    /// grid layout), for [`LightTable::stream_point`]; the same for every pixel sample.
+    pub(super) fn streams(&self, smp: &Samples, pks: &[PixelPacket], out: &mut Vec<Stream<U8>>) -> bool {
+        smp.table_streams(&self.dim, true, pks, out)
+    }
+
+    /// [`LightTable::point`] from `stream`, the pixels' stream of [`LightTable::streams`]: the same
+    /// point, bit for bit, without the per-pixel hashing.
+    #[inline]
+    pub(super) fn stream_point(&self, smp: &Samples, pixel: U8, stream: &Stream<U8>, k: u32) -> (F8, F8) {
+        smp.table_stream_point(&self.dim, true, Phase::SamplerLight, pixel, stream, self.first.wrapping_add(k))
     }
 }
 

@@ -46,8 +46,14 @@ pub(super) struct Each<'a, L> {
     buf: &'a mut Buffers,
     /// pixel sample s's constants
     one: Option<OneLight>,
+    /// whether `buf.table_streams` holds the light point's streams of the tile's packets (made
+    /// at the batch's first sample; none for a grid layout)
+    streamed: Option<bool>,
     lobes: std::marker::PhantomData<L>,
 }
+
+/// The fewest samples of a batch for which [`Each`] draws the light points from streams.
+const STREAM_BATCH: usize = 8;
 
 /// [`super::shade_one`]'s per-sample constants.
 struct OneLight {
@@ -58,9 +64,13 @@ struct OneLight {
 }
 
 impl<'a, L> Each<'a, L> {
-    /// `direct` (`it`) shading with the buffers `buf`.
-    pub(super) fn new(it: &'a Integrator, buf: &'a mut Buffers) -> Self {
-        Self { it, buf, one: None, lobes: std::marker::PhantomData }
+    /// `direct` (`it`) shading with the buffers `buf`, for a batch of `samples` pixel samples:
+    /// the light points come from per-packet streams when the batch has at least
+    /// [`STREAM_BATCH`] samples (a stream costs about five points' hashing: callgrind, pmj02),
+    /// else point by point. The same points either way.
+    pub(super) fn new(it: &'a Integrator, buf: &'a mut Buffers, samples: usize) -> Self {
+        let streamed = (samples < STREAM_BATCH).then_some(false);
+        Self { it, buf, one: None, streamed, lobes: std::marker::PhantomData }
     }
 }
 
@@ -79,13 +89,19 @@ impl<L: LobeSet> EachPacket for Each<'_, L> {
         // The light points of every packet that hit something (a point is a pure function of its
         // pixel and index: drawing it for a packet that turns out to shade nothing changes no
         // other).
+        // The light point's streams, hashed once per pixel for the batch's samples.
+        let Buffers { uv, table_streams, .. } = &mut *self.buf;
+        let streamed = *self.streamed.get_or_insert_with(|| table.streams(smp, ctx.pks, table_streams));
         let n = it.light_set.n();
-        let uv = &mut self.buf.uv;
         uv.clear();
-        for ((rh, traced), pk) in packets.iter().zip(ctx.pks) {
+        for (i, ((rh, traced), pk)) in packets.iter().zip(ctx.pks).enumerate() {
             let hit = Hits8::from_rayhit(rh, *traced).hit.any();
             for k in 0..n {
-                uv.push(if hit { table.point(smp, pk.pixel, k) } else { (F8::ZERO, F8::ZERO) });
+                uv.push(match (hit, streamed) {
+                    (false, _) => (F8::ZERO, F8::ZERO),
+                    (true, true) => table.stream_point(smp, pk.pixel, &table_streams[i], k),
+                    (true, false) => table.point(smp, pk.pixel, k),
+                });
             }
         }
         self.buf.batch.clear();
@@ -185,21 +201,24 @@ mod tests {
 
     /// `direct` packet by packet gives the wavefront's radiance bit for bit: one light (its
     /// choice certain) and two (chosen from the light point's u, or from a dimension of their
-    /// own), one and two light samples, three samplers, the diffuse and the general kernel.
+    /// own), one and two light samples, three samplers, batches whose light points are drawn point
+    /// by point and from streams, the diffuse and the general kernel.
     #[test]
     fn packet_by_packet_matches_the_wavefront_bit_for_bit() {
         for (lights, n, choice) in
             [(1, 1, LightChoice::Reuse), (2, 1, LightChoice::Reuse), (2, 2, LightChoice::Dimension)]
         {
             let sc = scene(lights);
-            for kind in [SamplerKind::INDEPENDENT, SamplerKind::SOBOL, SamplerKind::PMJ02] {
+            // 4 spp: the light points drawn point by point; 8 (`STREAM_BATCH`): from streams.
+            let runs = [SamplerKind::INDEPENDENT, SamplerKind::SOBOL, SamplerKind::PMJ02].map(|k| (k, 4)).into_iter();
+            for (kind, spp) in runs.chain([(SamplerKind::SOBOL, 8), (SamplerKind::PMJ02, 8)]) {
                 let samplers = SamplerChoice { sampler: None, pixel: Some(kind), light: Some(kind) };
-                let mut it = Integrator::new(&sc, 4, 3, samplers, Some(n));
+                let mut it = Integrator::new(&sc, spp, 3, samplers, Some(n));
                 it.first_sample = FirstSample::Jittered;
                 it.set_light_selection(&sc, "uniform".parse().expect("selection"));
                 it.light_choice = choice;
                 assert!(each_packet(&it, &sc), "{lights} lights, {n} samples: packet by packet");
-                let what = format!("{lights} lights, {n} light samples, {kind:?}");
+                let what = format!("{lights} lights, {n} light samples, {kind:?}, {spp} spp");
                 let each = radiance::<Diffuse>(&it, &sc, true);
                 assert!(each.iter().any(|p| p[0] != 0), "{what}: some light");
                 assert_eq!(each, radiance::<Diffuse>(&it, &sc, false), "{what}");

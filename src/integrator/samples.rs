@@ -176,6 +176,46 @@ impl<'a> Samples<'a> {
         if light { &it.light_table } else { &it.path_set }.path_dim(n, dim, it.seed)
     }
 
+    /// The streams of table dimension `d` (from [`Samples::table_dim`] with the same `light`) for
+    /// the pixels of each packet of `pks`, in order, into `out`, for [`Samples::table_stream_point`]:
+    /// the per-pixel hashing done once for every index. False (and `out` empty) when the table's
+    /// layout is a grid, whose points are drawn by [`Samples::table_point`] only.
+    pub fn table_streams(&self, d: &PathDim, light: bool, pks: &[PixelPacket], out: &mut Vec<Stream<U8>>) -> bool {
+        let _p = profile::scope(if light { Phase::SamplerLight } else { Phase::SamplerPath });
+        let it = self.it;
+        let table = if light { &it.light_table } else { &it.path_set };
+        out.clear();
+        for pk in pks {
+            match table.path_stream_x8(d, pk.pixel) {
+                Some(s) => out.push(s),
+                None => {
+                    out.clear();
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// [`Samples::table_point`] at the lane-uniform table index `index` from `stream`, the stream
+    /// of the pixels `pixel` (from [`Samples::table_streams`] with the same `d` and `light`): the
+    /// same point, bit for bit, timed and logged the same.
+    #[inline(always)]
+    pub fn table_stream_point(
+        &self,
+        d: &PathDim,
+        light: bool,
+        phase: Phase,
+        pixel: U8,
+        stream: &Stream<U8>,
+        index: u32,
+    ) -> (F8, F8) {
+        let _p = profile::leaf(phase);
+        replay::path_point(pixel, U8::splat(index), d.dim(), light);
+        let _ = self;
+        stream.point(index)
+    }
+
     /// The 2D point of table dimension `d` (from [`Samples::table_dim`] with the same `light`) for
     /// the pixels `pixel` at table indices `index`, timed as `phase`.
     #[inline(always)]

@@ -24,7 +24,7 @@ impl Layout for Independent {
     #[inline]
     fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
         let prefix = mix(mix(L::splat(stream_key(TAG_INDEPENDENT, seed, dim)), pixel), sample);
-        StreamKey { prefix, base: L::splat(0), sample, dim, seed }
+        StreamKey { prefix, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
     }
 
     #[inline]

@@ -68,6 +68,8 @@ pub struct StreamKey<L> {
     pub dim: u32,
     /// base seed
     pub seed: u64,
+    /// layout-defined further words of the stream (pmj02: its scramble); zero by default
+    pub words: [L; 5],
 }
 
 /// A 2D point-set layout: point k (0 <= k < n) of the n-point set of stream (pixel, sample, dim)
@@ -83,7 +85,7 @@ pub trait Layout: Send + Sync + 'static {
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
         let _ = set;
-        StreamKey { prefix: pixel, base: L::splat(0), sample, dim, seed }
+        StreamKey { prefix: pixel, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
     }
 
     /// Point k (lane-uniform) of a stream; must equal `point` with `k` splatted, bit for bit.

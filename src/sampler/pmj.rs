@@ -48,7 +48,7 @@ use std::sync::OnceLock;
 use super::hash::{combine, combine_key, fmix};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
-use super::sobol::prefix_shuffle;
+use super::sobol::{prefix_shuffle_key, prefix_shuffle_with};
 use crate::simd::{F8, U8};
 
 /// Points per table: the period of every pmj02 stream (a power of two, 2^12).
@@ -82,13 +82,15 @@ impl Layout for Pmj02 {
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
         let (key, pick) = stream_words(pixel, dim, seed);
         let first = sample.mul(L::splat(set.n().max(1))).and(L::splat(TABLE_POINTS - 1));
-        StreamKey { prefix: key, base: first.or(pick.shl(LOG_POINTS)), sample, dim, seed }
+        let words = Scramble::new(key).words();
+        StreamKey { prefix: key, base: first.or(pick.shl(LOG_POINTS)), sample, dim, seed, words }
     }
 
+    /// The stream's [`Scramble`] is in its `words`, computed once.
     #[inline]
     fn stream_point<L: Lanes>(&self, _: &SetShape, s: &StreamKey<L>, k: u32) -> (L::F, L::F) {
         let index = s.base.add(L::splat(k)).and(L::splat(TABLE_POINTS - 1));
-        table_point(s.prefix, index, s.base.shr(LOG_POINTS))
+        table_point(&Scramble::of(&s.words), index, s.base.shr(LOG_POINTS))
     }
 
     /// The tables (tens of milliseconds, built once per process).
@@ -114,7 +116,7 @@ pub fn pmj02_2d_x8(pixel: U8, sample: U8, dim: u32, k: U8, n: u32, seed: u64) ->
 fn pmj02<L: Lanes>(pixel: L, sample: L, dim: u32, k: L, n: u32, seed: u64) -> (L::F, L::F) {
     let (key, pick) = stream_words(pixel, dim, seed);
     let index = sample.mul(L::splat(n.max(1))).add(k).and(L::splat(TABLE_POINTS - 1));
-    table_point(key, index, pick)
+    table_point(&Scramble::new(key), index, pick)
 }
 
 /// The words of stream (pixel, dim, seed): its key and its base sequence `pick` (table and axis
@@ -127,21 +129,51 @@ fn stream_words<L: Lanes>(pixel: L, dim: u32, seed: u64) -> (L, L) {
     (key, offset.add(L::splat(dim)).and(L::splat((TABLES << 1) - 1)))
 }
 
-/// Sequence point `index` (< 4096) of base sequence `pick` under stream key `key`.
+/// What every point of one stream key shares: the index shuffle's multipliers
+/// (`sobol::prefix_shuffle_key`) and the axes' 24-bit digital shifts.
+#[derive(Clone, Copy)]
+struct Scramble<L> {
+    shuffle: [L; 3],
+    sx: L,
+    sy: L,
+}
+
+impl<L: Lanes> Scramble<L> {
+    /// The scramble of stream key `key`.
+    #[inline]
+    fn new(key: L) -> Self {
+        let (sx, sy) = (combine(key, L::splat(2)).shr(8), combine(key, L::splat(3)).shr(8));
+        Self { shuffle: prefix_shuffle_key(key), sx, sy }
+    }
+
+    /// As a stream's words ([`StreamKey::words`]).
+    #[inline]
+    fn words(&self) -> [L; 5] {
+        let [a, b, c] = self.shuffle;
+        [a, b, c, self.sx, self.sy]
+    }
+
+    /// From a stream's words.
+    #[inline]
+    fn of(w: &[L; 5]) -> Self {
+        Self { shuffle: [w[0], w[1], w[2]], sx: w[3], sy: w[4] }
+    }
+}
+
+/// Sequence point `index` (< 4096) of base sequence `pick` under the stream key's scramble `sc`.
 #[inline]
-fn table_point<L: Lanes>(key: L, index: L, pick: L) -> (L::F, L::F) {
+fn table_point<L: Lanes>(sc: &Scramble<L>, index: L, pick: L) -> (L::F, L::F) {
     // The index, shuffled per (pixel, dim) keeping every prefix [0, 2^m) (so prefixes stay nets):
     // without it two dims drawing the same index of tables built by the same forced construction
     // are correlated (a pixel's light choice then follows its light point).
-    let index = prefix_shuffle(index, key).and(L::splat(TABLE_POINTS - 1));
+    let index = prefix_shuffle_with(index, &sc.shuffle).and(L::splat(TABLE_POINTS - 1));
     // Table from the high bits, axis swap from the lowest bit (as an all-ones/all-zeros mask).
     let slot = pick.shr(1).shl(LOG_POINTS).or(index);
     let swap = pick.and(L::splat(1)).mul(L::splat(u32::MAX));
     let (x, y) = slot.gather2(tables());
     let d = x.xor(y).and(swap);
     let (x, y) = (x.xor(d), y.xor(d));
-    let (sx, sy) = (combine(key, L::splat(2)).shr(8), combine(key, L::splat(3)).shr(8));
-    (x.xor(sx).unit24(), y.xor(sy).unit24())
+    (x.xor(sc.sx).unit24(), y.xor(sc.sy).unit24())
 }
 
 /// All tables, table t at entries t * 4096 .. (t + 1) * 4096, as 24-bit fixed-point [x, y].

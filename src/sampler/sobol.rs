@@ -78,7 +78,7 @@ impl Layout for Sobol {
     /// `sample * n` in `base`, hashed once for all the points of the stream.
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        StreamKey { prefix: stream_key(pixel, dim, seed), base: sample.mul(L::splat(set.n().max(1))), sample, dim, seed }
+        StreamKey { prefix: stream_key(pixel, dim, seed), base: sample.mul(L::splat(set.n().max(1))), sample, dim, seed, words: [L::splat(0); 5] }
     }
 
     #[inline]
@@ -123,7 +123,20 @@ pub(super) fn keyed_point<L: Lanes>(key: L, index: L) -> (L::F, L::F) {
 /// hashes, four reversals); this is one hash and two reversals.
 #[inline]
 pub(super) fn prefix_shuffle<L: Lanes>(i: L, key: L) -> L {
-    reverse_bits(lk_shift_free(reverse_bits(i), key))
+    prefix_shuffle_with(i, &prefix_shuffle_key(key))
+}
+
+/// The multipliers [`prefix_shuffle`] derives from its key: what every index shuffled under one
+/// key shares (a stream computes them once, [`prefix_shuffle_with`] uses them).
+#[inline]
+pub(super) fn prefix_shuffle_key<L: Lanes>(key: L) -> [L; 3] {
+    [rotl(key, 11).shl(1), rotl(key, 22).or(L::splat(1)), rotl(key, 27).shl(1)]
+}
+
+/// [`prefix_shuffle`] of `i` under the key whose [`prefix_shuffle_key`] is `m`: the same bits.
+#[inline]
+pub(super) fn prefix_shuffle_with<L: Lanes>(i: L, m: &[L; 3]) -> L {
+    reverse_bits(lk_shift_free(reverse_bits(i), m))
 }
 
 /// [`lk_permute`] without its key additions: bit j of the result is bit j of `x` XOR a keyed
@@ -131,11 +144,11 @@ pub(super) fn prefix_shuffle<L: Lanes>(i: L, key: L) -> L {
 /// a multiplication by an odd number or an XOR with `x` times an even number), so 0 stays 0 and
 /// the lowest set bit stays.
 #[inline]
-fn lk_shift_free<L: Lanes>(x: L, key: L) -> L {
-    let x = x.xor(x.mul(rotl(key, 11).shl(1)));
-    let x = x.mul(rotl(key, 22).or(L::splat(1)));
+fn lk_shift_free<L: Lanes>(x: L, m: &[L; 3]) -> L {
+    let x = x.xor(x.mul(m[0]));
+    let x = x.mul(m[1]);
     let x = x.xor(x.mul(L::splat(0x6d4e_1c2a)));
-    x.xor(x.mul(rotl(key, 27).shl(1)))
+    x.xor(x.mul(m[2]))
 }
 
 /// Sobol' point `i` (dimensions 0, 1), Owen-scrambled with the axis keys `combine(key, 2)` and

@@ -9,7 +9,7 @@ use super::hash::{hash, mix, stream_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
 use super::permute::ShuffleKey;
-use super::PointSet;
+use super::{PointSet, Stream};
 use crate::simd::{F8, U8};
 
 const TAG_STRATIFIED: u32 = 0x51a7_0002;
@@ -63,7 +63,7 @@ impl Layout for Stratified {
     #[inline]
     fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
         let prefix = mix(mix(L::splat(stream_key(TAG_STRATIFIED, seed, dim)), pixel), sample);
-        StreamKey { prefix, base: L::splat(0), sample, dim, seed }
+        StreamKey { prefix, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
     }
 
     #[inline]
@@ -262,6 +262,15 @@ impl GridTable {
         let shuffle = ShuffleKey::new(spp, dim, seed);
         let key = stream_key(TAG_STRATIFIED, seed, dim);
         PathDim { dim, seed, shuffle, key, in_range: shuffle.n() <= self.set.n() }
+    }
+
+    /// The points of dimension `d` of pixels `pixel` as a stream, for a layout that is not a grid
+    /// (`None` for a grid: its indices are shuffled per pixel): `path_stream_x8(d, pixel)?.point(s)`
+    /// equals [`GridTable::path_point_x8`]`(d, pixel, U8::splat(s))` bit for bit, with the hashing
+    /// of (pixel, dim) done once for every index s.
+    #[inline]
+    pub fn path_stream_x8(&self, d: &PathDim, pixel: U8) -> Option<Stream<U8>> {
+        (!self.grid).then(|| self.set.stream_x8(pixel, U8::splat(0), d.dim, d.seed))
     }
 
     /// The path tracer's point of dimension `d` for pixel samples `s`: for grid layouts bit for
