@@ -81,7 +81,12 @@ fn box_scene(light: &str) -> String {
 #[test]
 fn non_finite_samples_warn_and_negative_radiance_is_refused() {
     let dir = scratch("radiance");
-    fs::write(dir.join("hot.test"), box_scene("3e38 3e38 3e38")).unwrap();
+    // A floor under a ceiling-wide light: most of its bounces toward the light have cos > 0.81,
+    // where uniform hemisphere sampling's weight (1.4 cos) takes 3e38 past f32's range (27 samples
+    // of 1024 for every sampler tried). The wall and small light alone overflowed by chance: one
+    // sample with the old default sampler, none with multijitter.
+    let floor = "vertex 1 0 1\nvertex -1 0 1\ntri 0 5 4\ntri 0 4 1\nquadLight -1 1.99 -1 0 0 2 2 0 0 3e38 3e38 3e38\n";
+    fs::write(dir.join("hot.test"), box_scene("3e38 3e38 3e38") + floor).unwrap();
     let r = strata(&dir, &["render", "hot.test", "--threads", "1", "-o", "hot", "-q"], 60);
     assert_eq!(r.code, Some(0), "{}", r.err);
     let line = r.err.lines().find(|l| l.contains("non-finite sample")).unwrap_or_else(|| panic!("{}", r.err));
