@@ -15,9 +15,9 @@ use accumulate::{Moments8, PassBlocks};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
+use std::time::Instant;
 
 mod accumulate;
-use std::time::Instant;
 
 /// Tile side in pixels.
 pub const TILE: u32 = 16;

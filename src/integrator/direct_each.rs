@@ -86,12 +86,12 @@ impl<L: LobeSet> EachPacket for Each<'_, L> {
             choice_table: LightTable::new(it, smp, LIGHT_CHOICE.first, s),
             inv_n: F8::splat(1.0 / it.light_set.n() as f32),
         });
-        // The light points of every packet that hit something (a point is a pure function of its
-        // pixel and index: drawing it for a packet that turns out to shade nothing changes no
-        // other).
         // The light point's streams, hashed once per pixel for the batch's samples.
         let Buffers { uv, table_streams, .. } = &mut *self.buf;
         let streamed = *self.streamed.get_or_insert_with(|| table.streams(smp, ctx.pks, table_streams));
+        // The light points of every packet that hit something (a point is a pure function of its
+        // pixel and index: drawing it for a packet that turns out to shade nothing changes no
+        // other).
         let n = it.light_set.n();
         uv.clear();
         for (i, ((rh, traced), pk)) in packets.iter().zip(ctx.pks).enumerate() {

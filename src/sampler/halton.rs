@@ -50,7 +50,7 @@ impl Layout for Halton {
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
         let prefix = mix(L::splat(stream_key(TAG_HALTON, seed, dim)), pixel);
-        StreamKey { prefix, base: sample.mul(L::splat(set.n())), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::new(prefix, sample.mul(L::splat(set.n())), sample, dim, seed)
     }
 
     #[inline]

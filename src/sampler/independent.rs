@@ -1,6 +1,6 @@
 //! `independent`: two hashed uniforms per point, independent across every input.
 
-use super::hash::{hash, mix, stream_key, unit};
+use super::hash::{hash, mix, unit};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
 
@@ -23,8 +23,7 @@ impl Layout for Independent {
 
     #[inline]
     fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        let prefix = mix(mix(L::splat(stream_key(TAG_INDEPENDENT, seed, dim)), pixel), sample);
-        StreamKey { prefix, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::hashed(TAG_INDEPENDENT, pixel, sample, dim, seed)
     }
 
     #[inline]

@@ -6,6 +6,7 @@
 
 use super::divisor::Divisor;
 use super::grid::Grid;
+use super::hash::hash;
 use super::lanes::{Lanes, PointFn};
 use crate::simd::{F8, U8};
 
@@ -72,6 +73,21 @@ pub struct StreamKey<L> {
     pub words: [L; 5],
 }
 
+impl<L: Lanes> StreamKey<L> {
+    /// The stream with these words and no further ones (`words` zero).
+    #[inline]
+    pub fn new(prefix: L, base: L, sample: L, dim: u32, seed: u64) -> Self {
+        Self { prefix, base, sample, dim, seed, words: [L::splat(0); 5] }
+    }
+
+    /// The stream of a layout that hashes (tag, seed, dim, pixel, sample) before its point index:
+    /// that hash as `prefix`, `base` zero (independent, stratified, multijitter).
+    #[inline]
+    pub(super) fn hashed(tag: u32, pixel: L, sample: L, dim: u32, seed: u64) -> Self {
+        Self::new(hash(tag, seed, dim, [pixel, sample]), L::splat(0), sample, dim, seed)
+    }
+}
+
 /// A 2D point-set layout: point k (0 <= k < n) of the n-point set of stream (pixel, sample, dim)
 /// under seed, both coordinates in [0, 1), as a pure function of its inputs. Write each method once
 /// against [`Lanes`]; scalar and x8 then agree bit for bit. Any inputs are valid (k >= n wraps or
@@ -85,7 +101,7 @@ pub trait Layout: Send + Sync + 'static {
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
         let _ = set;
-        StreamKey { prefix: pixel, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::new(pixel, L::splat(0), sample, dim, seed)
     }
 
     /// Point k (lane-uniform) of a stream; must equal `point` with `k` splatted, bit for bit.

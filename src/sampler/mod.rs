@@ -147,7 +147,9 @@ impl SamplerKind {
     /// Correlated multi-jittered points (Kensler 2013): strata cells and n-rooks, padded per dim.
     pub const MULTIJITTER: Self = Self::named("multijitter");
     /// The sampler of every dimension a scene and the flags leave unset: [`SamplerKind::MULTIJITTER`]
-    /// (issue 33: lower error than `stratified` on the path tracer's dimensions, at the same cost).
+    /// (issue 33: lower error per sample than `stratified`; dearer per point, so at equal time it
+    /// leads on the Cornell box and trails on direct lighting with many light samples:
+    /// `docs/performance.md`).
     pub const DEFAULT: Self = Self::MULTIJITTER;
     /// Scrambled Halton points (base 2 Owen, base 3 random digit permutations) at `sample * n + k`.
     pub const HALTON: Self = Self::named("halton");

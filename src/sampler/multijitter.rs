@@ -30,7 +30,7 @@
 
 use super::divisor::Divisor;
 use super::grid::{cell_span, jittered, FIXED_ONE};
-use super::hash::{hash, mix, stream_key};
+use super::hash::{hash, mix};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
 use super::permute::permute_lanes;
@@ -99,8 +99,7 @@ impl Layout for MultiJitter {
 
     #[inline]
     fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        let prefix = mix(mix(L::splat(stream_key(TAG_MULTIJITTER, seed, dim)), pixel), sample);
-        StreamKey { prefix, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::hashed(TAG_MULTIJITTER, pixel, sample, dim, seed)
     }
 
     #[inline]

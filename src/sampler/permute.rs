@@ -64,6 +64,8 @@ impl PermDomain {
             let mut best = (m.div_ceil(2), 2u32);
             for b in (2..=root).rev().take(64) {
                 let a = m.div_ceil(b);
+                // An exact pair near the root also replaces the starting (m / 2, 2), exact for
+                // even m: the most balanced exact pair wins.
                 if u64::from(a) * u64::from(b) < u64::from(best.0) * u64::from(best.1) || a * b == m {
                     best = (a, b);
                 }

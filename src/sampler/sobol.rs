@@ -78,7 +78,7 @@ impl Layout for Sobol {
     /// `sample * n` in `base`, hashed once for all the points of the stream.
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        StreamKey { prefix: stream_key(pixel, dim, seed), base: sample.mul(L::splat(set.n().max(1))), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::new(stream_key(pixel, dim, seed), sample.mul(L::splat(set.n().max(1))), sample, dim, seed)
     }
 
     #[inline]

@@ -62,8 +62,7 @@ impl Layout for Stratified {
 
     #[inline]
     fn stream<L: Lanes>(&self, _: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        let prefix = mix(mix(L::splat(stream_key(TAG_STRATIFIED, seed, dim)), pixel), sample);
-        StreamKey { prefix, base: L::splat(0), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::hashed(TAG_STRATIFIED, pixel, sample, dim, seed)
     }
 
     #[inline]

@@ -106,7 +106,7 @@ impl Layout for ZSobol {
     /// k < 2^b).
     #[inline]
     fn stream<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, seed: u64) -> StreamKey<L> {
-        StreamKey { prefix: block_start(set, pixel), base: sample_key(sample, dim, seed), sample, dim, seed, words: [L::splat(0); 5] }
+        StreamKey::new(block_start(set, pixel), sample_key(sample, dim, seed), sample, dim, seed)
     }
 
     #[inline]
