@@ -135,7 +135,7 @@ fn dimensions_are_decorrelated_as_well_as_random_pairings() {
         ("sin", |a, b| (6.0 * f64::from(a[0]) + 5.0 * f64::from(b[0]) + 4.0 * f64::from(a[1] * b[1])).sin()),
     ];
     let mut failures = Vec::new();
-    for n in [16, 64] {
+    for n in [8, 16, 64, 100, 256] {
         for (name, f) in cases {
             let (layout, random) = pairing_variances(n, 4000, f);
             let ratio = layout / random;
@@ -163,7 +163,7 @@ fn power_of_two_spans_match_the_grid() {
 /// and it is not `permute`.
 #[test]
 fn permute_lanes_is_a_permutation() {
-    for n in [1u32, 2, 3, 7, 8, 16, 17, 64, 100, 256, 1000] {
+    for n in [1u32, 2, 3, 4, 7, 8, 16, 17, 32, 64, 100, 128, 256, 512, 1000] {
         for key in [0u32, 1, 0xdead_beef, u32::MAX] {
             let mut seen = vec![false; n as usize];
             let d = PermDomain::new(n);
@@ -202,6 +202,11 @@ fn permutation_domains_are_tight() {
         let (a, b) = PermDomain::new(m).shape();
         assert!(b >= 2 && a >= b && a * b >= m && a * b - m < a, "m = {m}: {a} x {b}");
     }
+    // Power-of-two domains up to 64 draw their rounds from tables of hashed words: 8 from one
+    // word (was five hashes), 64 from four; beyond, and off powers of two, the hashed rounds.
+    let words: Vec<(u32, Option<u32>)> = [2, 4, 8, 16, 32, 64, 128, 256, 512, 100].map(|m| (m, PermDomain::new(m).table_words())).to_vec();
+    let want = [(2, Some(1)), (4, Some(1)), (8, Some(1)), (16, Some(2)), (32, Some(3)), (64, Some(4)), (128, None), (256, None), (512, None), (100, None)];
+    assert_eq!(words, want);
     let m = (1u32 << 31) + 12_345;
     assert_eq!(PermDomain::new(m).shape(), (1 << 16, 1 << 16));
     let d = PermDomain::new(m);

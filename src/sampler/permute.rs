@@ -48,6 +48,8 @@ pub(super) struct PermDomain {
     pow2: bool,
     /// log2 b when `pow2`
     shift: u32,
+    /// the round functions as tables of hashed bits, where they fit (see [`RoundTables`])
+    tables: Option<RoundTables>,
 }
 
 impl PermDomain {
@@ -77,13 +79,65 @@ impl PermDomain {
         };
         let exact = u64::from(a) * u64::from(b) == u64::from(m);
         let pow2 = a.is_power_of_two() && b.is_power_of_two();
-        Self { m, a, b: Divisor::new(b), exact, pow2, shift: b.trailing_zeros() }
+        let tables = if pow2 && exact { RoundTables::new(a, b) } else { None };
+        Self { m, a, b: Divisor::new(b), exact, pow2, shift: b.trailing_zeros(), tables }
     }
 
     /// (a, b): 0..m lies in Z_a x Z_b.
     #[cfg(test)]
     pub(super) fn shape(&self) -> (u32, u32) {
         (self.a, self.b.d)
+    }
+
+    /// The hashed words of its round tables, if its rounds are tables.
+    #[cfg(test)]
+    pub(super) fn table_words(&self) -> Option<u32> {
+        self.tables.map(|t| t.words)
+    }
+}
+
+/// The rounds of a small power-of-two domain (m <= 64: Z_a x Z_b with a, b <= 8) as tables: round
+/// j's function of the other half h is entry h of a table of a (or b) values of log2 b (or
+/// log2 a) bits, packed from bit `at[j].1` of hashed word `at[j].0`; the rotation's log2 m bits
+/// sit at `rot`. The words hash the key alone, not the half, so they are computed side by side
+/// before the rounds, which are then a shift, a mask and an XOR each (the `fmix` per round sat
+/// on the index's chain); m <= 8 needs one word where the hashed rounds took five hashes, 64
+/// four. Each entry is uniform and independent of the others (bits of distinct hashes or distinct
+/// bits of one), as the hashed rounds' values are. (Two-word tables for m = 128 and 256 took
+/// six and nine words and measured no faster than the hashed rounds.)
+#[derive(Clone, Copy, Debug)]
+struct RoundTables {
+    /// hashed words used (<= 4)
+    words: u32,
+    /// (word, first bit) of each round's table
+    at: [(u32, u32); 4],
+    /// entry width of even rounds (log2 a: they change l) and of odd ones (log2 b)
+    width: [u32; 2],
+    /// (word, first bit) of the rotation
+    rot: (u32, u32),
+}
+
+impl RoundTables {
+    /// The tables of Z_a x Z_b (powers of two, exact), if every round's table fits in a word.
+    fn new(a: u32, b: u32) -> Option<Self> {
+        let width = [a.trailing_zeros(), b.trailing_zeros()];
+        // Even rounds: b entries of log2 a bits; odd rounds: a entries of log2 b bits.
+        let size = [b * width[0], a * width[1]];
+        if size[0] > 32 || size[1] > 32 {
+            return None;
+        }
+        // First fit: each table (and then the rotation) in the first word with room.
+        let mut used = [0u32; 5];
+        let mut place = |bits: u32| -> (u32, u32) {
+            let w = used.iter().position(|&u| u + bits <= 32).unwrap_or(4);
+            let at = (w as u32, used[w]);
+            used[w] += bits;
+            at
+        };
+        let at: [(u32, u32); 4] = std::array::from_fn(|j| place(size[j % 2]));
+        let rot = place(width[0] + width[1]);
+        let words = used.iter().filter(|&&u| u > 0).count() as u32;
+        (words <= 4).then_some(Self { words, at, width, rot })
     }
 }
 
@@ -111,6 +165,9 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
     let n = d.m;
     if n == 1 {
         return L::splat(0);
+    }
+    if let Some(t) = &d.tables {
+        return permute_tables(i, d.shift, n, t, key);
     }
     let r = rotation(key, n);
     let keys = ROUND.map(|c| key.xor(L::splat(c)));
@@ -157,6 +214,39 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
             return rotate(out);
         }
     }
+}
+
+/// [`permute_lanes`] on a domain with [`RoundTables`] (`shift` = log2 b, n = a b a power of two).
+#[inline(always)]
+fn permute_tables<L: Lanes>(i: L, shift: u32, n: u32, t: &RoundTables, key: L) -> L {
+    /// Per-word key offsets (distinct from the hashed rounds' and the rotation's).
+    const WORD: [u32; 4] = [0x1f83_d9ab, 0x5be0_cd19, 0x428a_2f98, 0xb5c0_fbcf];
+    let mut words = [L::splat(0); 4];
+    for (w, c) in words.iter_mut().zip(WORD).take(t.words as usize) {
+        *w = fmix(key.xor(L::splat(c)));
+    }
+    // Entry h of round j's table: bits at + h width.. of its word (h width without a multiply).
+    let entry = |j: usize, h: L| {
+        let ((w, at), width) = (t.at[j], t.width[j % 2]);
+        let scaled = match width {
+            0 => L::splat(0),
+            1 => h,
+            2 => h.shl(1),
+            _ => h.shl(1).add(h),
+        };
+        words[w as usize].shr_var(scaled.add(L::splat(at))).and(L::splat((1 << width) - 1))
+    };
+    let (mut hi, mut lo) = (i.shr(shift), i.and(L::splat((1 << shift) - 1)));
+    for j in 0..4 {
+        if j % 2 == 0 {
+            hi = hi.xor(entry(j, lo));
+        } else {
+            lo = lo.xor(entry(j, hi));
+        }
+    }
+    // The rotation: its log2 n bits and those above, which the final mask drops.
+    let (w, at) = t.rot;
+    hi.shl(shift).or(lo).add(words[w as usize].shr(at)).and(L::splat(n - 1))
 }
 
 /// Keyed rotation r in 0..n applied after the rounds: `(x + r) mod n`. The rounds alone are a
