@@ -135,7 +135,7 @@ fn dimensions_are_decorrelated_as_well_as_random_pairings() {
         ("sin", |a, b| (6.0 * f64::from(a[0]) + 5.0 * f64::from(b[0]) + 4.0 * f64::from(a[1] * b[1])).sin()),
     ];
     let mut failures = Vec::new();
-    for n in [8, 16, 64, 100, 256] {
+    for n in [8, 9, 16, 25, 64, 100, 256] {
         for (name, f) in cases {
             let (layout, random) = pairing_variances(n, 4000, f);
             let ratio = layout / random;
@@ -202,10 +202,26 @@ fn permutation_domains_are_tight() {
         let (a, b) = PermDomain::new(m).shape();
         assert!(b >= 2 && a >= b && a * b >= m && a * b - m < a, "m = {m}: {a} x {b}");
     }
-    // Power-of-two domains up to 64 draw their rounds from tables of hashed words: 8 from one
-    // word (was five hashes), 64 from four; beyond, and off powers of two, the hashed rounds.
-    let words: Vec<(u32, Option<u32>)> = [2, 4, 8, 16, 32, 64, 128, 256, 512, 100].map(|m| (m, PermDomain::new(m).table_words())).to_vec();
-    let want = [(2, Some(1)), (4, Some(1)), (8, Some(1)), (16, Some(2)), (32, Some(3)), (64, Some(4)), (128, None), (256, None), (512, None), (100, None)];
+    // Small domains draw their rounds from tables of hashed words: 8 points from one word (was
+    // five hashes), 64 from four, 9 and 25 from two and three (a word of their own for the
+    // rotation off powers of two); larger ones keep the hashed rounds.
+    let sizes = [2, 3, 4, 8, 9, 16, 25, 32, 64, 100, 128, 256, 512];
+    let words: Vec<(u32, Option<u32>)> = sizes.map(|m| (m, PermDomain::new(m).words().map(|w| w as u32))).to_vec();
+    let want = [
+        (2, Some(1)),
+        (3, Some(2)),
+        (4, Some(1)),
+        (8, Some(1)),
+        (9, Some(2)),
+        (16, Some(2)),
+        (25, Some(3)),
+        (32, Some(3)),
+        (64, Some(4)),
+        (100, None),
+        (128, None),
+        (256, None),
+        (512, None),
+    ];
     assert_eq!(words, want);
     let m = (1u32 << 31) + 12_345;
     assert_eq!(PermDomain::new(m).shape(), (1 << 16, 1 << 16));

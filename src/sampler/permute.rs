@@ -79,8 +79,14 @@ impl PermDomain {
         };
         let exact = u64::from(a) * u64::from(b) == u64::from(m);
         let pow2 = a.is_power_of_two() && b.is_power_of_two();
-        let tables = if pow2 && exact { RoundTables::new(a, b) } else { None };
+        let tables = RoundTables::new(a, b, pow2 && exact);
         Self { m, a, b: Divisor::new(b), exact, pow2, shift: b.trailing_zeros(), tables }
+    }
+
+    /// The hashed words its rounds take from a key, if they are tables.
+    #[cfg(test)]
+    pub(super) fn words(&self) -> Option<usize> {
+        self.tables.map(|t| t.words as usize)
     }
 
     /// (a, b): 0..m lies in Z_a x Z_b.
@@ -88,54 +94,53 @@ impl PermDomain {
     pub(super) fn shape(&self) -> (u32, u32) {
         (self.a, self.b.d)
     }
-
-    /// The hashed words of its round tables, if its rounds are tables.
-    #[cfg(test)]
-    pub(super) fn table_words(&self) -> Option<u32> {
-        self.tables.map(|t| t.words)
-    }
 }
 
-/// The rounds of a small power-of-two domain (m <= 64: Z_a x Z_b with a, b <= 8) as tables: round
-/// j's function of the other half h is entry h of a table of a (or b) values of log2 b (or
-/// log2 a) bits, packed from bit `at[j].1` of hashed word `at[j].0`; the rotation's log2 m bits
-/// sit at `rot`. The words hash the key alone, not the half, so they are computed side by side
-/// before the rounds, which are then a shift, a mask and an XOR each (the `fmix` per round sat
-/// on the index's chain); m <= 8 needs one word where the hashed rounds took five hashes, 64
-/// four. Each entry is uniform and independent of the others (bits of distinct hashes or distinct
-/// bits of one), as the hashed rounds' values are. (Two-word tables for m = 128 and 256 took
-/// six and nine words and measured no faster than the hashed rounds.)
+/// The rounds of a small domain (Z_a x Z_b whose round tables fit in a word each: m <= 64 on
+/// powers of two, 9 = 3 x 3, 25 = 5 x 5, 36 = 6 x 6...) as tables: round j's function of the other
+/// half h is entry h of a table of b (or a) values of ceil(log2 a) (or ceil(log2 b)) bits, packed
+/// from bit `at[j].1` of hashed word `at[j].0`. The words hash the key alone, not the half, so
+/// they are computed side by side before the rounds, which are then a shift, a mask and an XOR
+/// (an add mod a or b) each; the `fmix` per round sat on the index's chain. On powers of two the
+/// entries are uniform and the rotation's log2 m bits share the words (8 points: one word where
+/// the hashed rounds took five hashes; 64: four); otherwise an entry e >= a counts as e - a (the
+/// round stays a bijection; its values are no longer uniform, which the decorrelation test bounds)
+/// and the rotation takes a word of its own (uniform to 2^-32, as [`rotation`]). (Two-word tables
+/// for 100 to 256 points took nine words and measured no faster than the hashed rounds; hashed
+/// once per stream of a light table they cost more instructions than they saved: callgrind.)
 #[derive(Clone, Copy, Debug)]
 struct RoundTables {
     /// hashed words used (<= 4)
     words: u32,
     /// (word, first bit) of each round's table
     at: [(u32, u32); 4],
-    /// entry width of even rounds (log2 a: they change l) and of odd ones (log2 b)
+    /// entry width of even rounds (they change l < a) and of odd ones (r < b)
     width: [u32; 2],
-    /// (word, first bit) of the rotation
+    /// (word, first bit) of the rotation: its low log2 m bits where m is a power of two, else the word
     rot: (u32, u32),
 }
 
 impl RoundTables {
-    /// The tables of Z_a x Z_b (powers of two, exact), if every round's table fits in a word.
-    fn new(a: u32, b: u32) -> Option<Self> {
-        let width = [a.trailing_zeros(), b.trailing_zeros()];
-        // Even rounds: b entries of log2 a bits; odd rounds: a entries of log2 b bits.
+    /// The tables of Z_a x Z_b (`pow2_m`: both powers of two and m = a b), if every round's table
+    /// fits in a word and all of them (with the rotation) in four.
+    fn new(a: u32, b: u32, pow2_m: bool) -> Option<Self> {
+        let bits_for = |n: u32| 32 - (n.max(1) - 1).leading_zeros();
+        let width = [bits_for(a), bits_for(b)];
+        // Even rounds: b entries of width[0] bits; odd rounds: a entries of width[1] bits.
         let size = [b * width[0], a * width[1]];
         if size[0] > 32 || size[1] > 32 {
             return None;
         }
         // First fit: each table (and then the rotation) in the first word with room.
-        let mut used = [0u32; 5];
+        let mut used = [0u32; 6];
         let mut place = |bits: u32| -> (u32, u32) {
-            let w = used.iter().position(|&u| u + bits <= 32).unwrap_or(4);
+            let w = used.iter().position(|&u| u + bits <= 32).unwrap_or(5);
             let at = (w as u32, used[w]);
             used[w] += bits;
             at
         };
         let at: [(u32, u32); 4] = std::array::from_fn(|j| place(size[j % 2]));
-        let rot = place(width[0] + width[1]);
+        let rot = place(if pow2_m { width[0] + width[1] } else { 32 });
         let words = used.iter().filter(|&&u| u > 0).count() as u32;
         (words <= 4).then_some(Self { words, at, width, rot })
     }
@@ -167,7 +172,7 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
         return L::splat(0);
     }
     if let Some(t) = &d.tables {
-        return permute_tables(i, d.shift, n, t, key);
+        return permute_tables(i, d, t, key);
     }
     let r = rotation(key, n);
     let keys = ROUND.map(|c| key.xor(L::splat(c)));
@@ -216,37 +221,72 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
     }
 }
 
-/// [`permute_lanes`] on a domain with [`RoundTables`] (`shift` = log2 b, n = a b a power of two).
+/// [`permute_lanes`] on a domain `d` with [`RoundTables`] `t`.
 #[inline(always)]
-fn permute_tables<L: Lanes>(i: L, shift: u32, n: u32, t: &RoundTables, key: L) -> L {
+fn permute_tables<L: Lanes>(i: L, d: &PermDomain, t: &RoundTables, key: L) -> L {
     /// Per-word key offsets (distinct from the hashed rounds' and the rotation's).
     const WORD: [u32; 4] = [0x1f83_d9ab, 0x5be0_cd19, 0x428a_2f98, 0xb5c0_fbcf];
     let mut words = [L::splat(0); 4];
     for (w, c) in words.iter_mut().zip(WORD).take(t.words as usize) {
         *w = fmix(key.xor(L::splat(c)));
     }
-    // Entry h of round j's table: bits at + h width.. of its word (h width without a multiply).
+    let (n, a, b) = (d.m, d.a, d.b.d);
+    // Entry h of round j's table: bits at + h width.. of its word (h width by shifts and adds).
     let entry = |j: usize, h: L| {
         let ((w, at), width) = (t.at[j], t.width[j % 2]);
         let scaled = match width {
             0 => L::splat(0),
             1 => h,
             2 => h.shl(1),
-            _ => h.shl(1).add(h),
+            3 => h.shl(1).add(h),
+            4 => h.shl(2),
+            5 => h.shl(2).add(h),
+            6 => h.shl(2).add(h.shl(1)),
+            7 => h.shl(3).sub(h),
+            _ => h.mul(L::splat(width)),
         };
         words[w as usize].shr_var(scaled.add(L::splat(at))).and(L::splat((1 << width) - 1))
     };
-    let (mut hi, mut lo) = (i.shr(shift), i.and(L::splat((1 << shift) - 1)));
-    for j in 0..4 {
-        if j % 2 == 0 {
-            hi = hi.xor(entry(j, lo));
-        } else {
-            lo = lo.xor(entry(j, hi));
+    // (x + y) mod m for x < m, y < 2^width < 2m: y reduced first (e >= m counts as e - m).
+    let add_mod = |x: L, y: L, m: u32| {
+        let m = L::splat(m);
+        let y = y.lt_select(m, y, y.sub(m));
+        let s = x.add(y);
+        s.lt_select(m, s, s.sub(m))
+    };
+    let nn = L::splat(n);
+    let (mut x, mut out, mut todo) = (i, L::splat(0), L::splat(u32::MAX));
+    loop {
+        let (mut hi, mut lo) = if d.pow2 { (x.shr(d.shift), x.and(L::splat(b - 1))) } else { d.b.div_rem(x) };
+        for j in 0..4 {
+            match (j % 2 == 0, d.pow2) {
+                (true, true) => hi = hi.xor(entry(j, lo)),
+                (false, true) => lo = lo.xor(entry(j, hi)),
+                (true, false) => hi = add_mod(hi, entry(j, lo), a),
+                (false, false) => lo = add_mod(lo, entry(j, hi), b),
+            }
+        }
+        x = if d.pow2 { hi.shl(d.shift).or(lo) } else { hi.mul(L::splat(b)).add(lo) };
+        if d.exact {
+            out = x;
+            break;
+        }
+        // Cycle walking: the first pass in range wins; lanes already done keep their value.
+        let inside = x.lt_mask(nn).and(todo);
+        out = out.or(x.and(inside));
+        todo = todo.and(inside.xor(L::splat(u32::MAX)));
+        if todo.max_lane() == 0 {
+            break;
         }
     }
-    // The rotation: its log2 n bits and those above, which the final mask drops.
     let (w, at) = t.rot;
-    hi.shl(shift).or(lo).add(words[w as usize].shr(at)).and(L::splat(n - 1))
+    if d.pow2 && d.exact {
+        // The rotation's log2 n bits (those above drop under the mask).
+        return out.add(words[w as usize].shr(at)).and(L::splat(n - 1));
+    }
+    let r = words[w as usize].mulhi(nn);
+    let tt = nn.sub(r);
+    out.lt_select(tt, out.add(r), out.sub(tt))
 }
 
 /// Keyed rotation r in 0..n applied after the rounds: `(x + r) mod n`. The rounds alone are a
