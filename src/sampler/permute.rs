@@ -157,7 +157,9 @@ impl RoundTables {
 /// related permutations, which correlates the dimensions (issue 33: a function coupling two padded
 /// dimensions of a 16-point `multijitter` set had 1.17-1.18x the variance it has under uniformly
 /// random pairings, with one round or two). The Feistel network is level with random pairings
-/// (`multijitter_tests.rs`). The indices must be below m (callers reduce them first).
+/// (`multijitter_tests.rs`). Small domains take their round functions from [`RoundTables`]
+/// (the same network, its rounds looking up tables of hashed bits). The indices must be below m
+/// (callers reduce them first).
 ///
 /// `key` must be a hash (all 32 bits uniform: callers pass `mix` outputs, offset by a constant per
 /// use): round j hashes `key ^ ROUND[j] ^ half`, so the round keys cost nothing (they were one
