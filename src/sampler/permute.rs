@@ -176,51 +176,68 @@ pub(super) fn permute_lanes<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
     if let Some(t) = &d.tables {
         return permute_tables(i, d, t, key);
     }
-    let r = rotation(key, n);
     let keys = ROUND.map(|c| key.xor(L::splat(c)));
-    let (a, b) = (L::splat(d.a), L::splat(d.b.d));
+    let (ma, mb, a, b) = (L::splat(d.a - 1), L::splat(d.b.d - 1), L::splat(d.a), L::splat(d.b.d));
+    // Round j's value: the hash's low bits (powers of two, the group Z_2^k: bits of the hash
+    // instead of a high multiply), else its high multiply by a or b.
+    let round = |j: usize, h: L| {
+        let v = fmix(keys[j].xor(h));
+        match (j.is_multiple_of(2), d.pow2) {
+            (true, true) => v.and(ma),
+            (false, true) => v.and(mb),
+            (true, false) => v.mulhi(a),
+            (false, false) => v.mulhi(b),
+        }
+    };
+    feistel(i, d, round, rotation(key, n))
+}
+
+/// The network both kinds of round share: 0..m in `d`'s Z_a x Z_b, four alternating rounds
+/// (l += `round(0, r)`, r += `round(1, l)`, ...; `round(j, h)` below a for even j, below b for
+/// odd; XOR instead of addition when a and b are powers of two), cycle-walked back into 0..m
+/// where a * b > m, then the rotation `(x + r) mod m` (r < m, or any r when m is a power of two:
+/// its bits above drop under the mask).
+#[inline(always)]
+fn feistel<L: Lanes>(i: L, d: &PermDomain, round: impl Fn(usize, L) -> L, r: L) -> L {
+    let (n, a, b) = (d.m, d.a, d.b.d);
     // (x + y) mod m for x, y < m.
-    let add_mod = |x: L, y: L, m: L| {
+    let add_mod = |x: L, y: L, m: u32| {
+        let m = L::splat(m);
         let s = x.add(y);
         s.lt_select(m, s, s.sub(m))
     };
     let nn = L::splat(n);
-    // (x + r) mod n for x, r < n, without overflow (n may exceed 2^31).
-    let rotate = |x: L| {
-        if d.exact && d.pow2 {
-            return x.add(r).and(L::splat(n - 1));
-        }
-        let t = nn.sub(r);
-        x.lt_select(t, x.add(r), x.sub(t))
-    };
     let (mut x, mut out, mut todo) = (i, L::splat(0), L::splat(u32::MAX));
-    // Powers of two (the common spp) split by shifts and add by XOR (bits of the hash instead of
-    // a high multiply): the same network over the group Z_2^k.
-    let pow2 = d.pow2;
-    let (ma, mb, shift) = (a.sub(L::splat(1)), b.sub(L::splat(1)), d.shift);
     loop {
-        let (mut hi, mut lo) = if pow2 { (x.shr(shift), x.and(mb)) } else { d.b.div_rem(x) };
-        for (j, k) in keys.into_iter().enumerate() {
-            match (j % 2 == 0, pow2) {
-                (true, true) => hi = hi.xor(fmix(k.xor(lo)).and(ma)),
-                (false, true) => lo = lo.xor(fmix(k.xor(hi)).and(mb)),
-                (true, false) => hi = add_mod(hi, fmix(k.xor(lo)).mulhi(a), a),
-                (false, false) => lo = add_mod(lo, fmix(k.xor(hi)).mulhi(b), b),
+        let (mut hi, mut lo) = if d.pow2 { (x.shr(d.shift), x.and(L::splat(b - 1))) } else { d.b.div_rem(x) };
+        for j in 0..4 {
+            match (j % 2 == 0, d.pow2) {
+                (true, true) => hi = hi.xor(round(j, lo)),
+                (false, true) => lo = lo.xor(round(j, hi)),
+                (true, false) => hi = add_mod(hi, round(j, lo), a),
+                (false, false) => lo = add_mod(lo, round(j, hi), b),
             }
         }
-        x = if pow2 { hi.shl(shift).or(lo) } else { hi.mul(b).add(lo) };
+        x = if d.pow2 { hi.shl(d.shift).or(lo) } else { hi.mul(L::splat(b)).add(lo) };
         if d.exact {
             // The domain is 0..n: every lane is in range after one pass.
-            return rotate(x);
+            out = x;
+            break;
         }
-        // First pass in range wins: lanes already done keep their value.
+        // Cycle walking: the first pass in range wins; lanes already done keep their value.
         let inside = x.lt_mask(nn).and(todo);
         out = out.or(x.and(inside));
         todo = todo.and(inside.xor(L::splat(u32::MAX)));
         if todo.max_lane() == 0 {
-            return rotate(out);
+            break;
         }
     }
+    if d.pow2 && d.exact {
+        return out.add(r).and(L::splat(n - 1));
+    }
+    // (x + r) mod n for x, r < n, without overflow (n may exceed 2^31).
+    let t = nn.sub(r);
+    out.lt_select(t, out.add(r), out.sub(t))
 }
 
 /// [`permute_lanes`] on a domain `d` with [`RoundTables`] `t`.
@@ -232,9 +249,9 @@ fn permute_tables<L: Lanes>(i: L, d: &PermDomain, t: &RoundTables, key: L) -> L 
     for (w, c) in words.iter_mut().zip(WORD).take(t.words as usize) {
         *w = fmix(key.xor(L::splat(c)));
     }
-    let (n, a, b) = (d.m, d.a, d.b.d);
-    // Entry h of round j's table: bits at + h width.. of its word (h width by shifts and adds).
-    let entry = |j: usize, h: L| {
+    // Entry h of round j's table: bits at + h width.. of its word (h width by shifts and adds),
+    // off powers of two reduced below a (or b): an entry e >= a counts as e - a.
+    let round = |j: usize, h: L| {
         let ((w, at), width) = (t.at[j], t.width[j % 2]);
         let scaled = match width {
             0 => L::splat(0),
@@ -247,48 +264,18 @@ fn permute_tables<L: Lanes>(i: L, d: &PermDomain, t: &RoundTables, key: L) -> L 
             7 => h.shl(3).sub(h),
             _ => h.mul(L::splat(width)),
         };
-        words[w as usize].shr_var(scaled.add(L::splat(at))).and(L::splat((1 << width) - 1))
+        let e = words[w as usize].shr_var(scaled.add(L::splat(at))).and(L::splat((1 << width) - 1));
+        if d.pow2 {
+            return e;
+        }
+        let m = L::splat(if j.is_multiple_of(2) { d.a } else { d.b.d });
+        e.lt_select(m, e, e.sub(m))
     };
-    // (x + y) mod m for x < m, y < 2^width < 2m: y reduced first (e >= m counts as e - m).
-    let add_mod = |x: L, y: L, m: u32| {
-        let m = L::splat(m);
-        let y = y.lt_select(m, y, y.sub(m));
-        let s = x.add(y);
-        s.lt_select(m, s, s.sub(m))
-    };
-    let nn = L::splat(n);
-    let (mut x, mut out, mut todo) = (i, L::splat(0), L::splat(u32::MAX));
-    loop {
-        let (mut hi, mut lo) = if d.pow2 { (x.shr(d.shift), x.and(L::splat(b - 1))) } else { d.b.div_rem(x) };
-        for j in 0..4 {
-            match (j % 2 == 0, d.pow2) {
-                (true, true) => hi = hi.xor(entry(j, lo)),
-                (false, true) => lo = lo.xor(entry(j, hi)),
-                (true, false) => hi = add_mod(hi, entry(j, lo), a),
-                (false, false) => lo = add_mod(lo, entry(j, hi), b),
-            }
-        }
-        x = if d.pow2 { hi.shl(d.shift).or(lo) } else { hi.mul(L::splat(b)).add(lo) };
-        if d.exact {
-            out = x;
-            break;
-        }
-        // Cycle walking: the first pass in range wins; lanes already done keep their value.
-        let inside = x.lt_mask(nn).and(todo);
-        out = out.or(x.and(inside));
-        todo = todo.and(inside.xor(L::splat(u32::MAX)));
-        if todo.max_lane() == 0 {
-            break;
-        }
-    }
     let (w, at) = t.rot;
-    if d.pow2 && d.exact {
-        // The rotation's log2 n bits (those above drop under the mask).
-        return out.add(words[w as usize].shr(at)).and(L::splat(n - 1));
-    }
-    let r = words[w as usize].mulhi(nn);
-    let tt = nn.sub(r);
-    out.lt_select(tt, out.add(r), out.sub(tt))
+    // The rotation: its log2 m bits of the shared words when m is a power of two, else a word of
+    // its own times m.
+    let r = if d.pow2 && d.exact { words[w as usize].shr(at) } else { words[w as usize].mulhi(L::splat(d.m)) };
+    feistel(i, d, round, r)
 }
 
 /// Keyed rotation r in 0..n applied after the rounds: `(x + r) mod n`. The rounds alone are a
