@@ -97,7 +97,7 @@ impl PermDomain {
 }
 
 /// The rounds of a small domain (Z_a x Z_b whose round tables fit in a word each: m <= 64 on
-/// powers of two, 9 = 3 x 3, 25 = 5 x 5, 36 = 6 x 6...) as tables: round j's function of the other
+/// powers of two, 9 = 3 x 3, 25 = 5 x 5, 36 = 6 x 6...; two words for 128 and 256) as tables: round j's function of the other
 /// half h is entry h of a table of b (or a) values of ceil(log2 a) (or ceil(log2 b)) bits, packed
 /// from bit `at[j].1` of hashed word `at[j].0`. The words hash the key alone, not the half, so
 /// they are computed side by side before the rounds, which are then a shift, a mask and an XOR
@@ -105,13 +105,25 @@ impl PermDomain {
 /// entries are uniform and the rotation's log2 m bits share the words (8 points: one word where
 /// the hashed rounds took five hashes; 64: four); otherwise an entry e >= a counts as e - a (the
 /// round stays a bijection; its values are no longer uniform, which the decorrelation test bounds)
-/// and the rotation takes a word of its own (uniform to 2^-32, as [`rotation`]). (Two-word tables
-/// for 100 to 256 points took nine words and measured no faster than the hashed rounds; hashed
-/// once per stream of a light table they cost more instructions than they saved: callgrind.)
+/// and the rotation takes a word of its own (uniform to 2^-32, as [`rotation`]).
+///
+/// 128 = 16 x 8 and 256 = 16 x 16 points (`wide`: a table of up to 64 bits, each half of its
+/// entries fitting a word) take one hashed word per round, its entries' first half from the word
+/// and the second half from the word's xorshift (a bijection of the word: each half uniform, the
+/// two halves linearly related, which the decorrelation test at n = 128 and 256 bounds), and a
+/// fifth hashed word for the rotation: five hashes, as the hashed rounds (four rounds and the
+/// rotation), but side by side instead of chained through the index. Cornell's path sampler at 256
+/// spp 71.9 -> 64.8 ns/sample (`strata profile`). Nine hashed words (two a table) measured no faster
+/// than the hashed rounds; hashed once per stream of a light table, tables cost more instructions
+/// than they saved (callgrind); deriving every word of a permutation from one hash by xorshift
+/// steps saved no measurable time (0.4 %) and was left out.
 #[derive(Clone, Copy, Debug)]
 struct RoundTables {
-    /// hashed words used (<= 4)
+    /// hashed words used (<= 5)
     words: u32,
+    /// two-word tables (128 and 256 points): round j's table is hashed word j (its first half of
+    /// the entries) and that word's xorshift (the second half); word 4 is the rotation
+    wide: bool,
     /// (word, first bit) of each round's table
     at: [(u32, u32); 4],
     /// entry width of even rounds (they change l < a) and of odd ones (r < b)
@@ -129,7 +141,15 @@ impl RoundTables {
         // Even rounds: b entries of width[0] bits; odd rounds: a entries of width[1] bits.
         let size = [b * width[0], a * width[1]];
         if size[0] > 32 || size[1] > 32 {
-            return None;
+            // Two words a table where each half of its entries fits a word (powers of two).
+            let fits = pow2_m && size[0] <= 64 && size[1] <= 64;
+            return fits.then_some(Self {
+                words: 5,
+                wide: true,
+                at: [(0, 0), (1, 0), (2, 0), (3, 0)],
+                width,
+                rot: (4, 0),
+            });
         }
         // First fit: each table (and then the rotation) in the first word with room.
         let mut used = [0u32; 6];
@@ -142,7 +162,7 @@ impl RoundTables {
         let at: [(u32, u32); 4] = std::array::from_fn(|j| place(size[j % 2]));
         let rot = place(if pow2_m { width[0] + width[1] } else { 32 });
         let words = used.iter().filter(|&&u| u > 0).count() as u32;
-        (words <= 4).then_some(Self { words, at, width, rot })
+        (words <= 4).then_some(Self { words, wide: false, at, width, rot })
     }
 }
 
@@ -244,27 +264,34 @@ fn feistel<L: Lanes>(i: L, d: &PermDomain, round: impl Fn(usize, L) -> L, r: L) 
 #[inline(always)]
 fn permute_tables<L: Lanes>(i: L, d: &PermDomain, t: &RoundTables, key: L) -> L {
     /// Per-word key offsets (distinct from the hashed rounds' and the rotation's).
-    const WORD: [u32; 4] = [0x1f83_d9ab, 0x5be0_cd19, 0x428a_2f98, 0xb5c0_fbcf];
-    let mut words = [L::splat(0); 4];
+    const WORD: [u32; 5] = [0x1f83_d9ab, 0x5be0_cd19, 0x428a_2f98, 0xb5c0_fbcf, 0x7137_4491];
+    let mut words = [L::splat(0); 5];
     for (w, c) in words.iter_mut().zip(WORD).take(t.words as usize) {
         *w = fmix(key.xor(L::splat(c)));
+    }
+    if t.wide {
+        // Round j: entries [0, e/2) in word j, [e/2, e) in its xorshift (a bijection of the word).
+        let xs = |w: L| {
+            let w = w.xor(w.shl(13));
+            let w = w.xor(w.shr(17));
+            w.xor(w.shl(5))
+        };
+        let second: [L; 4] = std::array::from_fn(|j| xs(words[j]));
+        let half = [d.b.d / 2, d.a / 2];
+        let round = |j: usize, h: L| {
+            let (width, half) = (t.width[j % 2], half[j % 2]);
+            let upper = L::splat(0).sub(h.shr(half.trailing_zeros()));
+            let w = words[j].xor(words[j].xor(second[j]).and(upper));
+            let at = times(h.and(L::splat(half - 1)), width);
+            w.shr_var(at).and(L::splat((1 << width) - 1))
+        };
+        return feistel(i, d, round, words[4]);
     }
     // Entry h of round j's table: bits at + h width.. of its word (h width by shifts and adds),
     // off powers of two reduced below a (or b): an entry e >= a counts as e - a.
     let round = |j: usize, h: L| {
         let ((w, at), width) = (t.at[j], t.width[j % 2]);
-        let scaled = match width {
-            0 => L::splat(0),
-            1 => h,
-            2 => h.shl(1),
-            3 => h.shl(1).add(h),
-            4 => h.shl(2),
-            5 => h.shl(2).add(h),
-            6 => h.shl(2).add(h.shl(1)),
-            7 => h.shl(3).sub(h),
-            _ => h.mul(L::splat(width)),
-        };
-        let e = words[w as usize].shr_var(scaled.add(L::splat(at))).and(L::splat((1 << width) - 1));
+        let e = words[w as usize].shr_var(times(h, width).add(L::splat(at))).and(L::splat((1 << width) - 1));
         if d.pow2 {
             return e;
         }
@@ -276,6 +303,22 @@ fn permute_tables<L: Lanes>(i: L, d: &PermDomain, t: &RoundTables, key: L) -> L 
     // its own times m.
     let r = if d.pow2 && d.exact { words[w as usize].shr(at) } else { words[w as usize].mulhi(L::splat(d.m)) };
     feistel(i, d, round, r)
+}
+
+/// `h * width` for a lane-uniform table entry width: shifts and adds below 8 (off the multiplier).
+#[inline(always)]
+fn times<L: Lanes>(h: L, width: u32) -> L {
+    match width {
+        0 => L::splat(0),
+        1 => h,
+        2 => h.shl(1),
+        3 => h.shl(1).add(h),
+        4 => h.shl(2),
+        5 => h.shl(2).add(h),
+        6 => h.shl(2).add(h.shl(1)),
+        7 => h.shl(3).sub(h),
+        _ => h.mul(L::splat(width)),
+    }
 }
 
 /// Keyed rotation r in 0..n applied after the rounds: `(x + r) mod n`. The rounds alone are a
