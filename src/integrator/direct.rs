@@ -81,8 +81,8 @@ struct Buffers {
     choice_streams: Vec<Stream<U8>>,
     /// packet by packet ([`Each`]): the light points of the sample's packets, N per packet
     uv: Vec<(F8, F8)>,
-    /// packet by packet ([`Each`]): the light table's streams of the tile's packets (the light
-    /// point's dimension), made once per batch of samples
+    /// the light table's streams of the tile's packets (one light point dimension): packet by
+    /// packet ([`Each`]) made once per batch of samples, under `all` once per sample and light
     table_streams: Vec<Stream<U8>>,
 }
 
@@ -228,6 +228,12 @@ fn shade<L: LobeSet>(
     }
 }
 
+/// The fewest light samples per pixel sample for which `direct` under `all` draws a light's
+/// points from per-packet streams of the light table (a stream costs a few points' hashing):
+/// hw2 `sphere.test` (25 light samples, 4 spp, 1 thread) 1.532 -> 1.445 CPU s with the default
+/// `multijitter`, 0.948 -> 0.921 with `sobol`; hw4 dragon (`pmj02`) 2.743 -> 2.674 (stop 42).
+const TABLE_STREAM_POINTS: u32 = 4;
+
 /// `direct` under `all`: every area light, group by group (see the module docs).
 fn shade_all<L: LobeSet>(
     it: &Integrator,
@@ -245,7 +251,7 @@ fn shade_all<L: LobeSet>(
     // Solid-angle points carry their own 1 / pdf_area per sample (`ls.area`); area ones share
     // the quad's area, applied once per group.
     let warped = it.light_warp == LightWarp::SolidAngle;
-    let Buffers { lanes, batch, acc, streams: st, .. } = sc;
+    let Buffers { lanes, batch, acc, streams: st, table_streams, .. } = sc;
     for (gi, group) in groups(scene).enumerate() {
         let dim = LIGHT_POINT.at(gi as u32);
         let table = LightTable::new(it, smp, dim, s);
@@ -255,12 +261,18 @@ fn shade_all<L: LobeSet>(
         if streams {
             smp.light_streams(pks, &lanes.shade, s, dim, true, st);
         }
+        // Other layouts: the light table's points from per-packet streams when the sample draws
+        // enough of them to repay a stream's hashing.
+        let tabled = !streams && n_light >= TABLE_STREAM_POINTS && table.streams(smp, pks, table_streams);
         for k in 0..n_light {
             let point_k = it.light_set.point_k(k);
-            // Point k of the shading packet's stream (stream j is the j-th shading packet's).
+            // Point k of the shading packet's stream (stream j is the j-th shading packet's), of
+            // packet i's table stream, or of the light table.
             let point = |i: usize, j: u32| {
                 if streams {
                     smp.light_stream_point(&st[j as usize], j, k, &point_k)
+                } else if tabled {
+                    table.stream_point(smp, &table_streams[i], i, k)
                 } else {
                     table.point(smp, pks[i].pixel, k)
                 }
@@ -324,11 +336,11 @@ impl LightTable {
         smp.table_streams(&self.dim, true, pks, out)
     }
 
-    /// [`LightTable::point`] from `stream`, the pixels' stream of [`LightTable::streams`]: the same
-    /// point, bit for bit, without the per-pixel hashing.
+    /// [`LightTable::point`] from stream `j` of [`LightTable::streams`] (`stream`, the pixels'):
+    /// the same point, bit for bit, without the per-pixel hashing.
     #[inline]
-    pub(super) fn stream_point(&self, smp: &Samples, pixel: U8, stream: &Stream<U8>, k: u32) -> (F8, F8) {
-        smp.table_stream_point(&self.dim, true, Phase::SamplerLight, pixel, stream, self.first.wrapping_add(k))
+    pub(super) fn stream_point(&self, smp: &Samples, stream: &Stream<U8>, j: usize, k: u32) -> (F8, F8) {
+        smp.table_stream_point(Phase::SamplerLight, stream, j as u32, self.first.wrapping_add(k))
     }
 }
 

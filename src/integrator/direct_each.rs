@@ -17,8 +17,10 @@ use crate::simd::{Mask8, Vec3x8, F8, U8};
 
 /// Whether `direct` shades packet by packet ([`super::primary::tile_each`], [`Each`]): light samples
 /// alone, one light each, from the light table (not per-sample streams), nothing outside the
-/// scene's area lights, and triangles only; not while the sampler replay log records (it keeps
-/// the wavefront's order of draws). The same radiance as the wavefront, bit for bit. Measured
+/// scene's area lights, and triangles only. The same radiance as the wavefront, bit for bit; the
+/// sampler replay logs its table streams (`replay::table_streams`), so a recording render draws
+/// as the render it measures (it used to fall back to the wavefront's point-by-point draws, and
+/// `strata profile` replayed hw2 analytic's pmj02 at twice its instrumented cost). Measured
 /// (CPU seconds, 1 thread, best of 9-13 under load): hw2 analytic 8 % faster (the wavefront's
 /// 70 KiB of hit records a tile no longer cycle through L2), hw2 sphere 4 % slower (its sphere
 /// lanes gather lane by lane; callgrind's caches do not show why), so scenes with spheres or
@@ -34,7 +36,6 @@ pub(super) fn each_packet(it: &Integrator, scene: &Scene) -> bool {
         && scene.envmap.is_none()
         && scene.delta.is_empty()
         && scene.ell_material.is_empty()
-        && !crate::sampler::replay::recording()
 }
 
 /// [`super::shade_one`] packet by packet ([`EachPacket`]): the light points of pixel sample s
@@ -99,7 +100,7 @@ impl<L: LobeSet> EachPacket for Each<'_, L> {
             for k in 0..n {
                 uv.push(match (hit, streamed) {
                     (false, _) => (F8::ZERO, F8::ZERO),
-                    (true, true) => table.stream_point(smp, pk.pixel, &table_streams[i], k),
+                    (true, true) => table.stream_point(smp, &table_streams[i], i, k),
                     (true, false) => table.point(smp, pk.pixel, k),
                 });
             }

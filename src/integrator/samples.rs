@@ -194,24 +194,17 @@ impl<'a> Samples<'a> {
                 }
             }
         }
+        replay::table_streams(pks.iter().map(|pk| pk.pixel), light, d.dim());
         true
     }
 
-    /// [`Samples::table_point`] at the lane-uniform table index `index` from `stream`, the stream
-    /// of the pixels `pixel` (from [`Samples::table_streams`] with the same `d` and `light`): the
-    /// same point, bit for bit, timed and logged the same.
+    /// [`Samples::table_point`] at the lane-uniform table index `index` from stream `j` of
+    /// [`Samples::table_streams`]' list (`stream` is that stream): the same point, bit for bit,
+    /// timed the same and logged as the stream point it is.
     #[inline(always)]
-    pub fn table_stream_point(
-        &self,
-        d: &PathDim,
-        light: bool,
-        phase: Phase,
-        pixel: U8,
-        stream: &Stream<U8>,
-        index: u32,
-    ) -> (F8, F8) {
+    pub fn table_stream_point(&self, phase: Phase, stream: &Stream<U8>, j: u32, index: u32) -> (F8, F8) {
         let _p = profile::leaf(phase);
-        replay::path_point(pixel, U8::splat(index), d.dim(), light);
+        replay::table_point(j, index);
         let _ = self;
         stream.point(index)
     }

@@ -6,7 +6,8 @@
 //!
 //! The render reports its calls here from one place, the integrators' sample handle
 //! (`integrator/samples.rs`: [`pixel_point`], or [`camera_streams`] and [`camera_point`];
-//! [`light_streams`], [`light_point`]; [`path_point`]), and `render.rs` brackets each
+//! [`light_streams`], [`light_point`]; [`path_point`], or [`table_streams`] and [`table_point`]),
+//! and `render.rs` brackets each
 //! tile with [`tile_begin`]/[`tile_end`]. Off (the default), each report is one relaxed atomic
 //! load; recording only observes, so images are bit-identical either way.
 //!
@@ -48,6 +49,14 @@ const F_RESET: u32 = 1 << 7;
 const F_CAMERA: u32 = 1 << 6;
 /// On `OP_PATH` (which has no k word): the light table, not the path table.
 const F_LIGHT_TABLE: u32 = 1 << 6;
+/// On `OP_PATH`: a table stream (`GridTable::path_stream_x8` of the pixels), appended to the
+/// table-stream list, not a point.
+const F_TABLE_STREAM: u32 = 1 << 7;
+/// On `OP_STREAM_POINT`: a point of the table-stream list (not the light or camera streams').
+const F_TABLE: u32 = 1 << 7;
+/// On `OP_STREAM_POINT | F_TABLE`: no call, a marker that a fresh table-stream list follows (the
+/// op word alone).
+const F_TABLE_RESET: u32 = 1 << 2;
 const DIM_SHIFT: u32 = 8;
 /// Dimensions from here on take a word of their own (escape: the op word's dim field is all ones).
 const DIM_WIDE: u32 = (1 << (32 - DIM_SHIFT)) - 1;
@@ -336,6 +345,30 @@ fn stream_point(op: u32, stream: u32, k: u32) {
     }
 }
 
+/// Reports a fresh list of table streams, `table.path_stream_x8(d, pixel)` of dimension `dim` for
+/// each of `pixels` in order, from the light table (`light`) or the path table
+/// (`integrator/samples.rs`: `Samples::table_streams`).
+#[inline]
+pub fn table_streams(pixels: impl IntoIterator<Item = U8>, light: bool, dim: u32) {
+    if recording() {
+        LOG.with_borrow_mut(|l| {
+            if l.counting && l.active {
+                l.words.push(OP_STREAM_POINT | F_TABLE | F_TABLE_RESET);
+            }
+            let op = OP_PATH | F_TABLE_STREAM | if light { F_LIGHT_TABLE } else { 0 };
+            for p in pixels {
+                l.push(op, p, U8::splat(0), dim, None);
+            }
+        });
+    }
+}
+
+/// Reports `streams[stream].point(k)` of the last list of [`table_streams`].
+#[inline]
+pub fn table_point(stream: u32, k: u32) {
+    stream_point(OP_STREAM_POINT | F_TABLE, stream, k);
+}
+
 /// Reports a fresh table of camera streams, `pixel_set.stream_x8(pixel, sample, dim, seed)` for
 /// each of `pixels` in order (the pixel jitter of a batch of samples, see `integrator/samples.rs`).
 #[inline]
@@ -443,6 +476,7 @@ impl Recording {
     pub fn replay(&self, sets: &ReplaySets, mode: ReplayMode) -> (u64, u32) {
         let mut streams: Vec<Stream<U8>> = Vec::new();
         let mut cam_streams: Vec<Stream<U8>> = Vec::new();
+        let mut table_streams: Vec<Stream<U8>> = Vec::new();
         // The render finds point k's per-k work once for all its streams (`PointSet::point_k`,
         // then `Stream::point_k`): so does the replay, for the last k seen.
         let mut point_k = sets.light.point_k(0);
@@ -460,8 +494,23 @@ impl Recording {
                 i += 1;
                 calls += 1;
                 if op & 3 == OP_STREAM_POINT {
+                    if op & F_TABLE != 0 && op & F_TABLE_RESET != 0 {
+                        // A marker, not a call.
+                        calls -= 1;
+                        table_streams.clear();
+                        continue;
+                    }
                     let (si, k) = (w[i], w[i + 1]);
                     i += 2;
+                    if op & F_TABLE != 0 {
+                        if let (true, Some(s)) = (sample_on, table_streams.get(si as usize)) {
+                            let (x, y) = s.point(k);
+                            sum = fold(sum, x.to_bits() ^ y.to_bits());
+                        } else {
+                            sum = fold(sum, U8::splat(std::hint::black_box(si ^ k)));
+                        }
+                        continue;
+                    }
                     if op & F_CAMERA != 0 {
                         if let (true, Some(s)) = (sample_on, cam_streams.get(si as usize)) {
                             let (x, y) = s.point(k);
@@ -547,6 +596,11 @@ impl Recording {
                                 dims.resize(at + 1, None);
                             }
                             let d = *dims[at].get_or_insert_with(|| table.path_dim(n, dim, seed));
+                            if op & F_TABLE_STREAM != 0 {
+                                // (Only layouts that are not grids make table streams.)
+                                table_streams.extend(table.path_stream_x8(&d, pixel));
+                                continue;
+                            }
                             let (x, y) = table.path_point_x8(&d, pixel, sample);
                             fold(sum, x.to_bits() ^ y.to_bits())
                         } else {

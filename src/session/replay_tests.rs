@@ -26,8 +26,10 @@ fn pool_calls(pool: &rayon::ThreadPool) -> u64 {
     pool.broadcast(|_| take_api_calls()).iter().sum()
 }
 
-/// On every integrator (`direct` also with one light per sample) and with a sequence and a grid
-/// sampler: the log holds every sampler call
+/// On every integrator (`direct` also with one light per sample, packet by packet at 8 spp, and
+/// with enough light samples that every light's points come from per-packet streams of the light
+/// table) and with a
+/// sequence and a grid sampler: the log holds every sampler call
 /// the render made (the render's count comes from a counter inside the sampler API, not from the
 /// log), the replay makes exactly that many calls, and recording leaves the image bit-identical.
 #[test]
@@ -35,11 +37,29 @@ fn replay_calls_the_sampler_exactly_as_often_as_the_render() {
     let _g = crate::profile::TEST_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     use crate::light::select::LightSelection;
     use IntegratorKind::*;
-    let cases =
-        [(RayTracer, None), (AnalyticDirect, None), (Direct, None), (Direct, Some(LightSelection::named("power")))];
-    for (kind, selection) in cases.into_iter().chain([(PathTracer, None)]) {
+    let power = Some(LightSelection::named("power"));
+    // (integrator, light selection, light samples, spp, scene; the built-in Cornell box when
+    // none): `direct` with one light per sample in a scene without spheres shades packet by
+    // packet, from per-packet streams at 8 spp or more.
+    let no_spheres = Some(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/three_lights.test"));
+    let cases = [
+        (RayTracer, None, None, 3, None),
+        (AnalyticDirect, None, None, 3, None),
+        (Direct, None, None, 3, None),
+        (Direct, power, None, 3, None),
+        (Direct, power, None, 16, no_spheres),
+        (Direct, None, Some(4), 3, None),
+        (PathTracer, None, None, 3, None),
+    ];
+    for (kind, selection, light_samples, spp, scene) in cases {
         for sampler in [None, Some(SamplerKind::SOBOL)] {
-            let o = RenderOptions { light_selection: selection, ..opts(kind, sampler) };
+            let o = RenderOptions {
+                scene: scene.map(std::path::PathBuf::from),
+                light_selection: selection,
+                light_samples,
+                spp: Some(spp),
+                ..opts(kind, sampler)
+            };
             let (scene, it) = prepare(&o).unwrap();
             let pool = render::thread_pool(2).unwrap();
             let mut film = Film::new(scene.desc.width, scene.desc.height);
@@ -49,7 +69,11 @@ fn replay_calls_the_sampler_exactly_as_often_as_the_render() {
             let render_calls = pool_calls(&pool);
             let (rec, img) = record(&scene, &it, &pool, replay::DEFAULT_CAP_WORDS);
             assert_eq!(pool_calls(&pool), render_calls, "{kind:?}: the recording render makes the same calls");
-            assert_eq!(rec.calls(), render_calls, "{kind:?} {sampler:?}: calls counted while recording");
+            assert_eq!(
+                rec.calls(),
+                render_calls,
+                "{kind:?} {sampler:?} {selection:?} {light_samples:?} {spp} spp: calls counted while recording"
+            );
             assert_eq!(rec.recorded_calls(), render_calls, "{kind:?}: nothing capped");
             assert!(!rec.is_subset());
             take_api_calls();
