@@ -502,17 +502,9 @@ impl Recording {
                     }
                     let (si, k) = (w[i], w[i + 1]);
                     i += 2;
-                    if op & F_TABLE != 0 {
-                        if let (true, Some(s)) = (sample_on, table_streams.get(si as usize)) {
-                            let (x, y) = s.point(k);
-                            sum = fold(sum, x.to_bits() ^ y.to_bits());
-                        } else {
-                            sum = fold(sum, U8::splat(std::hint::black_box(si ^ k)));
-                        }
-                        continue;
-                    }
-                    if op & F_CAMERA != 0 {
-                        if let (true, Some(s)) = (sample_on, cam_streams.get(si as usize)) {
+                    if op & (F_TABLE | F_CAMERA) != 0 {
+                        let list = if op & F_TABLE != 0 { &table_streams } else { &cam_streams };
+                        if let (true, Some(s)) = (sample_on, list.get(si as usize)) {
                             let (x, y) = s.point(k);
                             sum = fold(sum, x.to_bits() ^ y.to_bits());
                         } else {
