@@ -476,7 +476,7 @@ impl Recording {
     pub fn replay(&self, sets: &ReplaySets, mode: ReplayMode) -> (u64, u32) {
         let mut streams: Vec<Stream<U8>> = Vec::new();
         let mut cam_streams: Vec<Stream<U8>> = Vec::new();
-        let mut table_streams: Vec<Stream<U8>> = Vec::new();
+        let mut table_streams: Vec<TableStream> = Vec::new();
         // The render finds point k's per-k work once for all its streams (`PointSet::point_k`,
         // then `Stream::point_k`): so does the replay, for the last k seen.
         let mut point_k = sets.light.point_k(0);
@@ -502,9 +502,24 @@ impl Recording {
                     }
                     let (si, k) = (w[i], w[i + 1]);
                     i += 2;
-                    if op & (F_TABLE | F_CAMERA) != 0 {
-                        let list = if op & F_TABLE != 0 { &table_streams } else { &cam_streams };
-                        if let (true, Some(s)) = (sample_on, list.get(si as usize)) {
+                    if op & F_TABLE != 0 {
+                        sum = match (sample_on, table_streams.get(si as usize)) {
+                            (true, Some(t)) => {
+                                let (x, y) = match &t.stream {
+                                    Some(s) => s.point(k),
+                                    None => {
+                                        let table = if t.light { &sets.light_table } else { &sets.path };
+                                        table.path_point_x8(&t.d, t.pixel, U8::splat(k))
+                                    }
+                                };
+                                fold(sum, x.to_bits() ^ y.to_bits())
+                            }
+                            _ => fold(sum, U8::splat(std::hint::black_box(si ^ k))),
+                        };
+                        continue;
+                    }
+                    if op & F_CAMERA != 0 {
+                        if let (true, Some(s)) = (sample_on, cam_streams.get(si as usize)) {
                             let (x, y) = s.point(k);
                             sum = fold(sum, x.to_bits() ^ y.to_bits());
                         } else {
@@ -589,8 +604,13 @@ impl Recording {
                             }
                             let d = *dims[at].get_or_insert_with(|| table.path_dim(n, dim, seed));
                             if op & F_TABLE_STREAM != 0 {
-                                // (Only layouts that are not grids make table streams.)
-                                table_streams.extend(table.path_stream_x8(&d, pixel));
+                                // A grid layout (replaying another kind's log) has no streams:
+                                // its points are drawn one by one, and this op makes no call.
+                                let stream = table.path_stream_x8(&d, pixel);
+                                if stream.is_none() {
+                                    calls -= 1;
+                                }
+                                table_streams.push(TableStream { stream, light: op & F_LIGHT_TABLE != 0, d, pixel });
                                 continue;
                             }
                             let (x, y) = table.path_point_x8(&d, pixel, sample);
@@ -604,6 +624,16 @@ impl Recording {
         }
         (calls, sum)
     }
+}
+
+/// A logged table stream as the replay's sets draw it: the stream, or (a grid layout, which has
+/// none) its points one by one from the table (the light table's or the path table's), dimension
+/// and pixels.
+struct TableStream {
+    stream: Option<Stream<U8>>,
+    light: bool,
+    d: PathDim,
+    pixel: U8,
 }
 
 #[inline]
