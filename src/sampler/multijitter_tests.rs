@@ -207,7 +207,7 @@ fn permutation_domains_are_tight() {
     // rotation off powers of two), 128 and 256 from five (two-word tables, one word and its
     // xorshift); larger ones keep the hashed rounds.
     let sizes = [2, 3, 4, 8, 9, 16, 25, 32, 64, 100, 128, 256, 512];
-    let words: Vec<(u32, Option<u32>)> = sizes.map(|m| (m, PermDomain::new(m).words().map(|w| w as u32))).to_vec();
+    let words: Vec<(u32, Option<u32>)> = sizes.map(|m| (m, PermDomain::new(m).words())).to_vec();
     let want = [
         (2, Some(1)),
         (3, Some(2)),

@@ -85,8 +85,8 @@ impl PermDomain {
 
     /// The hashed words its rounds take from a key, if they are tables.
     #[cfg(test)]
-    pub(super) fn words(&self) -> Option<usize> {
-        self.tables.map(|t| t.words as usize)
+    pub(super) fn words(&self) -> Option<u32> {
+        self.tables.map(|t| t.words)
     }
 
     /// (a, b): 0..m lies in Z_a x Z_b.
@@ -97,9 +97,9 @@ impl PermDomain {
 }
 
 /// The rounds of a small domain (Z_a x Z_b whose round tables fit in a word each: m <= 64 on
-/// powers of two, 9 = 3 x 3, 25 = 5 x 5, 36 = 6 x 6...; two words for 128 and 256) as tables: round j's function of the other
-/// half h is entry h of a table of b (or a) values of ceil(log2 a) (or ceil(log2 b)) bits, packed
-/// from bit `at[j].1` of hashed word `at[j].0`. The words hash the key alone, not the half, so
+/// powers of two, 9 = 3 x 3, 25 = 5 x 5, 36 = 6 x 6...; two words for 128 and 256) as tables:
+/// round j's function of the other half h is entry h of a table of b (or a) values of
+/// ceil(log2 a) (or ceil(log2 b)) bits, packed from bit `at[j].1` of hashed word `at[j].0`. The words hash the key alone, not the half, so
 /// they are computed side by side before the rounds, which are then a shift, a mask and an XOR
 /// (an add mod a or b) each; the `fmix` per round sat on the index's chain. On powers of two the
 /// entries are uniform and the rotation's log2 m bits share the words (8 points: one word where
@@ -121,8 +121,9 @@ impl PermDomain {
 struct RoundTables {
     /// hashed words used (<= 5)
     words: u32,
-    /// two-word tables (128 and 256 points): round j's table is hashed word j (its first half of
-    /// the entries) and that word's xorshift (the second half); word 4 is the rotation
+    /// two-word tables (128 and 256 points): round j's table is hashed word `at[j].0` (its first
+    /// half of the entries) and that word's xorshift (the second half); the rotation is word
+    /// `rot.0`
     wide: bool,
     /// (word, first bit) of each round's table
     at: [(u32, u32); 4],
@@ -276,16 +277,17 @@ fn permute_tables<L: Lanes>(i: L, d: &PermDomain, t: &RoundTables, key: L) -> L 
             let w = w.xor(w.shr(17));
             w.xor(w.shl(5))
         };
-        let second: [L; 4] = std::array::from_fn(|j| xs(words[j]));
+        let first: [L; 4] = std::array::from_fn(|j| words[t.at[j].0 as usize]);
+        let second = first.map(xs);
         let half = [d.b.d / 2, d.a / 2];
         let round = |j: usize, h: L| {
             let (width, half) = (t.width[j % 2], half[j % 2]);
             let upper = L::splat(0).sub(h.shr(half.trailing_zeros()));
-            let w = words[j].xor(words[j].xor(second[j]).and(upper));
+            let w = first[j].xor(first[j].xor(second[j]).and(upper));
             let at = times(h.and(L::splat(half - 1)), width);
             w.shr_var(at).and(L::splat((1 << width) - 1))
         };
-        return feistel(i, d, round, words[4]);
+        return feistel(i, d, round, words[t.rot.0 as usize]);
     }
     // Entry h of round j's table: bits at + h width.. of its word (h width by shifts and adds),
     // off powers of two reduced below a (or b): an entry e >= a counts as e - a.
