@@ -77,13 +77,18 @@ impl Ellipsoid {
             let row = inv.row(i);
             [row.x, row.y, row.z, row.w]
         };
-        // Bounds of the image of the unit ball: centre +- the row norms of the linear part.
+        // Bounds of the image of the unit ball: centre +- the row norms of the linear part, padded
+        // by 2^-10 of the extent and 2^-20 of the larger of the centre's coordinate and the extent
+        // (16x the f32 rounding of either end, so the f32 box holds the ellipsoid however the
+        // casts round, even one smaller than an f32 step of its position; Embree's box test, which
+        // decides which packets reach the callbacks, then rejects no ray that hits it).
         let (mut lower, mut upper) = ([0f32; 3], [0f32; 3]);
         for i in 0..3 {
             let row = md.row(i);
-            let ext = (row.x * row.x + row.y * row.y + row.z * row.z).sqrt() * (1.0 + 1e-6);
-            lower[i] = (row.w - ext) as f32;
-            upper[i] = (row.w + ext) as f32;
+            let ext = (row.x * row.x + row.y * row.y + row.z * row.z).sqrt();
+            let pad = ext / 1024.0 + row.w.abs().max(ext) / f64::from(1u32 << 20);
+            lower[i] = (row.w - ext - pad) as f32;
+            upper[i] = (row.w + ext + pad) as f32;
         }
         let inv = [r(0), r(1), r(2)];
         Some(Self { inv, lower, upper, fast: Fast::new(&inv) })

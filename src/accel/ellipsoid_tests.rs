@@ -374,3 +374,32 @@ fn sure_lanes(e: &Fast, org: Vec3x8, dir: Vec3x8) -> Mask8 {
     let Approach { e_o, e_d, a, inv_a, oo, ff, .. } = approach(e, org, dir);
     certain_misses(e_o, e_d, a, inv_a, oo, ff, F8::ONE - ff)
 }
+
+/// The f32 box Embree tests packets against holds the ellipsoid (its extreme points along each
+/// axis, in f64) however the casts round, down to ellipsoids smaller than an f32 step of their
+/// position: a box cut short would drop rays that the exact test hits before any callback runs.
+#[test]
+fn bounds_hold_the_ellipsoid_at_any_scale_and_position() {
+    let mut rng = Rng(23);
+    let mut checked = 0;
+    for r in [1e-5f32, 1e-4, 3e-3, 0.5, 7.0, 1e4] {
+        for c in [Vec3::ZERO, Vec3::new(0.3, -0.7, 0.1), Vec3::new(1e3, 2e3, -5e2), Vec3::new(-6e4, 3e5, 1e5)] {
+            let axes = Vec3::new(r, r * (0.2 + rng.unit()), r * (0.5 + rng.unit()));
+            for m in [sphere(c, r), ellipsoid(c, axes)] {
+                let e = Ellipsoid::new(&m).unwrap();
+                let md = glam::DMat4::from_cols_array(&m.to_cols_array().map(f64::from));
+                for i in 0..3 {
+                    let row = md.row(i);
+                    let ext = (row.x * row.x + row.y * row.y + row.z * row.z).sqrt();
+                    let (lo, hi) = (f64::from(e.lower[i]), f64::from(e.upper[i]));
+                    assert!(lo <= row.w - ext && hi >= row.w + ext, "r {r} at {c}, axis {i}: [{lo}, {hi}]");
+                    // Padded, not blown up: within 2^-8 of the extent plus 2^-18 of the position.
+                    let slack = ext / 256.0 + row.w.abs().max(ext) / f64::from(1u32 << 18);
+                    assert!(lo >= row.w - ext - slack && hi <= row.w + ext + slack, "r {r} at {c}: loose box");
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 6 * 4 * 2 * 3);
+}

@@ -212,8 +212,17 @@ impl<'d> SceneBuilder<'d> {
         for (i, m) in object_to_world.iter().enumerate() {
             prims.push(Ellipsoid::new(m).ok_or_else(|| AccelError(format!("sphere {i} has a singular transform")))?);
         }
+        // Embree makes a one-primitive BVH a bare leaf, whose primitive every ray of every packet
+        // reaches without a box test: a lone ellipsoid gets a sentinel primitive (a point box
+        // outside its own, never hit: `user_geometry::sentinel_point`), so the BVH has a root
+        // node and only packets with a ray crossing the ellipsoid's box call it (cornellSimple:
+        // half the callback calls).
+        let sentinel = u32::from(prims.len() == 1);
         let data = Box::new(prims);
-        let count = u32::try_from(data.len()).map_err(|_| AccelError("too many spheres".into()))?;
+        let count = u32::try_from(data.len())
+            .ok()
+            .and_then(|n| n.checked_add(sentinel))
+            .ok_or_else(|| AccelError("too many spheres".into()))?;
         // SAFETY: the user pointer is the boxed Vec<Ellipsoid>, moved into the Scene (heap address
         // unchanged) and dropped only after the Embree scene is released; the callbacks read it only.
         unsafe {

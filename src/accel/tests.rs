@@ -168,3 +168,51 @@ fn two_instances_share_one_group_and_report_their_ids() {
     let t = h.t.to_array();
     assert!((t[0] - 2.0).abs() < 1e-5 && (t[2] - 7.0).abs() < 1e-5, "{t:?}");
 }
+
+/// A lone ellipsoid is called only by packets with a ray that crosses its box: Embree makes a
+/// one-primitive BVH a bare leaf, which every packet reaches without a box test, so
+/// `add_ellipsoids` gives it a sentinel primitive that is never hit (the same hits as without).
+#[test]
+fn a_lone_ellipsoid_is_called_only_by_rays_near_it() {
+    use super::user_geometry::CALLBACK_CALLS;
+    let calls = || CALLBACK_CALLS.with(|c| c.replace(0));
+    let dev = Device::new().unwrap();
+    let mut b = SceneBuilder::new(&dev).unwrap();
+    b.add_triangles(&[Vec3::new(-9.0, -9.0, 9.0), Vec3::new(9.0, -9.0, 9.0), Vec3::new(0.0, 9.0, 9.0)], &[[0, 1, 2]])
+        .unwrap();
+    // The unit sphere at (0, 0, 5): its box is [-1, 1]^2 x [4, 6].
+    b.add_ellipsoids(&[Mat4::from_translation(Vec3::new(0.0, 0.0, 5.0))]).unwrap();
+    let scene = b.commit().unwrap();
+    let trace = |xs: [f32; 8], ys: [f32; 8]| {
+        let (org, dir) = packet(xs, ys);
+        let mut rh = RayHit8::default();
+        rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
+        let traced = scene.intersect8(&mut rh, false, mask_all());
+        let h = Hits8::from_rayhit(&rh, traced);
+        // Shadow rays stop short of the triangle: only the sphere can occlude them.
+        let mut r = Ray8::default();
+        r.set(org, dir, F8::ZERO, F8::splat(8.5), mask_all());
+        let occ = scene.occluded8(&mut r, mask_all());
+        (mask_to_bools(h.hit), h.geom.to_array(), h.t.to_array(), mask_to_bools(occ))
+    };
+    calls();
+    // Rays along +z at |x| >= 2: they hit the triangle at z = 9 and pass far from the sphere's box.
+    let far = [2.0, 2.5, 3.0, -2.0, -2.5, -3.0, 2.0, -2.0];
+    let (hit, geom, t, occ) = trace(far, [0.0; 8]);
+    assert_eq!((hit, occ), ([true; 8], [false; 8]));
+    assert!(geom.iter().all(|&g| g == GEOM_TRIANGLES) && t.iter().all(|t| (t - 9.0).abs() < 1e-5));
+    assert_eq!(calls(), 0, "a packet that misses the ellipsoid's box called its callbacks");
+    // Half the rays through the sphere: it is hit at z = 4 (the sentinel hides nothing).
+    let xs = [0.0, 2.0, 0.5, 2.5, -0.5, 3.0, 0.0, -2.0];
+    let ys = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0];
+    let (hit, geom, t, occ) = trace(xs, ys);
+    assert_eq!((hit, occ), ([true; 8], [true, false, true, false, true, false, true, false]));
+    for i in [0, 2, 4, 6] {
+        let z = 5.0 - (1.0 - xs[i] * xs[i] - ys[i] * ys[i]).sqrt();
+        assert_eq!(geom[i], GEOM_ELLIPSOIDS);
+        assert!((t[i] - z).abs() < 1e-5, "lane {i}: t {} against {z}", t[i]);
+    }
+    assert!([1, 3, 5, 7].iter().all(|&i| geom[i] == GEOM_TRIANGLES));
+    assert!(calls() >= 2, "the packets through the sphere called its intersect and occluded callbacks");
+    dev.take_errors().unwrap();
+}

@@ -45,15 +45,30 @@ fn timed(f: impl FnOnce()) {
 
 pub(super) unsafe extern "C" fn ellipsoid_bounds(args: *const sys::RTCBoundsFunctionArguments) {
     // SAFETY: Embree passes valid arguments; the user pointer is the Vec<Ellipsoid> set in
-    // add_ellipsoids and primID < its length (the primitive count we declared).
+    // add_ellipsoids (never empty) and primID < the primitive count we declared (its length, one more
+    // with the sentinel).
     unsafe {
         let a = &*args;
         let prims = &*(a.geometryUserPtr as *const Vec<Ellipsoid>);
-        let e = &prims[a.primID as usize];
+        let (lower, upper) = match prims.get(a.primID as usize) {
+            Some(e) => (e.lower, e.upper),
+            None => {
+                let p = sentinel_point(&prims[0]);
+                (p, p)
+            }
+        };
         let b = &mut *a.bounds_o;
-        (b.lower_x, b.lower_y, b.lower_z) = (e.lower[0], e.lower[1], e.lower[2]);
-        (b.upper_x, b.upper_y, b.upper_z) = (e.upper[0], e.upper[1], e.upper[2]);
+        (b.lower_x, b.lower_y, b.lower_z) = (lower[0], lower[1], lower[2]);
+        (b.upper_x, b.upper_y, b.upper_z) = (upper[0], upper[1], upper[2]);
     }
+}
+
+/// Where the sentinel primitive of a lone ellipsoid sits (`SceneBuilder::add_ellipsoids`): a
+/// point box outside the ellipsoid's box, below its lower corner by the box's size plus one.
+/// Its callbacks answer no hit, so where it sits changes no image; a point that is not finite
+/// makes Embree drop the sentinel, which only costs the box test it buys.
+fn sentinel_point(e: &Ellipsoid) -> [f32; 3] {
+    std::array::from_fn(|i| e.lower[i] - (e.upper[i] - e.lower[i]) - 1.0)
 }
 
 /// Float at 4-byte word `field * n + lane` of an Embree SoA ray/hit block of width `n`.
@@ -64,14 +79,23 @@ unsafe fn soa(base: *mut u32, n: usize, field: usize, lane: usize) -> *mut u32 {
     unsafe { base.add(field * n + lane) }
 }
 
-/// The ellipsoid `prim` of the Vec<Ellipsoid> behind `user`.
+/// The ellipsoid `prim` of the Vec<Ellipsoid> behind `user`; None for the sentinel primitive
+/// (`prim` = its length; see `SceneBuilder::add_ellipsoids`), which no ray hits.
 ///
 /// # Safety
-/// `user` must be the Vec<Ellipsoid> set in add_ellipsoids and `prim` < its length.
+/// `user` must be the Vec<Ellipsoid> set in add_ellipsoids.
 #[inline]
-unsafe fn ellipsoid<'a>(user: *mut c_void, prim: u32) -> &'a Ellipsoid {
+unsafe fn ellipsoid<'a>(user: *mut c_void, prim: u32) -> Option<&'a Ellipsoid> {
+    #[cfg(test)]
+    CALLBACK_CALLS.with(|c| c.set(c.get() + 1));
     // SAFETY: guaranteed by the caller; the Vec lives as long as the scene that calls us.
-    unsafe { &(&*(user as *const Vec<Ellipsoid>))[prim as usize] }
+    unsafe { (&*(user as *const Vec<Ellipsoid>)).get(prim as usize) }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Intersect and occluded callback invocations on this thread (tests count them).
+    pub(super) static CALLBACK_CALLS: Cell<u64> = const { Cell::new(0) };
 }
 
 /// Field `field` (8 lanes) of an Embree SoA ray/hit block of width 8.
@@ -153,7 +177,7 @@ pub(super) unsafe extern "C" fn ellipsoid_intersect(args: *const sys::RTCInterse
         let a = &*args;
         let (n, base) = (a.N as usize, a.rayhit as *mut u32);
         let ctx = &*(a.context as *const RayQueryContext);
-        let e = ellipsoid(a.geometryUserPtr, a.primID);
+        let Some(e) = ellipsoid(a.geometryUserPtr, a.primID) else { return };
         // Hit record: t, Ng and u, v zero (strata computes its own normals), the ids.
         let ids = [a.primID, a.geomID, ctx.inst_id[0], ctx.inst_prim_id[0]];
         if n == 8 {
@@ -187,7 +211,7 @@ pub(super) unsafe extern "C" fn ellipsoid_occluded(args: *const sys::RTCOccluded
     timed(|| unsafe {
         let a = &*args;
         let (n, base) = (a.N as usize, a.ray as *mut u32);
-        let e = ellipsoid(a.geometryUserPtr, a.primID);
+        let Some(e) = ellipsoid(a.geometryUserPtr, a.primID) else { return };
         if n == 8 {
             let (hit, _) = ellipsoid_hits8(e, a.valid, base);
             if hit.any() {
