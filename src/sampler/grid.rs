@@ -8,15 +8,11 @@ use super::permute::PermDomain;
 
 /// Grid shape used for n strata: (nx, ny) with nx * ny == n, nx <= ny, nx the largest divisor of n
 /// that is <= sqrt(n). Any n; n == 0 acts as 1, giving (1, 1).
-pub fn strata_shape(n: u32) -> (u32, u32) {
-    let n = n.max(1);
-    let mut nx = ((n as f64).sqrt() as u32).max(1);
-    while u64::from(nx) * u64::from(nx) > u64::from(n) {
-        nx -= 1;
-    }
-    while u64::from(nx + 1) * u64::from(nx + 1) <= u64::from(n) {
-        nx += 1;
-    }
+/// A `const fn` (the integer square root is exact), so that [`Grid::new`] can run at compile
+/// time for the common set sizes (`multijitter`'s specialised points).
+pub const fn strata_shape(n: u32) -> (u32, u32) {
+    let n = if n == 0 { 1 } else { n };
+    let mut nx = n.isqrt();
     while !n.is_multiple_of(nx) {
         nx -= 1;
     }
@@ -38,9 +34,9 @@ pub(super) struct Grid {
 
 impl Grid {
     /// The `strata_shape(n)` grid of n cells (n == 0 acts as 1).
-    pub(super) fn new(n: u32) -> Self {
+    pub(super) const fn new(n: u32) -> Self {
         let (nx, ny) = strata_shape(n);
-        let perm = [n, nx, ny].map(PermDomain::new);
+        let perm = [PermDomain::new(n), PermDomain::new(nx), PermDomain::new(ny)];
         Self { n: Divisor::new(n), nx: Divisor::new(nx), ny: Divisor::new(ny), perm }
     }
 }

@@ -256,3 +256,57 @@ fn camera_points_keep_their_coarse_cell() {
     assert!(moved, "dimension 66 keeps the index order");
 }
 
+
+/// Power-of-two sets run on compile-time grids (`keyed_point`'s specialisation): every point, for
+/// the camera's dimension and others, lanes with different keys and indices past n, has the bits
+/// of the same code on the grid made at run time.
+#[test]
+fn constant_grids_give_the_run_time_points() {
+    use crate::simd::U8;
+    let mut st = 0x9e37_79b9u32;
+    let mut next = || {
+        st ^= st << 13;
+        st ^= st >> 17;
+        st ^= st << 5;
+        st
+    };
+    for n in [4u32, 8, 16, 32, 64, 128, 256] {
+        let set = SetShape::new(n, 640);
+        let grid = std::hint::black_box(Grid::new(n));
+        for dim in [DIM_CAMERA, 1, 7, 66] {
+            for _ in 0..64 {
+                let key = U8::new(std::array::from_fn(|_| next()));
+                let k = U8::new(std::array::from_fn(|i| if i == 7 { n + next() % (3 * n) } else { next() % n }));
+                let (ax, ay) = keyed_point(&set, key, dim, k);
+                let (bx, by) = grid_point(&grid, key, dim, k);
+                assert_eq!((ax.to_array(), ay.to_array()), (bx.to_array(), by.to_array()), "n {n}, dim {dim}");
+                let (key, k) = (key.to_array()[0], k.to_array()[0]);
+                let (sa, sb) = (keyed_point(&set, key, dim, k), grid_point(&grid, key, dim, k));
+                assert_eq!((sa.0.to_bits(), sa.1.to_bits()), (sb.0.to_bits(), sb.1.to_bits()), "scalar, n {n}");
+            }
+        }
+    }
+}
+
+/// The grid's square roots are integer ones (`u32::isqrt`, so that `Grid::new` is a `const fn`):
+/// the same as the float roots they replaced wherever those could differ (next to squares), and
+/// the same strata shapes and permutation domains.
+#[test]
+fn integer_roots_are_the_float_roots_they_replaced() {
+    for k in 1u64..=65_536 {
+        for m in [k * k - 1, k * k, k * k + 1] {
+            let Ok(m) = u32::try_from(m) else { continue };
+            assert_eq!(m.isqrt(), (f64::from(m)).sqrt() as u32, "m = {m}");
+        }
+    }
+    let float_shape = |n: u32| {
+        let mut nx = (f64::from(n).sqrt() as u32).max(1);
+        while n % nx != 0 {
+            nx -= 1;
+        }
+        (nx, n / nx)
+    };
+    for n in (1..70_000u32).chain([1 << 24, (1 << 24) + 7, u32::MAX]) {
+        assert_eq!(strata_shape(n), float_shape(n), "n = {n}");
+    }
+}

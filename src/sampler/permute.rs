@@ -53,31 +53,36 @@ pub(super) struct PermDomain {
 }
 
 impl PermDomain {
-    /// The domain of 0..m (m == 0 acts as 1).
-    pub(super) fn new(m: u32) -> Self {
-        let m = m.max(1);
+    /// The domain of 0..m (m == 0 acts as 1). A `const fn`, so that the domains of the common set
+    /// sizes can be constants (`multijitter`'s specialised points).
+    pub(super) const fn new(m: u32) -> Self {
+        let m = if m == 0 { 1 } else { m };
         let (a, b) = if m > 1 << 31 {
             // Z_2^16 x Z_2^16: all of u32 (x = l * b + r stays exact in wrapping arithmetic).
             (1 << 16, 1 << 16)
         } else if m <= 2 {
             (m, 1)
         } else {
-            let root = (f64::from(m).sqrt() as u32).max(2);
+            let root = if m.isqrt() < 2 { 2 } else { m.isqrt() };
             let mut best = (m.div_ceil(2), 2u32);
-            for b in (2..=root).rev().take(64) {
+            // b from the root down, at most 64 steps.
+            let (mut b, mut steps) = (root, 0);
+            while b >= 2 && steps < 64 {
                 let a = m.div_ceil(b);
                 // An exact pair near the root also replaces the starting (m / 2, 2), exact for
                 // even m: the most balanced exact pair wins.
-                if u64::from(a) * u64::from(b) < u64::from(best.0) * u64::from(best.1) || a * b == m {
+                if (a as u64) * (b as u64) < (best.0 as u64) * (best.1 as u64) || a * b == m {
                     best = (a, b);
                 }
                 if a * b == m {
                     break;
                 }
+                b -= 1;
+                steps += 1;
             }
             best
         };
-        let exact = u64::from(a) * u64::from(b) == u64::from(m);
+        let exact = (a as u64) * (b as u64) == m as u64;
         let pow2 = a.is_power_of_two() && b.is_power_of_two();
         let tables = RoundTables::new(a, b, pow2 && exact);
         Self { m, a, b: Divisor::new(b), exact, pow2, shift: b.trailing_zeros(), tables }
@@ -136,35 +141,54 @@ struct RoundTables {
 impl RoundTables {
     /// The tables of Z_a x Z_b (`pow2_m`: both powers of two and m = a b), if every round's table
     /// fits in a word and all of them (with the rotation) in four.
-    fn new(a: u32, b: u32, pow2_m: bool) -> Option<Self> {
-        let bits_for = |n: u32| 32 - (n.max(1) - 1).leading_zeros();
+    const fn new(a: u32, b: u32, pow2_m: bool) -> Option<Self> {
         let width = [bits_for(a), bits_for(b)];
         // Even rounds: b entries of width[0] bits; odd rounds: a entries of width[1] bits.
         let size = [b * width[0], a * width[1]];
         if size[0] > 32 || size[1] > 32 {
             // Two words a table where each half of its entries fits a word (powers of two).
-            let fits = pow2_m && size[0] <= 64 && size[1] <= 64;
-            return fits.then_some(Self {
-                words: 5,
-                wide: true,
-                at: [(0, 0), (1, 0), (2, 0), (3, 0)],
-                width,
-                rot: (4, 0),
-            });
+            if !(pow2_m && size[0] <= 64 && size[1] <= 64) {
+                return None;
+            }
+            return Some(Self { words: 5, wide: true, at: [(0, 0), (1, 0), (2, 0), (3, 0)], width, rot: (4, 0) });
         }
         // First fit: each table (and then the rotation) in the first word with room.
         let mut used = [0u32; 6];
-        let mut place = |bits: u32| -> (u32, u32) {
-            let w = used.iter().position(|&u| u + bits <= 32).unwrap_or(5);
-            let at = (w as u32, used[w]);
-            used[w] += bits;
-            at
-        };
-        let at: [(u32, u32); 4] = std::array::from_fn(|j| place(size[j % 2]));
-        let rot = place(if pow2_m { width[0] + width[1] } else { 32 });
-        let words = used.iter().filter(|&&u| u > 0).count() as u32;
-        (words <= 4).then_some(Self { words, wide: false, at, width, rot })
+        let mut at = [(0u32, 0u32); 4];
+        let mut j = 0;
+        while j < 4 {
+            at[j] = place(&mut used, size[j % 2]);
+            j += 1;
+        }
+        let rot = place(&mut used, if pow2_m { width[0] + width[1] } else { 32 });
+        let (mut words, mut w) = (0, 0);
+        while w < used.len() {
+            words += (used[w] > 0) as u32;
+            w += 1;
+        }
+        if words <= 4 {
+            Some(Self { words, wide: false, at, width, rot })
+        } else {
+            None
+        }
     }
+}
+
+/// Bits of an entry below n (n == 0 acts as 1).
+const fn bits_for(n: u32) -> u32 {
+    32 - (if n == 0 { 0 } else { n - 1 }).leading_zeros()
+}
+
+/// [`RoundTables::new`]'s first fit: `bits` bits in the first of the six words with room (the
+/// last one if none has), as (word, first bit).
+const fn place(used: &mut [u32; 6], bits: u32) -> (u32, u32) {
+    let mut w = 0;
+    while w < 5 && used[w] + bits > 32 {
+        w += 1;
+    }
+    let at = (w as u32, used[w]);
+    used[w] += bits;
+    at
 }
 
 /// A keyed permutation of 0..m (`d`'s m; lane-uniform, per-lane keys) that is close to a
