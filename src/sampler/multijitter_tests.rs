@@ -301,7 +301,7 @@ fn integer_roots_are_the_float_roots_they_replaced() {
     }
     let float_shape = |n: u32| {
         let mut nx = (f64::from(n).sqrt() as u32).max(1);
-        while n % nx != 0 {
+        while !n.is_multiple_of(nx) {
             nx -= 1;
         }
         (nx, n / nx)
