@@ -161,8 +161,22 @@ impl Ray8 {
     /// harmless ray. Resets mask, id, flags.
     #[inline]
     pub fn set(&mut self, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, active: Mask8) -> Mask8 {
-        let (ray, ok) = Self::new(org, dir, tnear, tfar, active);
-        *self = ray;
+        // Field by field in place, as `new` builds them (a whole new packet and a 384-byte copy
+        // cost more than the stores).
+        let ok = active & org.is_finite() & dir.is_finite() & tnear.is_finite() & !tfar.is_nan();
+        let z = F8::ZERO;
+        self.org_x = ok.select(org.x, z).to_array();
+        self.org_y = ok.select(org.y, z).to_array();
+        self.org_z = ok.select(org.z, z).to_array();
+        self.tnear = ok.select(tnear, z).to_array();
+        self.dir_x = ok.select(dir.x, z).to_array();
+        self.dir_y = ok.select(dir.y, z).to_array();
+        self.dir_z = ok.select(dir.z, F8::ONE).to_array();
+        self.time = [0.0; 8];
+        self.tfar = ok.select(tfar, z).to_array();
+        self.mask = [u32::MAX; 8];
+        self.id = [0; 8];
+        self.flags = [0; 8];
         ok
     }
 
@@ -170,22 +184,8 @@ impl Ray8 {
     /// also returns the lanes that are `active` and finite.
     #[inline]
     pub fn new(org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, active: Mask8) -> (Self, Mask8) {
-        let ok = active & org.is_finite() & dir.is_finite() & tnear.is_finite() & !tfar.is_nan();
-        let z = F8::ZERO;
-        let ray = Self {
-            org_x: ok.select(org.x, z).to_array(),
-            org_y: ok.select(org.y, z).to_array(),
-            org_z: ok.select(org.z, z).to_array(),
-            tnear: ok.select(tnear, z).to_array(),
-            dir_x: ok.select(dir.x, z).to_array(),
-            dir_y: ok.select(dir.y, z).to_array(),
-            dir_z: ok.select(dir.z, F8::ONE).to_array(),
-            time: [0.0; 8],
-            tfar: ok.select(tfar, z).to_array(),
-            mask: [u32::MAX; 8],
-            id: [0; 8],
-            flags: [0; 8],
-        };
+        let mut ray = Self::default();
+        let ok = ray.set(org, dir, tnear, tfar, active);
         (ray, ok)
     }
 }

@@ -58,8 +58,9 @@ pub trait Lanes: Copy {
     fn shr_var(self, s: Self) -> Self;
     /// Per lane `table[self % 8]`: an 8-entry table look-up.
     fn lookup8(self, table: [u32; 8]) -> Self;
-    /// Per lane both words of `table[self]` (panics if out of range).
-    fn gather2(self, table: &[[u32; 2]]) -> (Self, Self);
+    /// Per lane both words of `table[self mod N]` (N a power of two: the index is masked, so
+    /// there is no bounds check per lane).
+    fn gather2<const N: usize>(self, table: &[[u32; 2]; N]) -> (Self, Self);
     /// Per lane `table[self]` widened to u32 (panics if out of range).
     fn gather16(self, table: &[u16]) -> Self;
     /// The largest lane.
@@ -132,8 +133,9 @@ impl Lanes for u32 {
     fn lookup8(self, table: [u32; 8]) -> Self {
         table[self as usize & 7]
     }
-    fn gather2(self, table: &[[u32; 2]]) -> (Self, Self) {
-        let [x, y] = table[self as usize];
+    fn gather2<const N: usize>(self, table: &[[u32; 2]; N]) -> (Self, Self) {
+        const { assert!(N.is_power_of_two()) };
+        let [x, y] = table[self as usize & (N - 1)];
         (x, y)
     }
     fn gather16(self, table: &[u16]) -> Self {
@@ -219,10 +221,11 @@ impl Lanes for U8 {
         crate::simd::permute_lanes(U8::new(table), self)
     }
     #[inline]
-    fn gather2(self, table: &[[u32; 2]]) -> (Self, Self) {
+    fn gather2<const N: usize>(self, table: &[[u32; 2]; N]) -> (Self, Self) {
+        const { assert!(N.is_power_of_two()) };
         let (mut x, mut y) = ([0u32; 8], [0u32; 8]);
         for (l, i) in self.to_array().into_iter().enumerate() {
-            [x[l], y[l]] = table[i as usize];
+            [x[l], y[l]] = table[i as usize & (N - 1)];
         }
         (U8::new(x), U8::new(y))
     }

@@ -177,10 +177,17 @@ fn table_point<L: Lanes>(sc: &Scramble<L>, index: L, pick: L) -> (L::F, L::F) {
 }
 
 /// All tables, table t at entries t * 4096 .. (t + 1) * 4096, as 24-bit fixed-point [x, y].
-fn tables() -> &'static [[u32; 2]] {
-    static TABLES_CELL: OnceLock<Vec<[u32; 2]>> = OnceLock::new();
-    TABLES_CELL.get_or_init(|| (0..TABLES).flat_map(build_table).collect())
+fn tables() -> &'static [[u32; 2]; TABLE_LEN] {
+    static TABLES_CELL: OnceLock<Box<[[u32; 2]; TABLE_LEN]>> = OnceLock::new();
+    TABLES_CELL.get_or_init(|| {
+        let all: Box<[[u32; 2]]> = (0..TABLES).flat_map(build_table).collect();
+        all.try_into().expect("TABLES tables of TABLE_POINTS points")
+    })
 }
+
+/// Points in all the tables (a power of two: `gather2` masks its indices into them; `slot` in
+/// `table_point` is below it by construction).
+const TABLE_LEN: usize = (TABLES * TABLE_POINTS) as usize;
 
 /// 24 hashed bits for (table, point, what).
 fn rand24(table: u32, point: u32, what: u32) -> u32 {

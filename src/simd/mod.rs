@@ -47,11 +47,11 @@ pub fn mask_to_bools(m: Mask8) -> [bool; 8] {
     std::array::from_fn(|i| bits & (1 << i) != 0)
 }
 
-/// Embree's valid array for a mask: -1 for active lanes, 0 for inactive.
+/// Embree's valid array for a mask: -1 for active lanes, 0 for inactive (each lane's sign bit,
+/// which `to_bitmask` reads, spread over the lane by an arithmetic shift: no per-lane loop).
 #[inline]
 pub fn mask_to_valid(m: Mask8) -> [i32; 8] {
-    let bits = m.to_bitmask();
-    std::array::from_fn(|i| if bits & (1 << i) != 0 { -1 } else { 0 })
+    (i32x8::new(m.to_bits().to_array().map(|u| u as i32)) >> 31u32).to_array()
 }
 
 /// Lanes of `v` where `m` is set, `0.0` elsewhere.
@@ -340,6 +340,10 @@ mod tests {
         let m = mask_from_bools(b);
         assert_eq!(mask_to_bools(m), b);
         assert_eq!(mask_to_valid(m), [-1, 0, -1, -1, 0, 0, -1, 0]);
+        // Any lane bits: the sign bit decides, as for `to_bitmask`.
+        let odd = F8::new([-0.0, 1.5, -2.0, 0.0, f32::NAN, -f32::NAN, f32::from_bits(0x8000_0001), f32::MIN_POSITIVE]);
+        let bits = odd.to_bitmask();
+        assert_eq!(mask_to_valid(odd), std::array::from_fn(|i| if bits & (1 << i) != 0 { -1 } else { 0 }));
         assert_eq!(mask_to_bools(mask_first(3)), [true, true, true, false, false, false, false, false]);
         assert!(mask_all().all());
     }
