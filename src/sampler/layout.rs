@@ -49,8 +49,8 @@ impl SetShape {
     }
 
     /// The `strata_shape(n)` grid with its divisors.
-    pub(super) fn grid(&self) -> Grid {
-        self.grid
+    pub(super) fn grid(&self) -> &Grid {
+        &self.grid
     }
 }
 

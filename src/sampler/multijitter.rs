@@ -89,7 +89,7 @@ fn keyed_point<L: Lanes>(set: &SetShape, key: L, dim: u32, k: L) -> (L::F, L::F)
         64 => grid_point(const { &Grid::new(64) }, key, dim, k),
         128 => grid_point(const { &Grid::new(128) }, key, dim, k),
         256 => grid_point(const { &Grid::new(256) }, key, dim, k),
-        _ => grid_point(&set.grid(), key, dim, k),
+        _ => grid_point(set.grid(), key, dim, k),
     }
 }
 

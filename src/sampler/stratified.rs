@@ -103,7 +103,7 @@ impl Layout for Stratified {
     }
 
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]> {
-        let grid: Grid = set.grid();
+        let grid: Grid = *set.grid();
         let (cy, cx) = grid.nx.div_rem(grid.n.rem(k));
         Some(if self.jitter {
             let ((xl, xh), (yl, yh)) = (cell_span(cx, grid.nx), cell_span(cy, grid.ny));
@@ -182,7 +182,7 @@ impl GridTable {
         } else {
             Vec::new()
         };
-        let axes = Axes::of(&spans, shape.grid());
+        let axes = Axes::of(&spans, *shape.grid());
         let grid = layout.cell_span(&shape, 0).is_some();
         Self { set, spans, axes, grid }
     }
