@@ -161,8 +161,8 @@ impl Ray8 {
     /// harmless ray. Resets mask, id, flags.
     #[inline]
     pub fn set(&mut self, org: Vec3x8, dir: Vec3x8, tnear: F8, tfar: F8, active: Mask8) -> Mask8 {
-        // Field by field in place, as `new` builds them (a whole new packet and a 384-byte copy
-        // cost more than the stores).
+        // Field by field in place (a whole new packet and a 384-byte copy cost more than the
+        // stores; `new` fills a default packet through here, and the default's stores fold away).
         let ok = active & org.is_finite() & dir.is_finite() & tnear.is_finite() & !tfar.is_nan();
         let z = F8::ZERO;
         self.org_x = ok.select(org.x, z).to_array();

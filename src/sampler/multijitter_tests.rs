@@ -5,6 +5,7 @@
 
 use super::super::grid::strata_shape;
 use super::super::permute::{permute, PermDomain};
+use super::super::sobol::tests::lcg;
 use super::super::{PointSet, SamplerKind};
 use super::*;
 
@@ -256,20 +257,14 @@ fn camera_points_keep_their_coarse_cell() {
     assert!(moved, "dimension 66 keeps the index order");
 }
 
-
 /// Power-of-two sets run on compile-time grids (`keyed_point`'s specialisation): every point, for
 /// the camera's dimension and others, lanes with different keys and indices past n, has the bits
 /// of the same code on the grid made at run time.
 #[test]
 fn constant_grids_give_the_run_time_points() {
     use crate::simd::U8;
-    let mut st = 0x9e37_79b9u32;
-    let mut next = || {
-        st ^= st << 13;
-        st ^= st >> 17;
-        st ^= st << 5;
-        st
-    };
+    let mut st = 0x9e37_79b9u64;
+    let mut next = || lcg(&mut st);
     for n in [4u32, 8, 16, 32, 64, 128, 256] {
         let set = SetShape::new(n, 640);
         let grid = std::hint::black_box(Grid::new(n));

@@ -63,7 +63,8 @@ impl PermDomain {
         } else if m <= 2 {
             (m, 1)
         } else {
-            let root = if m.isqrt() < 2 { 2 } else { m.isqrt() };
+            let root = m.isqrt();
+            let root = if root < 2 { 2 } else { root };
             let mut best = (m.div_ceil(2), 2u32);
             // b from the root down, at most 64 steps.
             let (mut b, mut steps) = (root, 0);

@@ -4,16 +4,11 @@ use super::divisor::Divisor;
 use super::grid::{cell_coord, cell_span, centre_offset, jittered, FIXED_ONE};
 use super::halton::{POW3_15, RADIX2, RADIX3};
 use super::hash::{fmix, hash, mix, unit};
+use super::sobol::tests::lcg;
 use super::*;
 
 fn u8_from(f: impl FnMut(usize) -> u32) -> U8 {
     U8::new(std::array::from_fn(f))
-}
-
-/// Small deterministic generator for test inputs.
-fn lcg(state: &mut u64) -> u32 {
-    *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-    (*state >> 32) as u32
 }
 
 #[test]

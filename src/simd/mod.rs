@@ -51,7 +51,7 @@ pub fn mask_to_bools(m: Mask8) -> [bool; 8] {
 /// which `to_bitmask` reads, spread over the lane by an arithmetic shift: no per-lane loop).
 #[inline]
 pub fn mask_to_valid(m: Mask8) -> [i32; 8] {
-    (i32x8::new(m.to_bits().to_array().map(|u| u as i32)) >> 31u32).to_array()
+    (wide::bytemuck::cast::<Mask8, i32x8>(m) >> 31u32).to_array()
 }
 
 /// Lanes of `v` where `m` is set, `0.0` elsewhere.
