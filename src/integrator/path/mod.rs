@@ -542,12 +542,12 @@ impl Bounce<'_> {
                     for e in &scene.emitters.list {
                         for j in 0..n_all {
                             let (uj, wj) = lattice_point(u, w, j, n_all);
-                            let ls = {
-                                let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                                let mut ls = e.sample_x8(uj, wj);
-                                e.warp_x8(it.light_warp, &mut ls, sh.p, shade);
-                                ls
-                            };
+                            // (The sample stays where it is made: a block returning it copied its
+                            // 448 bytes out.)
+                            let p = crate::profile::leaf(crate::profile::Phase::Emitter);
+                            let mut ls = e.sample_x8(uj, wj);
+                            e.warp_x8(it.light_warp, &mut ls, sh.p, shade);
+                            drop(p);
                             push(&ls, scale, mis_n, shade);
                         }
                     }
