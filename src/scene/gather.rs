@@ -97,9 +97,9 @@ impl Scene {
     /// Gathers the shading records of a packet's hits (rays `org + t dir`, `dir` unit).
     ///
     /// Per lane only the table lookups run (normal, material and light index by primitive); the
-    /// rest is 8-wide: the two-sided flip, and the material fields, splatted once per distinct material of
-    /// the hit lanes (one in the common case of a coherent packet). Lanes that missed get
-    /// the miss record (normals +z, zero reflectances, roughness 1, no light).
+    /// rest is 8-wide: the two-sided flip, and the material fields, splatted once per distinct
+    /// material of the hit lanes (one in the common case of a coherent packet). Lanes that missed
+    /// get the miss record (normals +z, zero reflectances, roughness 1, no light).
     #[inline]
     pub fn gather(&self, org: Vec3x8, dir: Vec3x8, hits: &Hits8) -> SurfaceHit8 {
         let mut sh = SurfaceHit8::MISS;
