@@ -105,13 +105,14 @@ impl PermDomain {
 /// The rounds of a small domain (Z_a x Z_b whose round tables fit in a word each: m <= 64 on
 /// powers of two, 9 = 3 x 3, 25 = 5 x 5, 36 = 6 x 6...; two words for 128 and 256) as tables:
 /// round j's function of the other half h is entry h of a table of b (or a) values of
-/// ceil(log2 a) (or ceil(log2 b)) bits, packed from bit `at[j].1` of hashed word `at[j].0`. The words hash the key alone, not the half, so
-/// they are computed side by side before the rounds, which are then a shift, a mask and an XOR
-/// (an add mod a or b) each; the `fmix` per round sat on the index's chain. On powers of two the
-/// entries are uniform and the rotation's log2 m bits share the words (8 points: one word where
-/// the hashed rounds took five hashes; 64: four); otherwise an entry e >= a counts as e - a (the
-/// round stays a bijection; its values are no longer uniform, which the decorrelation test bounds)
-/// and the rotation takes a word of its own (uniform to 2^-32, as [`rotation`]).
+/// ceil(log2 a) (or ceil(log2 b)) bits, packed from bit `at[j].1` of hashed word `at[j].0`. The
+/// words hash the key alone, not the half, so they are computed side by side before the rounds,
+/// which are then a shift, a mask and an XOR (an add mod a or b) each; the `fmix` per round sat on
+/// the index's chain. On powers of two the entries are uniform and the rotation's log2 m bits
+/// share the words (8 points: one word where the hashed rounds took five hashes; 64: four);
+/// otherwise an entry e >= a counts as e - a (the round stays a bijection; its values are no
+/// longer uniform, which the decorrelation test bounds) and the rotation takes a word of its own
+/// (uniform to 2^-32, as [`rotation`]).
 ///
 /// 128 = 16 x 8 and 256 = 16 x 16 points (`wide`: a table of up to 64 bits, each half of its
 /// entries fitting a word) take one hashed word per round, its entries' first half from the word

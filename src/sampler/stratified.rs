@@ -4,7 +4,7 @@
 //! [`GridTable`] of precomputed cell spans.
 
 use super::divisor::Divisor;
-use super::grid::{cell_centre, cell_span, jittered, Grid};
+use super::grid::{cell_centre, cell_span, jittered};
 use super::hash::{hash, mix, stream_key};
 use super::lanes::Lanes;
 use super::layout::{Layout, SetShape, StreamKey};
@@ -103,7 +103,7 @@ impl Layout for Stratified {
     }
 
     fn cell_span(&self, set: &SetShape, k: u32) -> Option<[u32; 4]> {
-        let grid: Grid = *set.grid();
+        let grid = set.grid();
         let (cy, cx) = grid.nx.div_rem(grid.n.rem(k));
         Some(if self.jitter {
             let ((xl, xh), (yl, yh)) = (cell_span(cx, grid.nx), cell_span(cy, grid.ny));
