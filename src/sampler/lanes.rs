@@ -242,3 +242,123 @@ impl Lanes for U8 {
         f.point_8(pixel, sample, dim, k, seed)
     }
 }
+
+/// Two independent sets of lanes run as one: every operation applies to both halves, so a
+/// generator instantiated on `Pair<U8>` computes two 8-lane points with their instructions
+/// interleaved. A point is a long chain of dependent multiplies (hashes and permutation rounds);
+/// two chains side by side fill the pipeline that one leaves idle. Each half gets exactly the
+/// bits the generator gives it alone, provided the generator's lane-uniform branches
+/// (`max_lane`) only choose between forms that agree on every lane (as a reduction that is the
+/// identity below its modulus does).
+#[derive(Clone, Copy, Debug)]
+pub struct Pair<L>(pub L, pub L);
+
+impl<L: Lanes> Pair<L> {
+    #[inline(always)]
+    fn both(self, o: Self, f: impl Fn(L, L) -> L) -> Self {
+        Pair(f(self.0, o.0), f(self.1, o.1))
+    }
+}
+
+impl<L: Lanes> Lanes for Pair<L> {
+    type F = (L::F, L::F);
+    #[inline(always)]
+    fn splat(x: u32) -> Self {
+        Pair(L::splat(x), L::splat(x))
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.both(o, L::add)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self.both(o, L::sub)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.both(o, L::mul)
+    }
+    #[inline(always)]
+    fn xor(self, o: Self) -> Self {
+        self.both(o, L::xor)
+    }
+    #[inline(always)]
+    fn or(self, o: Self) -> Self {
+        self.both(o, L::or)
+    }
+    #[inline(always)]
+    fn and(self, o: Self) -> Self {
+        self.both(o, L::and)
+    }
+    #[inline(always)]
+    fn shr(self, s: u32) -> Self {
+        Pair(self.0.shr(s), self.1.shr(s))
+    }
+    #[inline(always)]
+    fn shl(self, s: u32) -> Self {
+        Pair(self.0.shl(s), self.1.shl(s))
+    }
+    #[inline(always)]
+    fn mul_wide(self, o: Self) -> (Self, Self) {
+        let ((l0, h0), (l1, h1)) = (self.0.mul_wide(o.0), self.1.mul_wide(o.1));
+        (Pair(l0, l1), Pair(h0, h1))
+    }
+    #[inline(always)]
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self {
+        Pair(self.0.lt_select(o.0, a.0, b.0), self.1.lt_select(o.1, a.1, b.1))
+    }
+    #[inline(always)]
+    fn unit24(self) -> Self::F {
+        (self.0.unit24(), self.1.unit24())
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(u32) -> u32) -> Self {
+        Pair(self.0.map(&f), self.1.map(&f))
+    }
+    #[inline(always)]
+    fn mulhi(self, o: Self) -> Self {
+        self.both(o, L::mulhi)
+    }
+    #[inline(always)]
+    fn lt_mask(self, o: Self) -> Self {
+        self.both(o, L::lt_mask)
+    }
+    #[inline(always)]
+    fn sign_mask(self) -> Self {
+        Pair(self.0.sign_mask(), self.1.sign_mask())
+    }
+    #[inline(always)]
+    fn shr_var(self, s: Self) -> Self {
+        self.both(s, L::shr_var)
+    }
+    #[inline(always)]
+    fn lookup8(self, table: [u32; 8]) -> Self {
+        Pair(self.0.lookup8(table), self.1.lookup8(table))
+    }
+    #[inline(always)]
+    fn gather2<const N: usize>(self, table: &[[u32; 2]; N]) -> (Self, Self) {
+        let ((x0, y0), (x1, y1)) = (self.0.gather2(table), self.1.gather2(table));
+        (Pair(x0, x1), Pair(y0, y1))
+    }
+    #[inline(always)]
+    fn gather16(self, table: &[u16]) -> Self {
+        Pair(self.0.gather16(table), self.1.gather16(table))
+    }
+    #[inline(always)]
+    fn max_lane(self) -> u32 {
+        self.0.max_lane().max(self.1.max_lane())
+    }
+    #[inline]
+    fn dyn_point<P: PointFn + ?Sized>(
+        f: &P,
+        pixel: Self,
+        sample: Self,
+        dim: u32,
+        k: Self,
+        seed: u64,
+    ) -> (Self::F, Self::F) {
+        let (x0, y0) = L::dyn_point(f, pixel.0, sample.0, dim, k.0, seed);
+        let (x1, y1) = L::dyn_point(f, pixel.1, sample.1, dim, k.1, seed);
+        ((x0, x1), (y0, y1))
+    }
+}

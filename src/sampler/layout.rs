@@ -96,6 +96,23 @@ pub trait Layout: Send + Sync + 'static {
     /// Point k of the set of (pixel, sample, dim) under seed, per lane.
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F);
 
+    /// The points of two dimensions `dims` of (pixel, sample) at indices `k`: bit for bit
+    /// `[point(.., dims[0], k[0], ..), point(.., dims[1], k[1], ..)]`. The default makes the two
+    /// calls; a layout whose point is a long dependent chain overrides it to run the two chains
+    /// interleaved (on [`Pair`](super::Pair) lanes), which a caller drawing two dimensions at once gains from.
+    #[inline]
+    fn point_pair<L: Lanes>(
+        &self,
+        set: &SetShape,
+        pixel: L,
+        sample: L,
+        dims: [u32; 2],
+        k: [L; 2],
+        seed: u64,
+    ) -> [(L::F, L::F); 2] {
+        [self.point(set, pixel, sample, dims[0], k[0], seed), self.point(set, pixel, sample, dims[1], k[1], seed)]
+    }
+
     /// The hash work the points of one (pixel, sample, dim) share. Override together with
     /// [`Layout::stream_point`]; the default keeps the inputs.
     #[inline]
@@ -147,6 +164,16 @@ pub trait DynLayout: Send + Sync {
     fn point_1(&self, set: &SetShape, pixel: u32, sample: u32, dim: u32, k: u32, seed: u64) -> (f32, f32);
     /// `Layout::point` for eight lanes.
     fn point_8(&self, set: &SetShape, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8);
+    /// `Layout::point_pair` for eight lanes.
+    fn point_pair_8(
+        &self,
+        set: &SetShape,
+        pixel: U8,
+        sample: U8,
+        dims: [u32; 2],
+        k: [U8; 2],
+        seed: u64,
+    ) -> [(F8, F8); 2];
     /// `Layout::stream` for one lane.
     fn stream_1(&self, set: &SetShape, pixel: u32, sample: u32, dim: u32, seed: u64) -> StreamKey<u32>;
     /// `Layout::stream` for eight lanes.
@@ -169,6 +196,17 @@ impl<T: Layout> DynLayout for T {
     }
     fn point_8(&self, set: &SetShape, pixel: U8, sample: U8, dim: u32, k: U8, seed: u64) -> (F8, F8) {
         self.point(set, pixel, sample, dim, k, seed)
+    }
+    fn point_pair_8(
+        &self,
+        set: &SetShape,
+        pixel: U8,
+        sample: U8,
+        dims: [u32; 2],
+        k: [U8; 2],
+        seed: u64,
+    ) -> [(F8, F8); 2] {
+        self.point_pair(set, pixel, sample, dims, k, seed)
     }
     fn stream_1(&self, set: &SetShape, pixel: u32, sample: u32, dim: u32, seed: u64) -> StreamKey<u32> {
         self.stream(set, pixel, sample, dim, seed)

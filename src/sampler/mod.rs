@@ -42,7 +42,7 @@ mod slow_test;
 
 pub use grid::strata_shape;
 pub use halton::radical_inverse;
-pub use lanes::{Lanes, PointFn};
+pub use lanes::{Lanes, Pair, PointFn};
 pub use layout::{DynLayout, Layout, SetLayout, SetShape, StreamKey};
 pub use permute::{permute, permute_x8, shuffled_index_x8, ShuffleKey};
 pub use stratified::{GridTable, PathDim};
@@ -338,6 +338,18 @@ impl PointSet {
         #[cfg(test)]
         replay::count_api_call();
         self.kind.layout().point_8(&self.shape, pixel, sample, dim, k, seed)
+    }
+
+    /// [`PointSet::point_x8`] of two dimensions `dims` at indices `k`, bit for bit: one call
+    /// (`Layout::point_pair`), which a layout may run as two interleaved chains.
+    #[inline]
+    pub fn point_pair_x8(&self, pixel: U8, sample: U8, dims: [u32; 2], k: [U8; 2], seed: u64) -> [(F8, F8); 2] {
+        // (Two points: two calls in the count the replay tests compare with the log.)
+        #[cfg(test)]
+        for _ in 0..2 {
+            replay::count_api_call();
+        }
+        self.kind.layout().point_pair_8(&self.shape, pixel, sample, dims, k, seed)
     }
 
     /// The set of (pixel, sample, dim) for 8 lanes, with the hash work its points share done once:

@@ -30,8 +30,8 @@
 
 use super::divisor::Divisor;
 use super::grid::{cell_span, jittered, Grid, FIXED_ONE};
-use super::hash::{hash, mix};
-use super::lanes::Lanes;
+use super::hash::{hash, mix, stream_key};
+use super::lanes::{Lanes, Pair};
 use super::layout::{Layout, SetShape, StreamKey};
 use super::permute::permute_lanes;
 
@@ -113,6 +113,29 @@ impl Layout for MultiJitter {
     #[inline]
     fn point<L: Lanes>(&self, set: &SetShape, pixel: L, sample: L, dim: u32, k: L, seed: u64) -> (L::F, L::F) {
         keyed_point(set, hash(TAG_MULTIJITTER, seed, dim, [pixel, sample]), dim, k)
+    }
+
+    /// Both points' chains (the key's hash, the three permutations, the jitter) side by side on
+    /// [`Pair`] lanes: the same bits as two [`Layout::point`] calls.
+    #[inline]
+    fn point_pair<L: Lanes>(
+        &self,
+        set: &SetShape,
+        pixel: L,
+        sample: L,
+        dims: [u32; 2],
+        k: [L; 2],
+        seed: u64,
+    ) -> [(L::F, L::F); 2] {
+        // The camera's dimension skips the index permutation: not one chain's code for both.
+        if dims.contains(&DIM_CAMERA) {
+            let point = |i: usize| self.point(set, pixel, sample, dims[i], k[i], seed);
+            return [point(0), point(1)];
+        }
+        let [a, b] = dims.map(|d| L::splat(stream_key(TAG_MULTIJITTER, seed, d)));
+        let key = [Pair(pixel, pixel), Pair(sample, sample)].into_iter().fold(Pair(a, b), mix);
+        let (x, y) = keyed_point(set, key, dims[0], Pair(k[0], k[1]));
+        [(x.0, y.0), (x.1, y.1)]
     }
 
     #[inline]

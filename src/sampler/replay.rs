@@ -57,6 +57,9 @@ const F_TABLE: u32 = 1 << 7;
 /// On `OP_STREAM_POINT | F_TABLE`: no call, a marker that a fresh table-stream list follows (the
 /// op word alone).
 const F_TABLE_RESET: u32 = 1 << 2;
+/// On `OP_STREAM_POINT | F_TABLE`: no call, a marker that the next two `OP_PATH` points are
+/// drawn by one call (`GridTable::path_point_pair_x8`: two chains side by side).
+const F_TABLE_PAIR: u32 = 1 << 3;
 const DIM_SHIFT: u32 = 8;
 /// Dimensions from here on take a word of their own (escape: the op word's dim field is all ones).
 const DIM_WIDE: u32 = (1 << (32 - DIM_SHIFT)) - 1;
@@ -296,6 +299,21 @@ pub fn path_point(pixel: U8, sample: U8, dim: u32, light: bool) {
     }
 }
 
+/// Reports the two points of [`path_point`] (dimension and table each) for the same pixels
+/// and samples drawn by one call (`Samples::table_point_pair`).
+pub fn path_point_pair(pixel: U8, sample: U8, dims: [(u32, bool); 2]) {
+    if recording() {
+        LOG.with_borrow_mut(|l| {
+            if l.counting && l.active {
+                l.words.push(OP_STREAM_POINT | F_TABLE | F_TABLE_PAIR);
+            }
+            for (dim, light) in dims {
+                l.push(if light { OP_PATH | F_LIGHT_TABLE } else { OP_PATH }, pixel, sample, dim, None);
+            }
+        });
+    }
+}
+
 /// Reports a fresh table of light streams, `light_set.stream_x8(pixel, sample, dim, seed)` for
 /// each of `pixels` in order (stream i of the table is the i-th).
 #[inline]
@@ -483,6 +501,9 @@ impl Recording {
         let mut last_k = 0u32;
         let mut path_dims: Vec<Option<PathDim>> = Vec::new();
         let mut light_dims: Vec<Option<PathDim>> = Vec::new();
+        // After a pair marker: the pair's first point (its table, dimension, pixels, samples)
+        // waits for the second, and the two are drawn by one call.
+        let (mut pair_next, mut pair_first): (bool, Option<(bool, PathDim)>) = (false, None);
         let (mut calls, mut sum) = (0u64, 0u32);
         let sample_on = mode == ReplayMode::Sample;
         for t in &self.tiles {
@@ -498,6 +519,12 @@ impl Recording {
                         // A marker, not a call.
                         calls -= 1;
                         table_streams.clear();
+                        continue;
+                    }
+                    if op & F_TABLE != 0 && op & F_TABLE_PAIR != 0 {
+                        // A marker, not a call.
+                        calls -= 1;
+                        pair_next = sample_on;
                         continue;
                     }
                     let (si, k) = (w[i], w[i + 1]);
@@ -613,8 +640,20 @@ impl Recording {
                                 table_streams.push(TableStream { stream, light: op & F_LIGHT_TABLE != 0, d, pixel });
                                 continue;
                             }
-                            let (x, y) = table.path_point_x8(&d, pixel, sample);
-                            fold(sum, x.to_bits() ^ y.to_bits())
+                            let light = op & F_LIGHT_TABLE != 0;
+                            if std::mem::take(&mut pair_next) {
+                                pair_first = Some((light, d));
+                                continue;
+                            }
+                            if let Some((first_light, first)) = pair_first.take() {
+                                let t = |l: bool| if l { &sets.light_table } else { &sets.path };
+                                let [(x0, y0), (x1, y1)] =
+                                    t(first_light).path_point_pair_x8(&first, t(light), &d, pixel, sample);
+                                fold(fold(sum, x0.to_bits() ^ y0.to_bits()), x1.to_bits() ^ y1.to_bits())
+                            } else {
+                                let (x, y) = table.path_point_x8(&d, pixel, sample);
+                                fold(sum, x.to_bits() ^ y.to_bits())
+                            }
                         } else {
                             fold(sum, std::hint::black_box(pixel ^ sample ^ U8::splat(dim)))
                         };

@@ -272,6 +272,24 @@ impl GridTable {
         (!self.grid).then(|| self.set.stream_x8(pixel, U8::splat(0), d.dim, d.seed))
     }
 
+    /// [`GridTable::path_point_x8`] of `d` here and of `e` in table `other` for the same pixel
+    /// samples `s`, bit for bit: where both tables draw from one set of a layout that is not a
+    /// grid, in one [`PointSet::point_pair_x8`] call (two chains interleaved); else two calls.
+    #[inline(always)]
+    pub fn path_point_pair_x8(&self, d: &PathDim, other: &GridTable, e: &PathDim, pixel: U8, s: U8) -> [(F8, F8); 2] {
+        let (a, b) = (&self.set, &other.set);
+        let shared = !self.grid
+            && !other.grid
+            && a.kind() == b.kind()
+            && a.n() == b.n()
+            && a.shape().width() == b.shape().width()
+            && d.seed == e.seed;
+        if shared {
+            return a.point_pair_x8(pixel, U8::splat(0), [d.dim, e.dim], [s, s], d.seed);
+        }
+        [self.path_point_x8(d, pixel, s), other.path_point_x8(e, pixel, s)]
+    }
+
     /// The path tracer's point of dimension `d` for pixel samples `s`: for grid layouts bit for
     /// bit `point_x8(pixel, 0, dim, shuffled_index_x8(s, spp, pixel, dim, seed), seed)` (strata
     /// shuffled per (pixel, dim): padded stratified sampling), for the others (sequences, which

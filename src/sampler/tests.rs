@@ -229,6 +229,56 @@ fn path_points_with_hoisted_dimensions_equal_the_per_call_form() {
     }
 }
 
+/// Two dimensions drawn by one call (`PointSet::point_pair_x8`, whose `multijitter` runs the two
+/// chains interleaved on `Pair` lanes) equal two `point_x8` calls bit for bit, for every layout
+/// and set size, with the camera's dimension (which skips `multijitter`'s index permutation) on
+/// either side, equal dimensions, and indices at and beyond n; and the path tracer's pair across
+/// two tables (`GridTable::path_point_pair_x8`) equals its two points, whether the tables share a
+/// set (one call) or not (two).
+#[test]
+fn point_pairs_equal_two_points_bit_for_bit() {
+    let bits = |p: (F8, F8)| (p.0.to_array().map(f32::to_bits), p.1.to_array().map(f32::to_bits));
+    let mut st = 41u64;
+    for n in interesting_n() {
+        for kind in SamplerKind::ALL {
+            let set = PointSet::new(kind, n);
+            for dims in [[3, 4], [0, 7], [9, 0], [5, 5], [u32::MAX, 1]] {
+                let seed = u64::from(lcg(&mut st)) << 32 | u64::from(lcg(&mut st));
+                let pixel = u8_from(|_| lcg(&mut st) % 100_000);
+                let sample = u8_from(|l| if l == 6 { u32::MAX } else { lcg(&mut st) % 64 });
+                let k: [U8; 2] = std::array::from_fn(|_| {
+                    u8_from(|l| match l {
+                        5 => u32::MAX,
+                        4 => n.wrapping_add(3),
+                        _ => lcg(&mut st) % n.max(1),
+                    })
+                });
+                let pair = set.point_pair_x8(pixel, sample, dims, k, seed);
+                for j in 0..2 {
+                    let one = set.point_x8(pixel, sample, dims[j], k[j], seed);
+                    assert_eq!(bits(pair[j]), bits(one), "{kind:?} n={n} dims {dims:?} point {j}");
+                }
+            }
+        }
+        for (a, b, nb) in [
+            (SamplerKind::MULTIJITTER, SamplerKind::MULTIJITTER, n),
+            (SamplerKind::MULTIJITTER, SamplerKind::MULTIJITTER, n / 2 + 1),
+            (SamplerKind::SOBOL, SamplerKind::MULTIJITTER, n),
+            (SamplerKind::STRATIFIED, SamplerKind::STRATIFIED, n),
+        ] {
+            let (ta, tb) = (GridTable::new(PointSet::new(a, n)), GridTable::new(PointSet::new(b, nb)));
+            let seed = u64::from(lcg(&mut st)) << 32 | u64::from(lcg(&mut st));
+            let spp = n.max(1);
+            let (d, e) = (ta.path_dim(spp, 64, seed), tb.path_dim(spp, 66, seed));
+            let pixel = u8_from(|_| lcg(&mut st) % 100_000);
+            let s = u8_from(|l| if l == 7 { u32::MAX } else { lcg(&mut st) % spp });
+            let [p, q] = ta.path_point_pair_x8(&d, &tb, &e, pixel, s);
+            assert_eq!(bits(p), bits(ta.path_point_x8(&d, pixel, s)), "{a:?} {b:?} n={n}");
+            assert_eq!(bits(q), bits(tb.path_point_x8(&e, pixel, s)), "{a:?} {b:?} n={n}");
+        }
+    }
+}
+
 /// Unbiasedness of shuffled strata needs, for a fixed sample index, the strata two dimensions
 /// give it to be jointly uniform over pixels (keys): chi-square of the (dim a, dim b) stratum
 /// pairs over 20000 pixel keys, derived as the path tracer derives them, for every sample

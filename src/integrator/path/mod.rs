@@ -469,13 +469,24 @@ impl Bounce<'_> {
         if delta_here {
             self.delta_next_events::<L>(vx, &at, from, shade);
         }
-        if nee_here && n_lights > 0 {
+        let nee_lights = nee_here && n_lights > 0;
+        // The light point and the bounce's direction, drawn by one call where both are used (the
+        // layout may run the two points' chains side by side; the same bits either way).
+        let (light_uw, bounce_u2) = if nee_lights && bounce_here {
+            let [a, b] =
+                self.smp.table_point_pair((&self.dk[0], true), (&self.dk[2], false), Phase::SamplerPath, pixel, s);
+            (Some(a), Some(b))
+        } else {
+            (None, None)
+        };
+        if nee_lights {
             let u_choice = if own_choice {
                 self.smp.table_point(&self.dk[1], true, Phase::SamplerPath, pixel, s).0
             } else {
                 F8::ZERO
             };
-            let (u, w) = self.smp.table_point(&self.dk[0], true, Phase::SamplerPath, pixel, s);
+            let (u, w) =
+                light_uw.unwrap_or_else(|| self.smp.table_point(&self.dk[0], true, Phase::SamplerPath, pixel, s));
             let shadow = &mut *self.shadow;
             let mut push = |ls: &LightSample8, scale: Option<F8>, mis_n: Option<F8>, ok: Mask8| {
                 let (y, l_rad, area, inv_pmf) = (ls.y, ls.radiance, ls.area, ls.inv_pmf);
@@ -571,7 +582,8 @@ impl Bounce<'_> {
             } else {
                 (F8::ZERO, F8::ZERO)
             };
-            let u2 = self.smp.table_point(&self.dk[2], false, Phase::SamplerPath, pixel, s);
+            let u2 =
+                bounce_u2.unwrap_or_else(|| self.smp.table_point(&self.dk[2], false, Phase::SamplerPath, pixel, s));
             let sampled = {
                 let _p = crate::profile::leaf(crate::profile::Phase::BsdfSample);
                 mat.sample_bsdf_k::<L>(it.path.strategy, wo, [u2.0, u2.1], u_lobe, shade)
