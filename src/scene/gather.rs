@@ -149,8 +149,11 @@ impl Scene {
         let same = F8::from_bits(hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES)) & hits.prim.simd_eq(U8::splat(first)));
         let one_triangle =
             !INST && same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
+        let all_triangles = !INST && same_geom(hits.geom, GEOM_TRIANGLES, bits);
         let Lanes8 { n, light, le, any_tri, mat } = if one_triangle {
             self.one_triangle(first as usize, valid)
+        } else if all_triangles {
+            self.distinct_triangles(bits, hits.prim, dir)
         } else {
             self.lane_by_lane::<INST>(bits, [geom, prim, hits.inst.as_array()], p, dir)
         };
@@ -237,6 +240,35 @@ impl Scene {
             any_tri: true,
             mat: [self.tri_material[t]; 8],
         }
+    }
+
+    /// [`Scene::lane_by_lane`]'s fields where every hit lane (`bits`) hit a triangle (primitive
+    /// ids `prim`): one pass of 8-wide selects per distinct triangle of the packet, where the
+    /// lane loop's scalar stores into arrays, read back as vectors, stalled on store forwarding.
+    /// The same values (a light's facing test in the scalar dot product's operation order).
+    #[inline]
+    fn distinct_triangles(&self, bits: u32, prim: U8, dir: Vec3x8) -> Lanes8 {
+        let (mut n, mut light, mut le, mut mat) = (Z8, U8::splat(INVALID_ID), Vec3x8::ZERO, U8::splat(0));
+        let ids = prim.to_array();
+        let mut rest = bits;
+        while rest != 0 {
+            let t = ids[rest.trailing_zeros() as usize];
+            let on_u = prim.simd_eq(U8::splat(t)) & lanes_mask(rest);
+            let on = F8::from_bits(on_u);
+            rest &= !on.to_bitmask();
+            let t = t as usize;
+            n = Vec3x8::select(on, Vec3x8::splat(self.tri_normal[t]), n);
+            mat = on_u.select(U8::splat(self.tri_material[t]), mat);
+            let l = self.tri_light[t];
+            if l != INVALID_ID {
+                light = on_u.select(U8::splat(l), light);
+                let q = &self.emitters.list[l as usize];
+                let s = |v: f32| F8::splat(v);
+                let facing = (s(q.normal.x) * dir.x + s(q.normal.y) * dir.y) + s(q.normal.z) * dir.z;
+                le = Vec3x8::select(on & facing.simd_lt(F8::ZERO), Vec3x8::splat(q.radiance), le);
+            }
+        }
+        Lanes8 { n, light, le, any_tri: true, mat: mat.to_array() }
     }
 
     /// The per-lane fields of the hit lanes `bits`, one table lookup per lane: normal, material
@@ -426,6 +458,19 @@ struct Lanes8 {
     any_tri: bool,
     /// material index per lane (0 on misses)
     mat: [u32; 8],
+}
+
+/// Every lane of `bits` has geometry id `geom` in `ids`.
+#[inline]
+fn same_geom(ids: U8, geom: u32, bits: u32) -> bool {
+    F8::from_bits(ids.simd_eq(U8::splat(geom))).to_bitmask() & bits == bits
+}
+
+/// All ones on the lanes of `bits`, zero elsewhere.
+#[inline]
+fn lanes_mask(bits: u32) -> U8 {
+    let iota = U8::new([1, 2, 4, 8, 16, 32, 64, 128]);
+    (U8::splat(bits) & iota).simd_eq(iota)
 }
 
 /// Eight vectors as three coordinate arrays, filled lane by lane (no AoS -> SoA transpose).
