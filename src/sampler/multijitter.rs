@@ -60,7 +60,7 @@ pub(super) const INFO: super::SamplerInfo = super::SamplerInfo::new(
 /// The fixed-point span of fine cell `c` of the n-cell axis: by shifts when n is a power of two
 /// (the common spp; bit-identical to `grid::cell_span`, whose cells are then exact), else by
 /// `grid::cell_span`'s long division.
-#[inline]
+#[inline(always)]
 fn fine_span<L: Lanes>(c: L, n: Divisor) -> (L, L) {
     let d = n.d;
     if d.is_power_of_two() && d <= FIXED_ONE {
