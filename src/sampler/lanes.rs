@@ -253,11 +253,14 @@ impl Lanes for U8 {
 #[derive(Clone, Copy, Debug)]
 pub struct Pair<L>(pub L, pub L);
 
-impl<L: Lanes> Pair<L> {
-    #[inline(always)]
-    fn both(self, o: Self, f: impl Fn(L, L) -> L) -> Self {
-        Pair(f(self.0, o.0), f(self.1, o.1))
-    }
+/// `Lanes` methods of one other operand, applied half by half.
+macro_rules! halves {
+    ($($op:ident),*) => {$(
+        #[inline(always)]
+        fn $op(self, o: Self) -> Self {
+            Pair(self.0.$op(o.0), self.1.$op(o.1))
+        }
+    )*};
 }
 
 impl<L: Lanes> Lanes for Pair<L> {
@@ -266,30 +269,7 @@ impl<L: Lanes> Lanes for Pair<L> {
     fn splat(x: u32) -> Self {
         Pair(L::splat(x), L::splat(x))
     }
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        self.both(o, L::add)
-    }
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        self.both(o, L::sub)
-    }
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        self.both(o, L::mul)
-    }
-    #[inline(always)]
-    fn xor(self, o: Self) -> Self {
-        self.both(o, L::xor)
-    }
-    #[inline(always)]
-    fn or(self, o: Self) -> Self {
-        self.both(o, L::or)
-    }
-    #[inline(always)]
-    fn and(self, o: Self) -> Self {
-        self.both(o, L::and)
-    }
+    halves!(add, sub, mul, xor, or, and, mulhi, lt_mask, shr_var);
     #[inline(always)]
     fn shr(self, s: u32) -> Self {
         Pair(self.0.shr(s), self.1.shr(s))
@@ -316,20 +296,8 @@ impl<L: Lanes> Lanes for Pair<L> {
         Pair(self.0.map(&f), self.1.map(&f))
     }
     #[inline(always)]
-    fn mulhi(self, o: Self) -> Self {
-        self.both(o, L::mulhi)
-    }
-    #[inline(always)]
-    fn lt_mask(self, o: Self) -> Self {
-        self.both(o, L::lt_mask)
-    }
-    #[inline(always)]
     fn sign_mask(self) -> Self {
         Pair(self.0.sign_mask(), self.1.sign_mask())
-    }
-    #[inline(always)]
-    fn shr_var(self, s: Self) -> Self {
-        self.both(s, L::shr_var)
     }
     #[inline(always)]
     fn lookup8(self, table: [u32; 8]) -> Self {
