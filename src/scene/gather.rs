@@ -146,14 +146,16 @@ impl Scene {
         }
         let (geom, prim) = (hits.geom.as_array(), hits.prim.as_array());
         let first = prim[bits.trailing_zeros() as usize];
-        let same = F8::from_bits(hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES)) & hits.prim.simd_eq(U8::splat(first)));
-        let one_triangle =
-            !INST && same.to_bitmask() & bits == bits && self.tri_light.get(first as usize) == Some(&INVALID_ID);
-        let all_triangles = !INST && same_geom(hits.geom, GEOM_TRIANGLES, bits);
+        let tri = hits.geom.simd_eq(U8::splat(GEOM_TRIANGLES));
+        let all_of = |m: U8| F8::from_bits(m).to_bitmask() & bits == bits;
+        let all_triangles = !INST && all_of(tri);
+        let one_triangle = all_triangles
+            && all_of(hits.prim.simd_eq(U8::splat(first)))
+            && self.tri_light.get(first as usize) == Some(&INVALID_ID);
         let Lanes8 { n, light, le, any_tri, mat } = if one_triangle {
             self.one_triangle(first as usize, valid)
         } else if all_triangles {
-            self.distinct_triangles(bits, hits.prim, dir)
+            self.distinct_triangles(valid, hits.prim, dir)
         } else {
             self.lane_by_lane::<INST>(bits, [geom, prim, hits.inst.as_array()], p, dir)
         };
@@ -165,7 +167,7 @@ impl Scene {
         if one_triangle {
             self.uniform_materials(mat[0], valid, out);
         } else {
-            self.gather_materials(bits, valid, &mat, out);
+            self.gather_materials(valid, &mat, out);
         }
         if self.registry_bsdfs {
             out.material = U8::new(mat);
@@ -247,15 +249,10 @@ impl Scene {
     /// lane loop's scalar stores into arrays, read back as vectors, stalled on store forwarding.
     /// The same values (a light's facing test in the scalar dot product's operation order).
     #[inline]
-    fn distinct_triangles(&self, bits: u32, prim: U8, dir: Vec3x8) -> Lanes8 {
+    fn distinct_triangles(&self, valid: Mask8, prim: U8, dir: Vec3x8) -> Lanes8 {
         let (mut n, mut light, mut le, mut mat) = (Z8, U8::splat(INVALID_ID), Vec3x8::ZERO, U8::splat(0));
-        let ids = prim.to_array();
-        let mut rest = bits;
-        while rest != 0 {
-            let t = ids[rest.trailing_zeros() as usize];
-            let on_u = prim.simd_eq(U8::splat(t)) & lanes_mask(rest);
-            let on = F8::from_bits(on_u);
-            rest &= !on.to_bitmask();
+        for (t, on) in distinct_ids(prim, valid) {
+            let on_u: U8 = wide::bytemuck::cast(on);
             let t = t as usize;
             n = Vec3x8::select(on, Vec3x8::splat(self.tri_normal[t]), n);
             mat = on_u.select(U8::splat(self.tri_material[t]), mat);
@@ -404,7 +401,7 @@ impl Scene {
     /// the miss record's on the other lanes: one pass of 8-wide selects per distinct material of
     /// the packet (a per-lane copy of every field cost twice the instructions: callgrind,
     /// cornell-diffuse, 84.2 M -> 38.4 M).
-    fn gather_materials(&self, bits: u32, valid: Mask8, mat: &[u32; 8], out: &mut SurfaceHit8) {
+    fn gather_materials(&self, valid: Mask8, mat: &[u32; 8], out: &mut SurfaceHit8) {
         // A packet holds a few distinct materials (often one): each one's lanes take its fields,
         // splatted.
         let z = &MISS_MATERIAL;
@@ -413,11 +410,7 @@ impl Scene {
         let (mut kd, mut ks, mut emitted, mut ambient) =
             (Vec3x8::splat(z.diffuse), Vec3x8::splat(z.specular), Vec3x8::splat(z.emission), Vec3x8::splat(z.ambient));
         let (mut shin, mut rough, mut ggx) = (F8::splat(z.shininess), F8::splat(z.roughness), F8::ZERO);
-        let mut rest = bits;
-        while rest != 0 {
-            let m0 = mat[rest.trailing_zeros() as usize];
-            let same = valid & F8::from_bits(ids.simd_eq(U8::splat(m0)));
-            rest &= !same.to_bitmask();
+        for (m0, same) in distinct_ids(ids, valid) {
             let m = &self.materials[m0 as usize];
             kd = Vec3x8::select(same, Vec3x8::splat(m.diffuse), kd);
             ks = Vec3x8::select(same, Vec3x8::splat(m.specular), ks);
@@ -460,17 +453,21 @@ struct Lanes8 {
     mat: [u32; 8],
 }
 
-/// Every lane of `bits` has geometry id `geom` in `ids`.
-#[inline]
-fn same_geom(ids: U8, geom: u32, bits: u32) -> bool {
-    F8::from_bits(ids.simd_eq(U8::splat(geom))).to_bitmask() & bits == bits
-}
-
-/// All ones on the lanes of `bits`, zero elsewhere.
-#[inline]
-fn lanes_mask(bits: u32) -> U8 {
-    let iota = U8::new([1, 2, 4, 8, 16, 32, 64, 128]);
-    (U8::splat(bits) & iota).simd_eq(iota)
+/// The distinct values of `ids` on the lanes of `live`, in the order of their first lane, each
+/// with its lanes among `live` as a mask: a packet's few distinct materials or triangles, each
+/// taken in one pass of 8-wide selects.
+#[inline(always)]
+fn distinct_ids(ids: U8, live: Mask8) -> impl Iterator<Item = (u32, Mask8)> {
+    let values = ids.to_array();
+    let mut rest = live.to_bitmask();
+    std::iter::from_fn(move || {
+        (rest != 0).then(|| {
+            let id = values[rest.trailing_zeros() as usize];
+            let on = live & F8::from_bits(ids.simd_eq(U8::splat(id)));
+            rest &= !on.to_bitmask();
+            (id, on)
+        })
+    })
 }
 
 /// Eight vectors as three coordinate arrays, filled lane by lane (no AoS -> SoA transpose).

@@ -77,7 +77,7 @@ fn one_triangle_packets_match_the_lane_by_lane_gather() {
         }
         let (mut a, mut c) = (SurfaceHit8::MISS, SurfaceHit8::MISS);
         sc.uniform_materials(fast.mat[0], valid, &mut a);
-        sc.gather_materials(b, valid, &slow.mat, &mut c);
+        sc.gather_materials(valid, &slow.mat, &mut c);
         same_record(&a, &c);
     }
     // Packets the splat path must not take still gather per lane: a light triangle, two
@@ -121,7 +121,7 @@ fn mixed_material_packets_take_each_lanes_material() {
             let valid = mask_from_bools(hit);
             let mut out = SurfaceHit8::MISS;
             out.mat.kd = Vec3x8::splat(Vec3::ONE); // stale contents of a reused buffer
-            sc.gather_materials(valid.to_bitmask(), valid, &mat, &mut out);
+            sc.gather_materials(valid, &mat, &mut out);
             for i in 0..8 {
                 let m = if hit[i] { &sc.materials[mat[i] as usize] } else { &MISS_MATERIAL };
                 let o = &out.mat;
@@ -176,7 +176,7 @@ fn distinct_triangle_packets_match_the_lane_by_lane_gather() {
             for d in [dir, up, mixed] {
                 let b = mask_from_bools(hit).to_bitmask();
                 let p = Vec3x8::splat(Vec3::new(0.1, 0.0, 0.2));
-                let fast = sc.distinct_triangles(b, U8::new(prim), d);
+                let fast = sc.distinct_triangles(mask_from_bools(hit), U8::new(prim), d);
                 let slow = sc.lane_by_lane::<false>(b, [&[GEOM_TRIANGLES; 8], &prim, &[INVALID_ID; 8]], p, d);
                 assert_eq!(bits(fast.n), bits(slow.n), "{prim:?} {hit:?}");
                 assert_eq!(fast.light.to_array(), slow.light.to_array(), "{prim:?} {hit:?}");
@@ -187,6 +187,6 @@ fn distinct_triangle_packets_match_the_lane_by_lane_gather() {
         }
     }
     // Some lane of the patterns saw the light's emission (the test reaches that branch).
-    let lit = sc.distinct_triangles(0xff, U8::new(patterns[1]), up);
+    let lit = sc.distinct_triangles(mask_from_bools([true; 8]), U8::new(patterns[1]), up);
     assert!(lit.le.max_elem().to_array().iter().any(|&v| v > 0.0));
 }
