@@ -1,6 +1,6 @@
 //! The path wavefront's structure-of-arrays lanes: columns of 32-bit lanes (f32, or u32 by bits)
 //! in packets of 8, appended a packet at a time by left-packing the lanes of a mask (one lane
-//! permute per column) at a running offset. Live paths and shadow rays so stay in packets from
+//! permute and one store per column) at a running offset. Live paths and shadow rays so stay in packets from
 //! one bounce to the next, with no per-lane copies.
 
 use crate::simd::{Mask8, Vec3x8, F8, U8};
@@ -54,22 +54,24 @@ fn permute(v: F8, idx: U8) -> F8 {
     bytemuck::cast(crate::simd::permute_lanes(bytemuck::cast(v), idx))
 }
 
-/// `K` columns of lanes in packets of 8, stored packet by packet (the K columns of a packet are
-/// adjacent, so one packet's state is one bounds check and a few cache lines). Lanes past `len` up
-/// to the packet boundary hold whatever the last append left there (see [`Columns::fill_tail`]).
+/// `K` columns of lanes in packets of 8, each column one run of lanes (column `c`'s packet `p` is
+/// `lanes[c * cap + p]`). An append stores the left-packed lanes of a packet whole, unaligned, at
+/// the column's running length: the lanes past the kept ones land beyond `len`, where the next
+/// append (or [`Columns::fill_tail`]) overwrites them, so no lane below `len` is ever blended or
+/// rewritten. (Packet-by-packet rows needed a blend into the last packet, which LLVM turns into
+/// masked stores, microcoded on AMD: 30 % of the path tracer's shading time.)
 pub(super) struct Columns<const K: usize> {
-    rows: Vec<[F8; K]>,
+    lanes: Vec<F8>,
+    /// packets per column
+    cap: usize,
     len: usize,
 }
 
 impl<const K: usize> Default for Columns<K> {
     fn default() -> Self {
-        Self { rows: Vec::new(), len: 0 }
+        Self { lanes: Vec::new(), cap: 0, len: 0 }
     }
 }
-
-/// Lane indices 0..8.
-const IOTA: [u32; 8] = [0, 1, 2, 3, 4, 5, 6, 7];
 
 impl<const K: usize> Columns<K> {
     /// No lanes (buffers kept).
@@ -101,60 +103,59 @@ impl<const K: usize> Columns<K> {
         self.grow(n + 1);
     }
 
-    /// Makes room for at least `packets` packets.
+    /// Makes room for at least `packets` packets per column, keeping every column's packets.
     #[cold]
     fn grow(&mut self, packets: usize) {
-        if self.rows.len() < packets {
-            let to = packets.max(2 * self.rows.len()).max(64);
-            self.rows.resize(to, [F8::ZERO; K]);
+        if self.cap < packets {
+            let cap = packets.max(2 * self.cap).max(64);
+            let mut lanes = vec![F8::ZERO; K * cap];
+            if self.cap > 0 {
+                for (to, from) in lanes.chunks_exact_mut(cap).zip(self.lanes.chunks_exact(self.cap)) {
+                    to[..self.cap].copy_from_slice(from);
+                }
+            }
+            self.lanes = lanes;
+            self.cap = cap;
         }
     }
 
     /// Writes packet `p` of column `c` (p below [`Columns::packets`]).
     #[inline]
     pub(super) fn set(&mut self, c: usize, p: usize, v: F8) {
-        self.rows[p][c] = v;
+        self.lanes[c * self.cap + p] = v;
     }
 
     /// Packet `p` of column `c`.
     #[inline]
     pub(super) fn get(&self, c: usize, p: usize) -> F8 {
-        self.rows[p][c]
+        self.lanes[c * self.cap + p]
     }
 
     /// Packet `p` of column `c` as u32 lanes.
     #[inline]
     pub(super) fn get_u(&self, c: usize, p: usize) -> U8 {
-        bytemuck::cast(self.rows[p][c])
+        bytemuck::cast(self.get(c, p))
     }
 
     /// Packet `p` of columns `c..c + 3` as vectors.
     #[inline]
     pub(super) fn get3(&self, c: usize, p: usize) -> Vec3x8 {
-        let r = &self.rows[p];
-        Vec3x8::new(r[c], r[c + 1], r[c + 2])
+        Vec3x8::new(self.get(c, p), self.get(c + 1, p), self.get(c + 2, p))
     }
 
     /// Appends the lanes `pack` keeps of `vals` to the columns `first..first + M` at the end;
     /// [`Columns::advance`] then counts them (so several calls can fill one row of columns).
-    /// The kept lanes land at lanes `l..` of the last packet (l = len % 8) and spill into lanes
-    /// `..l` of the next: one permute rotated by l per column, a blend into the last packet, and
-    /// a whole-packet store into the next (it holds no lane below `len`).
+    /// Per column one permute and one whole-packet store at lane `len` (it spills past the kept
+    /// lanes, never below `len`).
     #[inline(always)]
     pub(super) fn write<const M: usize>(&mut self, first: usize, pack: &Pack, vals: &[F8; M]) {
-        let (q, l) = (self.len / 8, (self.len % 8) as u32);
-        if self.rows.len() < q + 2 {
-            self.grow(q + 2);
+        if self.cap < self.len / 8 + 2 {
+            self.grow(self.len / 8 + 2);
         }
-        let iota = U8::new(IOTA);
-        let idx = crate::simd::permute_lanes(pack.idx, (iota + U8::splat(8 - l)) & U8::splat(7));
-        let below: Mask8 = bytemuck::cast(iota.simd_lt(U8::splat(l)));
-        if let [a, b, ..] = &mut self.rows[q..] {
-            for (j, v) in vals.iter().enumerate() {
-                let v = permute(*v, idx);
-                a[first + j] = below.select(a[first + j], v);
-                b[first + j] = v;
-            }
+        let (cap, len) = (8 * self.cap, self.len);
+        let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut self.lanes);
+        for (col, v) in flat.chunks_exact_mut(cap).skip(first).zip(vals) {
+            col[len..len + 8].copy_from_slice(permute(*v, pack.idx).as_array());
         }
     }
 
@@ -169,7 +170,7 @@ impl<const K: usize> Columns<K> {
         let p = self.len / 8;
         if !self.len.is_multiple_of(8) {
             let keep = crate::simd::mask_first(self.len % 8);
-            self.rows[p][c] = keep.select(self.rows[p][c], v);
+            self.set(c, p, keep.select(self.get(c, p), v));
         }
     }
 }
