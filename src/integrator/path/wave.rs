@@ -154,8 +154,9 @@ impl<const K: usize> Columns<K> {
         }
         let (cap, len) = (8 * self.cap, self.len);
         let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut self.lanes);
-        for (col, v) in flat.chunks_exact_mut(cap).skip(first).zip(vals) {
-            col[len..len + 8].copy_from_slice(permute(*v, pack.idx).as_array());
+        for (j, v) in vals.iter().enumerate() {
+            let at = (first + j) * cap + len;
+            flat[at..at + 8].copy_from_slice(permute(*v, pack.idx).as_array());
         }
     }
 
