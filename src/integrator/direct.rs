@@ -125,9 +125,9 @@ enum Group<'a> {
 }
 
 impl Group<'_> {
-    /// A point on the group's light(s) for the unit-square sample `uv` at the hits `sh`, and
-    /// the `active` lanes that got one. Inlined always: the caller's locals receive the 448-byte
-    /// result in place (a call copied it out).
+    /// A point on the group's light(s) for the unit-square sample `uv` at the hits `sh`, written
+    /// into `ls` (in place: a returned 448-byte sample was copied out); returns the `active`
+    /// lanes that got one.
     #[inline(always)]
     fn sample(
         self,
@@ -136,20 +136,21 @@ impl Group<'_> {
         sh: &SurfaceHit8,
         uv: (F8, F8),
         active: Mask8,
-    ) -> (LightSample8, Mask8) {
+        ls: &mut LightSample8,
+    ) -> Mask8 {
         match self {
             Group::Quad(e) => {
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                let mut ls = e.sample_x8(uv.0, uv.1);
-                e.warp_x8(it.light_warp, &mut ls, sh.p, active);
-                (ls, active)
+                *ls = e.sample_x8(uv.0, uv.1);
+                e.warp_x8(it.light_warp, ls, sh.p, active);
+                active
             }
             // The triangle chosen by power from u, u remapped within its interval (`reuse`).
             Group::Triangles => {
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
-                let (mut ls, ok) = it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, uv);
-                scene.emitters.warp_x8(it.light_warp, &mut ls, sh.p, ok);
-                (ls, ok)
+                let ok = it.triangle_sampler.sample_point_reuse_x8(&scene.emitters, sh.p, sh.n, active, uv, ls);
+                scene.emitters.warp_x8(it.light_warp, ls, sh.p, ok);
+                ok
             }
         }
     }
@@ -277,8 +278,9 @@ fn shade_all<L: LobeSet>(
                     table.point(smp, pks[i].pixel, k)
                 }
             };
-            let sample =
-                |sh: &SurfaceHit8, shade: Mask8, _: usize, _: u32, uv: (F8, F8)| group.sample(it, scene, sh, uv, shade);
+            let sample = |sh: &SurfaceHit8, shade: Mask8, _: usize, _: u32, uv: (F8, F8), ls: &mut LightSample8| {
+                group.sample(it, scene, sh, uv, shade, ls)
+            };
             // f cos_i cos_l / d^2: a quad's sum is scaled once below; the triangles' terms are
             // complete.
             let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| match group {
@@ -387,7 +389,7 @@ fn shade_one<L: LobeSet>(
                 table.point(smp, pks[i].pixel, k)
             }
         };
-        let sample = |sh: &SurfaceHit8, shade: Mask8, i: usize, j: u32, uv: (F8, F8)| {
+        let sample = |sh: &SurfaceHit8, shade: Mask8, i: usize, j: u32, uv: (F8, F8), ls: &mut LightSample8| {
             let choice = if one_light {
                 AreaChoice::Certain
             } else if own_choice {
@@ -400,7 +402,7 @@ fn shade_one<L: LobeSet>(
             } else {
                 AreaChoice::Reuse
             };
-            area_sample(it, scene, sh, shade, choice, uv)
+            area_sample(it, scene, sh, shade, choice, uv, ls)
         };
         let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| {
             let g = g * ls.area * ls.inv_pmf * inv_n;
@@ -412,7 +414,7 @@ fn shade_one<L: LobeSet>(
 
 /// Light sample k of every shading packet of the tile: its unit-square point (`point(packet,
 /// shading packet)`), a light point from it (`sample(hits, shading lanes, packet, shading packet,
-/// point)`), the light term ([`towards`], the BSDF value) and what it adds if the shadow ray is
+/// point, sample to fill)` returning the lanes that got one), the light term ([`towards`], the BSDF value) and what it adds if the shadow ray is
 /// clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`, f times the sample's MIS weight
 /// against the BSDF samples when `mis` is given), traced as one batch into `target`.
 #[allow(clippy::too_many_arguments)]
@@ -424,7 +426,7 @@ fn sample_batch<L: LobeSet>(
     lanes: &Lanes,
     batch: &mut Batch,
     mut point: impl FnMut(usize, u32) -> (F8, F8),
-    mut sample: impl FnMut(&SurfaceHit8, Mask8, usize, u32, (F8, F8)) -> (LightSample8, Mask8),
+    mut sample: impl FnMut(&SurfaceHit8, Mask8, usize, u32, (F8, F8), &mut LightSample8) -> Mask8,
     weigh: impl Fn(&LightSample8, Vec3x8, F8, Mask8) -> Vec3x8,
     target: &mut [Vec3x8],
     mis: Option<Mis>,
@@ -432,14 +434,14 @@ fn sample_batch<L: LobeSet>(
     batch.clear();
     // Per shading packet: the point, the light point, the light term and the shadow packet, in
     // one pass (the sampler and emitter calls are leaf spans).
-    let mut j = 0;
+    let (mut j, mut ls) = (0, LightSample8::ZERO);
     for (i, sh) in hits.iter().enumerate() {
         let shade = lanes.shade[i];
         if shade.none() {
             continue;
         }
         let uv = point(i, j);
-        let (ls, ok) = sample(sh, shade, i, j, uv);
+        let ok = sample(sh, shade, i, j, uv, &mut ls);
         j += 1;
         if let Some((contrib, ray)) = light_event::<L>(scene, sh, lanes.eps[i], &ls, ok, &weigh, mis) {
             batch.contrib.push(contrib);

@@ -118,6 +118,7 @@ impl<L: LobeSet> EachPacket for Each<'_, L> {
         let TileCtx { scene, pks, samples: smp, .. } = ctx;
         let eps = scene.offset_eps(sh.p);
         let n = it.light_set.n() as usize;
+        let mut ls = LightSample8::ZERO;
         for k in 0..n {
             let uv = self.buf.uv[i * n + k];
             let choice = if c.one_light {
@@ -127,7 +128,7 @@ impl<L: LobeSet> EachPacket for Each<'_, L> {
             } else {
                 AreaChoice::Reuse
             };
-            let (ls, ok) = area_sample(it, scene, sh, shade, choice, uv);
+            let ok = area_sample(it, scene, sh, shade, choice, uv, &mut ls);
             let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| {
                 let g = g * ls.area * ls.inv_pmf * c.inv_n;
                 masked(f.mul_elem(ls.radiance).scale(g), lit)

@@ -185,6 +185,19 @@ pub struct LightSample8 {
     pub uv: (F8, F8),
 }
 
+impl LightSample8 {
+    /// A sample of nothing (zero everywhere): a buffer for the calls that fill one in place.
+    pub const ZERO: Self = Self {
+        y: Vec3x8::ZERO,
+        normal: Vec3x8::ZERO,
+        radiance: Vec3x8::ZERO,
+        area: F8::ZERO,
+        inv_pmf: F8::ZERO,
+        light: U8::ZERO,
+        uv: (F8::ZERO, F8::ZERO),
+    };
+}
+
 /// The scene's area lights.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Emitters {
@@ -287,18 +300,29 @@ impl Emitters {
     }
 
     /// The points `(u, v)` on lights `idx` (per lane), carrying `inv_pmf`.
+    #[cfg(test)]
     pub(crate) fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
+        let mut ls = LightSample8::ZERO;
+        self.place_into_x8(idx, inv_pmf, u, v, &mut ls);
+        ls
+    }
+
+    /// [`Emitters::place_x8`] written into `out` (each branch's call writes it in place; a
+    /// returned sample was copied out with `memcpy`).
+    #[inline]
+    pub(crate) fn place_into_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8, out: &mut LightSample8) {
         let ids = idx.to_array();
         if ids.iter().all(|&i| i == ids[0]) {
             // One light on every lane (one light in the scene, or a coherent choice): its fields
             // splatted, the same values the per-lane gather below makes.
-            return self.place_one_x8(ids[0], inv_pmf, u, v);
+            *out = self.place_one_x8(ids[0], inv_pmf, u, v);
+        } else {
+            self.place_lanes_x8(idx, inv_pmf, u, v, out);
         }
-        self.place_lanes_x8(idx, inv_pmf, u, v)
     }
 
-    /// [`Emitters::place_x8`], each lane's light gathered on its own.
-    fn place_lanes_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
+    /// [`Emitters::place_into_x8`], each lane's light gathered on its own.
+    fn place_lanes_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8, out: &mut LightSample8) {
         let es = idx.to_array().map(|i| &self.list[i as usize]);
         let la = Vec3x8::from_lanes(es.map(|e| e.a));
         let lab = Vec3x8::from_lanes(es.map(|e| e.ab));
@@ -312,7 +336,7 @@ impl Emitters {
             y = Vec3x8::select(sph, ys, y);
             normal = Vec3x8::select(sph, ns, normal);
         }
-        LightSample8 {
+        *out = LightSample8 {
             y,
             normal,
             radiance: Vec3x8::from_lanes(es.map(|e| e.radiance)),
@@ -320,7 +344,7 @@ impl Emitters {
             inv_pmf,
             light: idx,
             uv: (u, v),
-        }
+        };
     }
 
     /// [`Emitters::place_x8`] with light `i` on every lane.
@@ -400,7 +424,9 @@ mod tests {
         let inv = F8::new([1.0, 2.0, 3.0, 4.0, 0.5, 0.25, 8.0, 1.5]);
         let bits = |v: Vec3x8| [v.x, v.y, v.z].map(|c| c.to_array().map(f32::to_bits));
         for i in 0..e.list.len() as u32 {
-            let (one, lanes) = (e.place_x8(U8::splat(i), inv, us, vs), e.place_lanes_x8(U8::splat(i), inv, us, vs));
+            let mut lanes = LightSample8::ZERO;
+            e.place_lanes_x8(U8::splat(i), inv, us, vs, &mut lanes);
+            let one = e.place_x8(U8::splat(i), inv, us, vs);
             assert_eq!(bits(one.y), bits(lanes.y), "light {i}");
             assert_eq!(bits(one.normal), bits(lanes.normal));
             assert_eq!(bits(one.radiance), bits(lanes.radiance));

@@ -538,7 +538,8 @@ impl Bounce<'_> {
             };
             if it.light_sampler.certain() {
                 // The one light (pmf 1), a point on it uniform in area.
-                let (ls, ok) = area_sample(it, scene, sh, shade, AreaChoice::Certain, (u, w));
+                let mut ls = LightSample8::ZERO;
+                let ok = area_sample(it, scene, sh, shade, AreaChoice::Certain, (u, w), &mut ls);
                 push(&ls, None, None, ok)
             } else if !it.light_selection.picks_one() {
                 // Every light, N points each (a lattice rotated by (u, w)), each weighted 1/N
@@ -567,7 +568,8 @@ impl Bounce<'_> {
                 // One light from the light sampler (uniform 1/N over quads and triangles alike,
                 // power or spatial), the choice reused from u or drawn on its own.
                 let choice = if own_choice { AreaChoice::Drawn(u_choice) } else { AreaChoice::Reuse };
-                let (ls, ok) = area_sample(it, scene, sh, shade, choice, (u, w));
+                let mut ls = LightSample8::ZERO;
+                let ok = area_sample(it, scene, sh, shade, choice, (u, w), &mut ls);
                 push(&ls, None, None, ok);
             }
         }

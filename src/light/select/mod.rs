@@ -353,7 +353,8 @@ impl LightSampler {
 
     /// [`LightSampler::sample_point_x8`] with the choice reused from the light point: the light
     /// chosen by `u` ([`LightSampler::sample_remap`]) and the point `(u', v)` on it, u' the
-    /// remapped u. Inactive lanes and lanes without a light are off in the mask.
+    /// remapped u, written into `out` (in place: the 448-byte sample is not copied out of a
+    /// return). Inactive lanes and lanes without a light are off in the mask returned.
     #[inline]
     pub fn sample_point_reuse_x8(
         &self,
@@ -362,18 +363,20 @@ impl LightSampler {
         n: Vec3x8,
         active: Mask8,
         (u, v): (F8, F8),
-    ) -> (LightSample8, Mask8) {
+        out: &mut LightSample8,
+    ) -> Mask8 {
         let (idx, pmf, rest) = match &self.rule {
             Some(r) => r.sample_remap_x8(u, p, n, active),
             None => (U8::splat(0), F8::ZERO, F8::ZERO),
         };
-        self.place_x8(emitters, idx, pmf, active, (rest, v))
+        self.place_x8(emitters, idx, pmf, active, (rest, v), out)
     }
 
     /// A light per lane chosen by [`LightSampler::sample_x8`] with `u_choice`, and the point
-    /// `(u, v)` on it (`emitters.place_x8`, with 1 / pmf in the sample); the mask is the `active`
-    /// lanes that got a light (pmf > 0).
+    /// `(u, v)` on it (`emitters.place_x8`, with 1 / pmf in the sample), written into `out`; the
+    /// mask returned is the `active` lanes that got a light (pmf > 0).
     #[inline]
+    #[allow(clippy::too_many_arguments)] // the reuse form's six and the choice
     pub fn sample_point_x8(
         &self,
         emitters: &Emitters,
@@ -382,13 +385,14 @@ impl LightSampler {
         n: Vec3x8,
         active: Mask8,
         (u, v): (F8, F8),
-    ) -> (LightSample8, Mask8) {
+        out: &mut LightSample8,
+    ) -> Mask8 {
         let (idx, pmf) = self.sample_x8(u_choice, p, n, active);
-        self.place_x8(emitters, idx, pmf, active, (u, v))
+        self.place_x8(emitters, idx, pmf, active, (u, v), out)
     }
 
-    /// The chosen lights' points (`(u, v)` on light `idx`, 1 / pmf in the sample) and the active
-    /// lanes that got a light (pmf > 0).
+    /// The chosen lights' points (`(u, v)` on light `idx`, 1 / pmf in the sample) into `out`;
+    /// returns the active lanes that got a light (pmf > 0).
     #[inline]
     fn place_x8(
         &self,
@@ -397,10 +401,12 @@ impl LightSampler {
         pmf: F8,
         active: Mask8,
         (u, v): (F8, F8),
-    ) -> (LightSample8, Mask8) {
+        out: &mut LightSample8,
+    ) -> Mask8 {
         let ok = active & pmf.simd_gt(F8::ZERO);
         let inv_pmf = ok.select(F8::ONE / pmf, F8::ONE);
-        (emitters.place_x8(idx + U8::splat(self.first), inv_pmf, u, v), ok)
+        emitters.place_into_x8(idx + U8::splat(self.first), inv_pmf, u, v, out);
+        ok
     }
 
     /// [`LightRule::sample_x8`]: `(light, pmf)` per lane; lanes that are inactive or got `None`

@@ -439,7 +439,8 @@ fn reused_choice_remaps_u_uniformly_per_light() {
         let u = F8::new(std::array::from_fn(|_| rng.f32()));
         let v = F8::new(std::array::from_fn(|_| rng.f32()));
         let (ps, ns) = (Vec3x8::splat(p), Vec3x8::splat(nrm));
-        let (ls, ok) = s.sample_point_reuse_x8(&emitters, ps, ns, mask_all(), (u, v));
+        let mut ls = LightSample8::ZERO;
+        let ok = s.sample_point_reuse_x8(&emitters, ps, ns, mask_all(), (u, v), &mut ls);
         let (ua, va, oka) = (u.to_array(), v.to_array(), mask_to_bools(ok));
         let ys = ls.y.to_lanes();
         for k in 0..8 {
