@@ -414,9 +414,10 @@ fn shade_one<L: LobeSet>(
 
 /// Light sample k of every shading packet of the tile: its unit-square point (`point(packet,
 /// shading packet)`), a light point from it (`sample(hits, shading lanes, packet, shading packet,
-/// point, sample to fill)` returning the lanes that got one), the light term ([`towards`], the BSDF value) and what it adds if the shadow ray is
-/// clear (`weigh(sample, f, cos_i cos_l / d^2, lit lanes)`, f times the sample's MIS weight
-/// against the BSDF samples when `mis` is given), traced as one batch into `target`.
+/// point, sample to fill)`, returning the lanes that got one), the light term ([`towards`], the
+/// BSDF value) and what it adds if the shadow ray is clear (`weigh(sample, f, cos_i cos_l / d^2,
+/// lit lanes)`, f times the sample's MIS weight against the BSDF samples when `mis` is given),
+/// traced as one batch into `target`.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn sample_batch<L: LobeSet>(

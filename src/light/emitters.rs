@@ -16,7 +16,7 @@
 //!
 //! Which light a sample picks is the one light-choice interface, `light::select::LightSampler`
 //! (uniform, power, spatial; also `direct`'s power choice among the emissive triangles); this
-//! file places the point on the chosen light ([`Emitters::place_x8`]).
+//! file places the point on the chosen light ([`Emitters::place_into_x8`]).
 
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
@@ -299,7 +299,7 @@ impl Emitters {
         self.list.len() - self.n_quads
     }
 
-    /// The points `(u, v)` on lights `idx` (per lane), carrying `inv_pmf`.
+    /// [`Emitters::place_into_x8`]'s sample, returned (for the tests).
     #[cfg(test)]
     pub(crate) fn place_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let mut ls = LightSample8::ZERO;
@@ -307,8 +307,8 @@ impl Emitters {
         ls
     }
 
-    /// [`Emitters::place_x8`] written into `out` (each branch's call writes it in place; a
-    /// returned sample was copied out with `memcpy`).
+    /// The points `(u, v)` on lights `idx` (per lane), carrying `inv_pmf`, written into `out` (each
+    /// branch's call writes it in place; a returned sample was copied out with `memcpy`).
     #[inline]
     pub(crate) fn place_into_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8, out: &mut LightSample8) {
         let ids = idx.to_array();
@@ -347,7 +347,7 @@ impl Emitters {
         };
     }
 
-    /// [`Emitters::place_x8`] with light `i` on every lane.
+    /// [`Emitters::place_into_x8`]'s sample with light `i` on every lane.
     #[inline]
     pub(crate) fn place_one_x8(&self, i: u32, inv_pmf: F8, u: F8, v: F8) -> LightSample8 {
         let e = &self.list[i as usize];

@@ -1,7 +1,7 @@
 //! The path wavefront's structure-of-arrays lanes: columns of 32-bit lanes (f32, or u32 by bits)
 //! in packets of 8, appended a packet at a time by left-packing the lanes of a mask (one lane
-//! permute and one store per column) at a running offset. Live paths and shadow rays so stay in packets from
-//! one bounce to the next, with no per-lane copies.
+//! permute and one store per column) at a running offset. Live paths and shadow rays so stay in
+//! packets from one bounce to the next, with no per-lane copies.
 
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use wide::bytemuck;

@@ -373,7 +373,7 @@ impl LightSampler {
     }
 
     /// A light per lane chosen by [`LightSampler::sample_x8`] with `u_choice`, and the point
-    /// `(u, v)` on it (`emitters.place_x8`, with 1 / pmf in the sample), written into `out`; the
+    /// `(u, v)` on it (`emitters.place_into_x8`, with 1 / pmf in the sample), written into `out`; the
     /// mask returned is the `active` lanes that got a light (pmf > 0).
     #[inline]
     #[allow(clippy::too_many_arguments)] // the reuse form's six and the choice
