@@ -1,4 +1,5 @@
-//! The one module that talks to Embree 4, and the only `unsafe` in strata.
+//! The one module that talks to Embree 4, and the only `unsafe` in strata (with the CPU-level
+//! helpers: FTZ/DAZ, the time-stamp counter, the hardware gather).
 //!
 //! Embree 4.4 (the library we link) is built with instance arrays, so its ray/hit structs carry an
 //! `instPrimID` field that the 4.2-era structs of `embree4-sys` lack: `RTCRayHit8` is 672 bytes, not
@@ -26,7 +27,8 @@
 //! committed scene and its 8-wide queries ([`Hits8`]); `user_geometry.rs` the ellipsoid callbacks
 //! (`ellipsoid.rs` their intersection); `sphere_points_tests.rs` Embree's sphere points against
 //! them and the f64 reference;
-//! `ftz.rs` the FTZ/DAZ switch; `alloc.rs` the counting allocator for tests.
+//! `ftz.rs` the FTZ/DAZ switch; `gather.rs` 8-lane table look-ups (the hardware gather on AMD);
+//! `alloc.rs` the counting allocator for tests.
 
 pub mod alloc;
 pub mod approx;
@@ -34,6 +36,7 @@ mod device;
 pub mod ellipsoid;
 mod ffi;
 mod ftz;
+mod gather;
 mod scene;
 #[cfg(test)]
 mod sphere_points_tests;
@@ -45,6 +48,7 @@ pub use approx::approx_id;
 pub use device::{cpu_has_avx512, default_isa, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
 pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
 pub use ftz::{set_ftz_daz, timestamp};
+pub use gather::{gather_u16, gather_u16_on, hardware_gather};
 pub use scene::{GroupId, Hits8, Scene, SceneBuilder};
 pub use user_geometry::{set_callback_timing, take_callback_ticks};
 

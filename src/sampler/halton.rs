@@ -91,10 +91,15 @@ const fn digit_perm(t: usize, p: usize) -> &'static [u16; 3] {
     &PERMS3[t / [1, 6, 36][p] % 6]
 }
 
+/// Entries of [`DIGIT_TABLES`]: the 216 x 27 = 5,832 table entries, padded with zeros to a power
+/// of two plus one (the form `accel::gather_u16` reads with one mask, no bounds check).
+const DIGIT_TABLES_LEN: usize = 8193;
+
 /// Table t at entries `t * 27 ..`: chunk value c (three base-3 digits d_0..d_2, d_0 least
 /// significant) to `sum_p perm_{t,p}(d_p) 3^(2 - p)`: permuted and digit-reversed.
-static DIGIT_TABLES: [u16; (TABLES3 * CHUNK) as usize] = {
-    let mut out = [0u16; (TABLES3 * CHUNK) as usize];
+static DIGIT_TABLES: [u16; DIGIT_TABLES_LEN] = {
+    assert!(((TABLES3 * CHUNK) as usize) < DIGIT_TABLES_LEN);
+    let mut out = [0u16; DIGIT_TABLES_LEN];
     let mut t = 0;
     while t < TABLES3 as usize {
         let mut c = 0;
@@ -123,10 +128,11 @@ fn permute3<L: Lanes>(index: L, h: L) -> L {
     const D27: Divisor = Divisor::new(CHUNK);
     let n = L::splat(TABLES3);
     let (mut rest, mut r, mut acc) = (index, h, L::splat(0));
+    let hardware = crate::accel::hardware_gather();
     for c in 0..5 {
         let (q, chunk) = D27.div_rem(rest);
         let t = r.mulhi(n);
-        let v = t.mul(L::splat(CHUNK)).add(chunk).gather16(&DIGIT_TABLES);
+        let v = t.mul(L::splat(CHUNK)).add(chunk).gather16(&DIGIT_TABLES, hardware);
         acc = if c == 0 { v } else { acc.mul(L::splat(CHUNK)).add(v) };
         r = r.mul(n);
         rest = q;

@@ -61,8 +61,10 @@ pub trait Lanes: Copy {
     /// Per lane both words of `table[self mod N]` (N a power of two: the index is masked, so
     /// there is no bounds check per lane).
     fn gather2<const N: usize>(self, table: &[[u32; 2]; N]) -> (Self, Self);
-    /// Per lane `table[self]` widened to u32 (panics if out of range).
-    fn gather16(self, table: &[u16]) -> Self;
+    /// Per lane `table[self & (N - 2)]` widened to u32 (`N - 1` a power of two; the last entry
+    /// is padding), by the hardware gather where `hardware` (`accel::gather_u16_on`: the value of
+    /// `accel::hardware_gather`, read once by the caller for its look-ups).
+    fn gather16<const N: usize>(self, table: &[u16; N], hardware: bool) -> Self;
     /// The largest lane.
     fn max_lane(self) -> u32;
     /// `f`'s point for these lanes (a run-time point function inside a generic one: file padding).
@@ -138,8 +140,9 @@ impl Lanes for u32 {
         let [x, y] = table[self as usize & (N - 1)];
         (x, y)
     }
-    fn gather16(self, table: &[u16]) -> Self {
-        u32::from(table[self as usize])
+    fn gather16<const N: usize>(self, table: &[u16; N], _: bool) -> Self {
+        const { assert!(N >= 2 && (N - 1).is_power_of_two()) };
+        u32::from(table[self as usize & (N - 2)])
     }
     fn max_lane(self) -> u32 {
         self
@@ -230,8 +233,8 @@ impl Lanes for U8 {
         (U8::new(x), U8::new(y))
     }
     #[inline]
-    fn gather16(self, table: &[u16]) -> Self {
-        U8::new(self.to_array().map(|i| u32::from(table[i as usize])))
+    fn gather16<const N: usize>(self, table: &[u16; N], hardware: bool) -> Self {
+        crate::accel::gather_u16_on(table, self, hardware)
     }
     #[inline]
     fn max_lane(self) -> u32 {
@@ -309,8 +312,8 @@ impl<L: Lanes> Lanes for Pair<L> {
         (Pair(x0, x1), Pair(y0, y1))
     }
     #[inline(always)]
-    fn gather16(self, table: &[u16]) -> Self {
-        Pair(self.0.gather16(table), self.1.gather16(table))
+    fn gather16<const N: usize>(self, table: &[u16; N], hardware: bool) -> Self {
+        Pair(self.0.gather16(table, hardware), self.1.gather16(table, hardware))
     }
     #[inline(always)]
     fn max_lane(self) -> u32 {
