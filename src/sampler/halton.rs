@@ -123,16 +123,27 @@ static DIGIT_TABLES: [u16; DIGIT_TABLES_LEN] = {
 /// by 27), chunk c through table t_c, the base-216 digits of the stream's hash `h` (t = floor(216 u)
 /// for successive fractions u of h; the last chunks, the least significant output digits, share
 /// fewer random bits), weighted 27^(4 - c) (Horner's rule).
+/// The look-ups by the hardware gather where `accel::hardware_gather` says so, each form compiled
+/// on its own (no branch per look-up).
 #[inline]
 fn permute3<L: Lanes>(index: L, h: L) -> L {
+    if crate::accel::hardware_gather() {
+        permute3_with::<L, true>(index, h)
+    } else {
+        permute3_with::<L, false>(index, h)
+    }
+}
+
+/// [`permute3`] with its look-ups by the hardware gather if `HW`.
+#[inline(always)]
+fn permute3_with<L: Lanes, const HW: bool>(index: L, h: L) -> L {
     const D27: Divisor = Divisor::new(CHUNK);
     let n = L::splat(TABLES3);
     let (mut rest, mut r, mut acc) = (index, h, L::splat(0));
-    let hardware = crate::accel::hardware_gather();
     for c in 0..5 {
         let (q, chunk) = D27.div_rem(rest);
         let t = r.mulhi(n);
-        let v = t.mul(L::splat(CHUNK)).add(chunk).gather16(&DIGIT_TABLES, hardware);
+        let v = t.mul(L::splat(CHUNK)).add(chunk).gather16(&DIGIT_TABLES, HW);
         acc = if c == 0 { v } else { acc.mul(L::splat(CHUNK)).add(v) };
         r = r.mul(n);
         rest = q;

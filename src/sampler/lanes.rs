@@ -232,7 +232,7 @@ impl Lanes for U8 {
         }
         (U8::new(x), U8::new(y))
     }
-    #[inline]
+    #[inline(always)]
     fn gather16<const N: usize>(self, table: &[u16; N], hardware: bool) -> Self {
         crate::accel::gather_u16_on(table, self, hardware)
     }
