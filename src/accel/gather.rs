@@ -14,7 +14,7 @@
 use crate::simd::U8;
 use std::sync::atomic::{AtomicU8, Ordering};
 
-/// Whether [`gather_u16`] uses the hardware gather: an x86_64 CPU with AVX2 from AMD. Cached in
+/// Whether [`gather_u16`] should use the hardware gather: an x86_64 CPU with AVX2 from AMD. Cached in
 /// a relaxed atomic (0 not yet known, 1 no, 2 yes): one load per call.
 #[inline]
 pub fn hardware_gather() -> bool {
@@ -44,18 +44,13 @@ fn detect_amd_avx2() -> bool {
     }
 }
 
-/// `table[i & (N - 2)]` per lane of `idx`, widened to u32. `N - 1` must be a power of two: the
-/// last entry is padding that only the 4-byte hardware reads touch (the index mask keeps every
-/// read inside the table, whatever `idx` holds).
-#[inline]
-pub fn gather_u16<const N: usize>(table: &[u16; N], idx: U8) -> U8 {
-    gather_u16_on(table, idx, hardware_gather())
-}
-
-/// [`gather_u16`] by the hardware gather if `hardware` (and AVX2 is compiled in), else by
-/// scalar loads: for callers that read [`hardware_gather`] once for several look-ups.
+/// `table[i & (N - 2)]` per lane of `idx`, widened to u32, by the hardware gather if `hardware`
+/// (pass [`hardware_gather`], read once for several look-ups; AVX2 compiled in) and by scalar
+/// loads otherwise. `N - 1` must be a power of two: the last entry is padding that only the
+/// 4-byte hardware reads touch (the index mask keeps every read inside the table, whatever `idx`
+/// holds).
 #[inline(always)]
-pub fn gather_u16_on<const N: usize>(table: &[u16; N], idx: U8, hardware: bool) -> U8 {
+pub fn gather_u16<const N: usize>(table: &[u16; N], idx: U8, hardware: bool) -> U8 {
     const { assert!(N >= 2 && (N - 1).is_power_of_two()) };
     let idx = idx & U8::splat((N - 2) as u32);
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
@@ -86,13 +81,13 @@ mod tests {
         for hardware in [true, false] {
             for base in (0..4096u32).step_by(8).chain([4088, u32::MAX - 7, 1 << 31]) {
                 let idx = U8::new(std::array::from_fn(|l| base.wrapping_add(l as u32 * 517)));
-                let got = gather_u16_on(&table, idx, hardware).to_array();
+                let got = gather_u16(&table, idx, hardware).to_array();
                 for (l, i) in idx.to_array().into_iter().enumerate() {
                     assert_eq!(got[l], u32::from(table[i as usize & 4095]), "lane {l} index {i} ({hardware})");
                 }
             }
             // The last entry (the hardware read there also covers the padding entry).
-            let last = gather_u16_on(&table, U8::splat(4095), hardware).to_array();
+            let last = gather_u16(&table, U8::splat(4095), hardware).to_array();
             assert_eq!(last, [u32::from(table[4095]); 8]);
         }
     }

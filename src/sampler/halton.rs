@@ -122,9 +122,9 @@ static DIGIT_TABLES: [u16; DIGIT_TABLES_LEN] = {
 /// digit permutations, before the fixed-point map: five chunks of three digits (exact divisions
 /// by 27), chunk c through table t_c, the base-216 digits of the stream's hash `h` (t = floor(216 u)
 /// for successive fractions u of h; the last chunks, the least significant output digits, share
-/// fewer random bits), weighted 27^(4 - c) (Horner's rule).
-/// The look-ups by the hardware gather where `accel::hardware_gather` says so, each form compiled
-/// on its own (no branch per look-up).
+/// fewer random bits), weighted 27^(4 - c) (Horner's rule). The look-ups are hardware gathers
+/// where `accel::hardware_gather` says so; each form is compiled on its own (no branch per
+/// look-up).
 #[inline]
 fn permute3<L: Lanes>(index: L, h: L) -> L {
     if crate::accel::hardware_gather() {

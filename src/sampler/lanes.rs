@@ -62,7 +62,7 @@ pub trait Lanes: Copy {
     /// there is no bounds check per lane).
     fn gather2<const N: usize>(self, table: &[[u32; 2]; N]) -> (Self, Self);
     /// Per lane `table[self & (N - 2)]` widened to u32 (`N - 1` a power of two; the last entry
-    /// is padding), by the hardware gather where `hardware` (`accel::gather_u16_on`: the value of
+    /// is padding), by the hardware gather where `hardware` (`accel::gather_u16`: the value of
     /// `accel::hardware_gather`, read once by the caller for its look-ups).
     fn gather16<const N: usize>(self, table: &[u16; N], hardware: bool) -> Self;
     /// The largest lane.
@@ -234,7 +234,7 @@ impl Lanes for U8 {
     }
     #[inline(always)]
     fn gather16<const N: usize>(self, table: &[u16; N], hardware: bool) -> Self {
-        crate::accel::gather_u16_on(table, self, hardware)
+        crate::accel::gather_u16(table, self, hardware)
     }
     #[inline]
     fn max_lane(self) -> u32 {
