@@ -9,24 +9,39 @@
 //! look-ups measured slower gathered (1.11-1.15x against 0.96x), so they stay scalar. On Intel
 //! CPUs the gather is not used: the microcode against Gather Data Sampling ("Downfall", 2023)
 //! slows `vpgatherdd` several-fold on many Xeons, and no Intel machine was at hand to measure it;
-//! there the masked scalar loads run.
+//! there the masked scalar loads run. `STRATA_GATHER=hardware|scalar` overrides the choice
+//! ([`set_hardware_gather`], from `scene::build::forced_gather`) to measure both on a new CPU.
 
 use crate::simd::U8;
 use std::sync::atomic::{AtomicU8, Ordering};
 
-/// Whether [`gather_u16`] should use the hardware gather: an x86_64 CPU with AVX2 from AMD. Cached in
-/// a relaxed atomic (0 not yet known, 1 no, 2 yes): one load per call.
+/// The look-up form: 0 not yet chosen, 1 scalar loads, 2 the hardware gather.
+static USE: AtomicU8 = AtomicU8::new(0);
+
+/// Whether [`gather_u16`] should use the hardware gather: as [`set_hardware_gather`] chose, else
+/// (nothing chosen yet) on an x86_64 CPU with AVX2 from AMD. Cached in a relaxed atomic: one load
+/// per call.
 #[inline]
 pub fn hardware_gather() -> bool {
-    static USE: AtomicU8 = AtomicU8::new(0);
     match USE.load(Ordering::Relaxed) {
-        0 => {
-            let yes = detect_amd_avx2();
-            USE.store(1 + u8::from(yes), Ordering::Relaxed);
-            yes
-        }
+        0 => set_hardware_gather(None),
         v => v == 2,
     }
+}
+
+/// Chooses the look-up form for the process: `Some(true)` the hardware gather (where AVX2 is
+/// compiled in; scalar loads otherwise), `Some(false)` scalar loads, `None` by the CPU (AMD with
+/// AVX2: the gather). Returns whether the gather is used. Only speed depends on it (the values are
+/// the same); `STRATA_GATHER` sets it for a render (`scene::build::forced_gather`).
+pub fn set_hardware_gather(on: Option<bool>) -> bool {
+    let yes = hardware_gather_compiled() && on.unwrap_or_else(detect_amd_avx2);
+    USE.store(1 + u8::from(yes), Ordering::Relaxed);
+    yes
+}
+
+/// Whether this build can run the hardware gather (AVX2 compiled in).
+pub fn hardware_gather_compiled() -> bool {
+    cfg!(all(target_arch = "x86_64", target_feature = "avx2"))
 }
 
 /// CPUID says "AuthenticAMD" and AVX2 is available.
@@ -66,7 +81,8 @@ pub fn gather_u16<const N: usize>(table: &[u16; N], idx: U8, hardware: bool) -> 
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     let _ = hardware;
-    U8::new(idx.to_array().map(|i| u32::from(table[i as usize])))
+    // Masked again per lane: that is what lets the compiler drop the bounds checks.
+    U8::new(idx.to_array().map(|i| u32::from(table[i as usize & (N - 2)])))
 }
 
 #[cfg(test)]

@@ -180,6 +180,10 @@ pub enum BuildError {
     /// `STRATA_BVH` set to something other than `high` or `medium`.
     #[error("STRATA_BVH={0:?}: expected `high` or `medium` (or unset: by triangle count)")]
     Bvh(String),
+    /// `STRATA_GATHER` set to something other than `auto`, `hardware` or `scalar`, or `hardware`
+    /// in a build without AVX2.
+    #[error("STRATA_GATHER={0:?}: expected `auto`, `hardware` or `scalar`{1}")]
+    Gather(String, &'static str),
 }
 
 /// The BVH quality `STRATA_BVH` forces: `high` (true), `medium` (false), unset or empty (None:
@@ -192,6 +196,24 @@ pub fn forced_bvh() -> Result<Option<bool>, BuildError> {
         Ok(v) => Err(BuildError::Bvh(v)),
         Err(std::env::VarError::NotPresent) => Ok(None),
         Err(std::env::VarError::NotUnicode(v)) => Err(BuildError::Bvh(v.to_string_lossy().into_owned())),
+    }
+}
+
+/// How table look-ups run (`accel::gather_u16`; the values are the same either way, only the
+/// speed differs) as `STRATA_GATHER` says: `hardware` (Some(true): AVX2's gather), `scalar`
+/// (Some(false)), `auto`, empty or unset (None: the gather on AMD CPUs); anything else is refused.
+pub fn forced_gather() -> Result<Option<bool>, BuildError> {
+    let v = match std::env::var("STRATA_GATHER") {
+        Ok(v) => v,
+        Err(std::env::VarError::NotPresent) => return Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => return Err(BuildError::Gather(v.to_string_lossy().into_owned(), "")),
+    };
+    match v.as_str() {
+        "" | "auto" => Ok(None),
+        "hardware" if accel::hardware_gather_compiled() => Ok(Some(true)),
+        "hardware" => Err(BuildError::Gather(v, " (this build has no AVX2: `scalar` or `auto`)")),
+        "scalar" => Ok(Some(false)),
+        _ => Err(BuildError::Gather(v, "")),
     }
 }
 
@@ -460,6 +482,7 @@ impl Scene {
         let device = accel::Device::new()?;
         let mut b = accel::SceneBuilder::new(&device)?;
         let high = forced_bvh()?.unwrap_or(indices.len() >= HIGH_QUALITY_MIN_TRIANGLES);
+        accel::set_hardware_gather(forced_gather()?);
         if high {
             b.high_quality();
         }

@@ -27,6 +27,7 @@ pub fn check_command_line(opts: &RenderOptions) -> Result<(), SessionError> {
     // STRATA_EMBREE_CONFIG: refused before the scene is read (the device checks it again).
     crate::accel::EmbreeConfig::from_env().map_err(|e| SessionError::Build(e.into()))?;
     crate::scene::build::forced_bvh().map_err(SessionError::Build)?;
+    crate::scene::build::forced_gather().map_err(SessionError::Build)?;
     match &opts.out {
         Some(o) => {
             film::check_stem(o).map_err(|e| SessionError::BadOutput { path: o.clone(), why: e.to_string() })?;
