@@ -67,11 +67,10 @@ fn detect_amd_avx2() -> bool {
 #[inline(always)]
 pub fn gather_u16<const N: usize>(table: &[u16; N], idx: U8, hardware: bool) -> U8 {
     const { assert!(N >= 2 && (N - 1).is_power_of_two()) };
-    let idx = idx & U8::splat((N - 2) as u32);
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     if hardware {
         use std::arch::x86_64::{__m256i, _mm256_i32gather_epi32};
-        let v: __m256i = wide::bytemuck::cast(idx);
+        let v: __m256i = wide::bytemuck::cast(idx & U8::splat((N - 2) as u32));
         // SAFETY: AVX2 is enabled at compile time (this cfg). Lane i reads the 4 bytes at
         // `table + 2 * idx_i` with idx_i <= N - 2 (masked above), i.e. bytes up to 2N: inside
         // the table, whose alignment of 2 is all an unaligned gather element needs.
@@ -81,7 +80,8 @@ pub fn gather_u16<const N: usize>(table: &[u16; N], idx: U8, hardware: bool) -> 
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     let _ = hardware;
-    // Masked again per lane: that is what lets the compiler drop the bounds checks.
+    // Masked per lane (a vector mask before taking the lanes apart would leave the compiler its
+    // bounds checks).
     U8::new(idx.to_array().map(|i| u32::from(table[i as usize & (N - 2)])))
 }
 
