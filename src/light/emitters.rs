@@ -18,6 +18,7 @@
 //! (uniform, power, spatial; also `direct`'s power choice among the emissive triangles); this
 //! file places the point on the chosen light ([`Emitters::place_into_x8`]).
 
+use super::lane_table::LaneTable;
 use crate::simd::{Mask8, Vec3x8, F8, U8};
 use glam::Vec3;
 
@@ -211,6 +212,27 @@ pub struct Emitters {
     /// each light's [`WarpRow`], then an all-zero row (kind [`WarpRow::NONE`]) that lanes
     /// without a light gather
     pub warp_rows: Vec<WarpRow>,
+    /// the lights' [`PlaceRow`]s as lane columns, where they fit ([`LaneTable`])
+    place_lanes: Option<LaneTable<PLACE_FIELDS>>,
+    /// `warp_rows` as lane columns, where they fit
+    pub(super) warp_lanes: Option<LaneTable<16>>,
+}
+
+/// Fields of a light that placing a point on it reads ([`place_row`]).
+const PLACE_FIELDS: usize = 19;
+
+/// A light's fields for [`Emitters::place_lanes_x8`] as bits: corner, edges, normal, radiance
+/// (3 each), area, radius, then the triangle and sphere flags as lane masks (all ones or zero).
+fn place_row(e: &Emitter) -> [u32; PLACE_FIELDS] {
+    let mut r = [0; PLACE_FIELDS];
+    for (k, v) in [e.a, e.ab, e.ac, e.normal, e.radiance].iter().enumerate() {
+        for (c, x) in v.to_array().iter().enumerate() {
+            r[3 * k + c] = x.to_bits();
+        }
+    }
+    let flag = |b: bool| if b { u32::MAX } else { 0 };
+    r[15..].copy_from_slice(&[e.area.to_bits(), e.radius.to_bits(), flag(e.triangle), flag(e.sphere)]);
+    r
 }
 
 /// Relative tolerance of `|ab . ac| / (|ab| |ac|)` for a quad light to count as a rectangle.
@@ -280,8 +302,10 @@ impl Emitters {
         let n_quads = list.len();
         list.extend(triangles);
         let any_sphere = list.iter().any(|e| e.sphere);
-        let warp_rows = list.iter().map(Emitter::warp_row).chain([WarpRow::default()]).collect();
-        Self { list, n_quads, any_sphere, warp_rows }
+        let warp_rows: Vec<WarpRow> = list.iter().map(Emitter::warp_row).chain([WarpRow::default()]).collect();
+        let place_lanes = LaneTable::new(&list.iter().map(place_row).collect::<Vec<_>>());
+        let warp_lanes = LaneTable::new(&warp_rows.iter().map(|r| r.0.map(f32::to_bits)).collect::<Vec<_>>());
+        Self { list, n_quads, any_sphere, warp_rows, place_lanes, warp_lanes }
     }
 
     /// Number of lights.
@@ -323,6 +347,21 @@ impl Emitters {
 
     /// [`Emitters::place_into_x8`], each lane's light gathered on its own.
     fn place_lanes_x8(&self, idx: U8, inv_pmf: F8, u: F8, v: F8, out: &mut LightSample8) {
+        if let Some(t) = &self.place_lanes {
+            let f = |k: usize| t.field(k, idx);
+            let v3 = |k: usize| Vec3x8::new(f(k), f(k + 1), f(k + 2));
+            let la = v3(0);
+            let mut y = point_x8(la, v3(3), v3(6), f(17), u, v);
+            let mut normal = v3(9);
+            if self.any_sphere {
+                let (ys, ns) = sphere_point_x8(la, f(16), u, v);
+                let sph = f(18);
+                y = Vec3x8::select(sph, ys, y);
+                normal = Vec3x8::select(sph, ns, normal);
+            }
+            *out = LightSample8 { y, normal, radiance: v3(12), area: f(15), inv_pmf, light: idx, uv: (u, v) };
+            return;
+        }
         let es = idx.to_array().map(|i| &self.list[i as usize]);
         let la = Vec3x8::from_lanes(es.map(|e| e.a));
         let lab = Vec3x8::from_lanes(es.map(|e| e.ab));
@@ -433,6 +472,36 @@ mod tests {
             assert_eq!(one.area.to_array().map(f32::to_bits), lanes.area.to_array().map(f32::to_bits));
             assert_eq!(one.inv_pmf.to_array().map(f32::to_bits), inv.to_array().map(f32::to_bits));
             assert_eq!(one.light.to_array(), [i; 8]);
+        }
+    }
+
+    #[test]
+    fn lane_table_and_per_lane_gather_place_the_same_points() {
+        // The same five lights, then (in `many`) dark triangles enough to leave the lane table.
+        let few = lights();
+        let dark = Emitter::triangle([Vec3::ZERO, Vec3::Y, Vec3::Z], Vec3::ZERO);
+        let many = Emitters::new(few.list[..2].to_vec(), few.list[2..].iter().copied().chain([dark; 6]));
+        assert!(few.place_lanes.is_some() && few.warp_lanes.is_some());
+        assert!(many.place_lanes.is_none() && many.warp_lanes.is_none());
+        let us = F8::new([0.0, 0.1, 0.62, 0.7, 0.8, 0.95, 0.999_999_94, 0.5]);
+        let vs = F8::new([0.9, 0.3, 0.77, 0.05, 0.6, 0.99, 0.2, 0.5]);
+        let bits = |v: Vec3x8| [v.x, v.y, v.z].map(|c| c.to_array().map(f32::to_bits));
+        for idx in [U8::new([4, 0, 3, 1, 2, 1, 0, 4]), U8::new([1, 1, 2, 3, 0, 0, 4, 2])] {
+            let (mut a, mut b) = (LightSample8::ZERO, LightSample8::ZERO);
+            few.place_lanes_x8(idx, F8::ONE, us, vs, &mut a);
+            many.place_lanes_x8(idx, F8::ONE, us, vs, &mut b);
+            assert_eq!(bits(a.y), bits(b.y));
+            assert_eq!(bits(a.normal), bits(b.normal));
+            assert_eq!(bits(a.radiance), bits(b.radiance));
+            assert_eq!(a.area.to_array().map(f32::to_bits), b.area.to_array().map(f32::to_bits));
+            // The solid-angle warp's rows of these lights, looked up both ways.
+            let p = Vec3x8::splat(Vec3::new(0.3, 0.2, -1.0));
+            for active in [crate::simd::mask_all(), crate::simd::mask_first(5)] {
+                let (sa, wa) = few.solid_angle_x8(idx, p, active);
+                let (sb, wb) = many.solid_angle_x8(idx, p, active);
+                assert_eq!(sa.to_array().map(f32::to_bits), sb.to_array().map(f32::to_bits));
+                assert_eq!(wa.to_bitmask(), wb.to_bitmask());
+            }
         }
     }
 

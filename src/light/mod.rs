@@ -6,6 +6,7 @@ pub mod desc;
 pub mod emission;
 pub mod emitters;
 pub mod envmap;
+pub mod lane_table;
 pub mod polygonal;
 pub mod select;
 pub mod sky;

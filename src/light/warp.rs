@@ -20,6 +20,7 @@
 //! `L f cos_i cos_l area / d^2 = L f cos_i S` its estimate.
 
 use super::emitters::{Emitter, Emitters, LightSample8, WarpRow};
+use super::lane_table::LaneTable;
 use crate::sampling::spherical_cap::SphericalCap8;
 use crate::sampling::spherical_rect::SphericalRect8;
 use crate::sampling::spherical_tri::SphericalTri8;
@@ -138,9 +139,14 @@ impl Lights8 {
     /// The lights `ids` (rows of `rows`, whose last row is the empty one) on lanes `active`; the
     /// other lanes get the empty row.
     #[inline]
-    fn lanes(rows: &[WarpRow], ids: U8, active: Mask8) -> Self {
-        let ids = ids.to_array();
+    fn lanes(rows: &[WarpRow], table: Option<&LaneTable<16>>, ids: U8, active: Mask8) -> Self {
         let last = rows.len() - 1;
+        if let Some(t) = table {
+            // Inactive lanes and out-of-range ids read the empty last row, as below.
+            let rows = active.to_bits().select(ids.min(U8::splat(last as u32)), U8::splat(last as u32));
+            return Self::from_cols(std::array::from_fn(|k| t.field(k, rows)));
+        }
+        let ids = ids.to_array();
         if ids.iter().all(|&i| i == ids[0]) && (ids[0] as usize) < last {
             return Self::one(&rows[ids[0] as usize]);
         }
@@ -239,7 +245,7 @@ impl Emitters {
     #[inline]
     pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
         if warp == LightWarp::SolidAngle && active.any() {
-            rewarp(&Lights8::lanes(&self.warp_rows, ls.light, active), ls, p, active);
+            rewarp(&Lights8::lanes(&self.warp_rows, self.warp_lanes.as_ref(), ls.light, active), ls, p, active);
         }
     }
 
@@ -257,7 +263,7 @@ impl Emitters {
     /// a BSDF-sampled hit of a light weighs its MIS with.
     #[inline]
     pub fn solid_angle_x8(&self, ids: U8, p: Vec3x8, active: Mask8) -> (F8, Mask8) {
-        let sub = Lights8::lanes(&self.warp_rows, ids, active).subtend(p, active);
+        let sub = Lights8::lanes(&self.warp_rows, self.warp_lanes.as_ref(), ids, active).subtend(p, active);
         (sub.omega, sub.warped)
     }
 }
