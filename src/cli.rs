@@ -210,7 +210,7 @@ pub(crate) enum Cmd {
         #[arg(long = "option", value_name = "KEY=VALUE")]
         options: Vec<String>,
     },
-    /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread).
+    /// Measure the whole renderer's rays/s next to Embree's raw rate on the same packets (1 thread), and Embree's rate on the same rays 16 and 1 at a time.
     #[command(allow_negative_numbers = true)]
     Rays {
         #[command(flatten)]

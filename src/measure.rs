@@ -5,6 +5,7 @@
 //! processes is not charged), and each part is run [`REPEATS`] times, interleaved, keeping the
 //! fastest: on a shared machine the minimum is the least disturbed estimate of the same work.
 
+use crate::accel::{Ray8, RayHit1, RayHit16, Valid16, RAY_WORDS};
 use crate::film::Film;
 use crate::integrator::{Counters, Integrator, RayLog, Scratch};
 use crate::render::{self, TILE};
@@ -43,6 +44,23 @@ pub struct RayRates {
     pub raw_mixed_mrays: f64,
     /// renderer_mrays / raw_mixed_mrays
     pub ratio: f64,
+    /// Embree alone through its 16-wide entry points, camera rays (each kind's traced lanes packed
+    /// 16 at a time in the renderer's order)
+    pub raw16_camera_mrays: f64,
+    /// 16-wide, bounce rays
+    pub raw16_bounce_mrays: f64,
+    /// 16-wide, shadow rays
+    pub raw16_shadow_mrays: f64,
+    /// 16-wide, the same mix
+    pub raw16_mixed_mrays: f64,
+    /// Embree alone, one ray per call (`rtcIntersect1`/`rtcOccluded1`), camera rays
+    pub raw1_camera_mrays: f64,
+    /// one by one, bounce rays
+    pub raw1_bounce_mrays: f64,
+    /// one by one, shadow rays
+    pub raw1_shadow_mrays: f64,
+    /// one by one, the same mix
+    pub raw1_mixed_mrays: f64,
 }
 
 /// Renders samples `0..spp` single-threaded and times it, then replays every packet the renderer
@@ -58,6 +76,13 @@ pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
     let bounce_rays: u64 = log.bounce.iter().map(|(_, m)| lanes(m)).sum();
     let (mut t_render, mut t_cam, mut t_bounce, mut t_sh) =
         (f64::INFINITY, f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    // The same lanes for the 16-wide and one-by-one replays: [camera, bounce, shadow].
+    let words = [
+        lane_words(log.camera.iter().map(|(rh, m)| (&rh.ray, m))),
+        lane_words(log.bounce.iter().map(|(rh, m)| (&rh.ray, m))),
+        lane_words(log.shadow.iter().map(|(r, m)| (r, m))),
+    ];
+    let (mut t16, mut t1) = ([f64::INFINITY; 3], [f64::INFINITY; 3]);
     let mut total_rays = 0;
     for _ in 0..REPEATS {
         // Whole renderer on the pool's one worker (nested `install` runs inline there).
@@ -76,6 +101,11 @@ pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
         t_cam = t_cam.min(thread_seconds(|| replay_camera(scene, &mut cam)));
         t_bounce = t_bounce.min(thread_seconds(|| replay_bounce(scene, &mut bounce)));
         t_sh = t_sh.min(thread_seconds(|| replay_shadow(scene, &mut shadow)));
+        for (k, w) in words.iter().enumerate() {
+            let (coherent, occluded) = (k == 0, k == 2);
+            t16[k] = t16[k].min(replay16(scene, w, coherent, occluded).0);
+            t1[k] = t1[k].min(replay1(scene, w, coherent, occluded).0);
+        }
     }
     let renderer_mrays = total_rays as f64 / t_render.max(1e-12) / 1e6;
     let mr = |n: u64, t: f64| n as f64 / t.max(1e-12) / 1e6;
@@ -90,7 +120,57 @@ pub fn ray_rates(scene: &Scene, integrator: &Integrator, spp: u32) -> RayRates {
         raw_bounce_mrays: mr(bounce_rays, t_bounce),
         raw_mixed_mrays,
         ratio: renderer_mrays / raw_mixed_mrays,
+        raw16_camera_mrays: mr(camera_rays, t16[0]),
+        raw16_bounce_mrays: mr(bounce_rays, t16[1]),
+        raw16_shadow_mrays: mr(shadow_rays, t16[2]),
+        raw16_mixed_mrays: mr(camera_rays + shadow_rays + bounce_rays, t16.iter().sum()),
+        raw1_camera_mrays: mr(camera_rays, t1[0]),
+        raw1_bounce_mrays: mr(bounce_rays, t1[1]),
+        raw1_shadow_mrays: mr(shadow_rays, t1[2]),
+        raw1_mixed_mrays: mr(camera_rays + shadow_rays + bounce_rays, t1.iter().sum()),
     }
+}
+
+/// The traced lanes of logged packets, in order, as Embree ray words.
+pub fn lane_words<'a>(packets: impl Iterator<Item = (&'a Ray8, &'a crate::simd::Mask8)>) -> Vec<[u32; RAY_WORDS]> {
+    let mut out = Vec::new();
+    for (ray, m) in packets {
+        let bits = m.to_bitmask();
+        out.extend((0..8).filter(|j| bits & (1 << j) != 0).map(|j| ray.lane_words(j)));
+    }
+    out
+}
+
+/// Traces `rays` through Embree's 16-wide entry point, 16 at a time (closest hit, or any hit
+/// when `occluded`): the thread seconds of the calls alone, and each ray's `tfar` after it.
+pub fn replay16(scene: &Scene, rays: &[[u32; RAY_WORDS]], coherent: bool, occluded: bool) -> (f64, Vec<f32>) {
+    let mut blocks: Vec<(RayHit16, Valid16)> = rays.chunks(16).map(RayHit16::new).collect();
+    let t = thread_seconds(|| {
+        for (b, valid) in blocks.iter_mut() {
+            if occluded {
+                scene.accel.occluded16(b, valid);
+            } else {
+                scene.accel.intersect16(b, valid, coherent);
+            }
+        }
+    });
+    (t, (0..rays.len()).map(|i| blocks[i / 16].0.tfar(i % 16)).collect())
+}
+
+/// Traces `rays` one per call (closest hit, or any hit when `occluded`): the thread seconds of
+/// the calls alone, and each ray's `tfar` after it.
+pub fn replay1(scene: &Scene, rays: &[[u32; RAY_WORDS]], coherent: bool, occluded: bool) -> (f64, Vec<f32>) {
+    let mut one: Vec<RayHit1> = rays.iter().map(RayHit1::new).collect();
+    let t = thread_seconds(|| {
+        for r in one.iter_mut() {
+            if occluded {
+                scene.accel.occluded1(r);
+            } else {
+                scene.accel.intersect1(r, coherent);
+            }
+        }
+    });
+    (t, one.iter().map(RayHit1::tfar).collect())
 }
 
 /// Every packet the renderer traces for samples `0..spp`, in the renderer's order (tile by tile).

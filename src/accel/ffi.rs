@@ -98,6 +98,95 @@ pub(super) struct QueryArgs {
     min_width_distance_factor: f32,
 }
 
+/// Words of a ray (origin, tnear, direction, time, tfar, mask, id, flags) and of a hit (normal,
+/// u, v, primitive, geometry, instance, instance primitive) in Embree 4.4's structs.
+pub const RAY_WORDS: usize = 12;
+/// Words of an Embree 4.4 hit with one instance level.
+pub const HIT_WORDS: usize = 9;
+
+/// 16 rays and hits, Embree 4.4 `RTCRayHit16` layout (1344 bytes, 64-byte aligned): word `k` of
+/// lane `j` at `16 k + j`, the 12 ray words, then the 9 hit words. Only `strata rays`' replay at
+/// Embree's other packet width uses it (rendering traces 8 wide).
+#[repr(C, align(64))]
+#[derive(Clone, Copy, Debug)]
+pub struct RayHit16(pub [u32; 16 * (RAY_WORDS + HIT_WORDS)]);
+
+/// One ray and hit, Embree 4.4 `RTCRayHit` layout (96 bytes, 16-byte aligned: the 12 ray words,
+/// the 9 hit words, 3 words of padding), for `strata rays`' one-by-one replay.
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug)]
+pub struct RayHit1(pub [u32; 24]);
+
+/// The valid-lane array of a 16-wide query (64-byte aligned for Embree's aligned loads).
+#[repr(C, align(64))]
+#[derive(Clone, Copy, Debug)]
+pub struct Valid16(pub [i32; 16]);
+
+impl RayHit16 {
+    /// Up to 16 rays' words (see [`RAY_WORDS`]) in lanes `0..rays.len()`, hits unset (invalid
+    /// ids), and the valid array of those lanes.
+    pub fn new(rays: &[[u32; RAY_WORDS]]) -> (Self, Valid16) {
+        assert!(rays.len() <= 16, "a 16-wide block holds at most 16 rays");
+        let mut b = Self([0; 16 * (RAY_WORDS + HIT_WORDS)]);
+        let mut valid = Valid16([0; 16]);
+        for (j, r) in rays.iter().enumerate() {
+            for (k, w) in r.iter().enumerate() {
+                b.0[16 * k + j] = *w;
+            }
+            valid.0[j] = -1;
+        }
+        for k in RAY_WORDS + 5..RAY_WORDS + HIT_WORDS {
+            b.0[16 * k..16 * (k + 1)].fill(INVALID_ID);
+        }
+        (b, valid)
+    }
+
+    /// Lane `j`'s `tfar` (the hit distance after an intersect, -inf if occluded).
+    pub fn tfar(&self, j: usize) -> f32 {
+        f32::from_bits(self.0[16 * 8 + j])
+    }
+}
+
+impl RayHit1 {
+    /// One ray's words, hit unset (invalid ids).
+    pub fn new(ray: &[u32; RAY_WORDS]) -> Self {
+        let mut b = Self([0; 24]);
+        b.0[..RAY_WORDS].copy_from_slice(ray);
+        b.0[RAY_WORDS + 5..RAY_WORDS + HIT_WORDS].fill(INVALID_ID);
+        b
+    }
+
+    /// The ray's `tfar` (the hit distance after an intersect, -inf if occluded).
+    pub fn tfar(&self) -> f32 {
+        f32::from_bits(self.0[8])
+    }
+}
+
+impl Ray8 {
+    /// Lane `j`'s words in Embree's order (see [`RAY_WORDS`]).
+    pub fn lane_words(&self, j: usize) -> [u32; RAY_WORDS] {
+        [
+            self.org_x[j].to_bits(),
+            self.org_y[j].to_bits(),
+            self.org_z[j].to_bits(),
+            self.tnear[j].to_bits(),
+            self.dir_x[j].to_bits(),
+            self.dir_y[j].to_bits(),
+            self.dir_z[j].to_bits(),
+            self.time[j].to_bits(),
+            self.tfar[j].to_bits(),
+            self.mask[j],
+            self.id[j],
+            self.flags[j],
+        ]
+    }
+}
+
+const _: () = assert!(std::mem::size_of::<RayHit16>() == 1344 && std::mem::align_of::<RayHit16>() == 64);
+const _: () = assert!(std::mem::size_of::<RayHit1>() == 96 && std::mem::align_of::<RayHit1>() == 16);
+const _: () = assert!(std::mem::size_of::<Valid16>() == 64 && std::mem::align_of::<Valid16>() == 64);
+const _: () = assert!(std::mem::size_of::<sys::RTCRayHit16>() <= std::mem::size_of::<RayHit16>());
+const _: () = assert!(std::mem::size_of::<sys::RTCRayHit>() <= std::mem::size_of::<RayHit1>());
 const _: () = assert!(std::mem::size_of::<Ray8>() == 384);
 const _: () = assert!(std::mem::size_of::<Hit8>() == 288);
 const _: () = assert!(std::mem::size_of::<RayHit8>() == 672);

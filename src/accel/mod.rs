@@ -46,7 +46,7 @@ mod user_geometry;
 
 pub use approx::approx_id;
 pub use device::{cpu_has_avx512, default_isa, AccelError, Device, EmbreeConfig, CONFIG_VAR, DEFAULT_ISA};
-pub use ffi::{Hit8, Ray8, RayHit8, RayQueryContext};
+pub use ffi::{Hit8, Ray8, RayHit1, RayHit16, RayHit8, RayQueryContext, Valid16, HIT_WORDS, RAY_WORDS};
 pub use ftz::{set_ftz_daz, timestamp};
 pub use gather::{gather_u16, hardware_gather, hardware_gather_compiled, set_hardware_gather};
 pub use scene::{GroupId, Hits8, Scene, SceneBuilder};

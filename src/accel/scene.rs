@@ -3,7 +3,9 @@
 
 use super::device::{AccelError, Device};
 use super::ellipsoid::Ellipsoid;
-use super::ffi::{finite_ray, query_args, QueryArgs, Ray8, RayHit8, RayQueryContext, Valid8};
+use super::ffi::{
+    finite_ray, query_args, QueryArgs, Ray8, RayHit1, RayHit16, RayHit8, RayQueryContext, Valid16, Valid8,
+};
 use super::user_geometry::{ellipsoid_bounds, ellipsoid_intersect, ellipsoid_occluded};
 use super::{GEOM_ELLIPSOIDS, GEOM_FIRST_INSTANCE, GEOM_SPHERES, GEOM_TRIANGLES, INVALID_ID};
 use crate::simd::{mask_to_valid, Mask8, F8, U8};
@@ -357,6 +359,73 @@ impl Scene {
             );
         }
         ok & F8::new(ray.tfar).simd_eq(F8::splat(f32::NEG_INFINITY))
+    }
+}
+
+impl Scene {
+    /// Closest hits of the valid lanes of a 16-ray block (`strata rays`' replay at Embree's 16-wide
+    /// entry point; rendering traces 8 wide). The rays must be finite ([`RayHit16::new`] of
+    /// logged, traced lanes).
+    pub fn intersect16(&self, rh: &mut RayHit16, valid: &Valid16, coherent: bool) {
+        let mut ctx = RayQueryContext { inst_id: [INVALID_ID], inst_prim_id: [INVALID_ID] };
+        let mut args = query_args(coherent, &mut ctx);
+        // SAFETY: `rh` has the 4.4 RTCRayHit16 layout (size and 64-byte alignment asserted in
+        // ffi.rs); `valid` holds 16 ints, 64-byte aligned; args/context as in intersect8.
+        unsafe {
+            sys::rtcIntersect16(
+                valid.0.as_ptr(),
+                self.raw,
+                rh as *mut RayHit16 as *mut sys::RTCRayHit16,
+                &mut args as *mut QueryArgs as *mut sys::RTCIntersectArguments,
+            );
+        }
+    }
+
+    /// Any-hit test of the valid lanes of a 16-ray block (its ray part); occluded lanes get
+    /// `tfar = -inf`. For `strata rays`' replay, as [`Scene::intersect16`].
+    pub fn occluded16(&self, r: &mut RayHit16, valid: &Valid16) {
+        let mut ctx = RayQueryContext { inst_id: [INVALID_ID], inst_prim_id: [INVALID_ID] };
+        let mut args = query_args(false, &mut ctx);
+        // SAFETY: the block starts with the RTCRay16 layout (12 fields of 16 lanes), 64-byte
+        // aligned; `valid` holds 16 ints, 64-byte aligned; args/context as in intersect8.
+        unsafe {
+            sys::rtcOccluded16(
+                valid.0.as_ptr(),
+                self.raw,
+                r as *mut RayHit16 as *mut sys::RTCRay16,
+                &mut args as *mut QueryArgs as *mut sys::RTCOccludedArguments,
+            );
+        }
+    }
+
+    /// Closest hit of one finite ray (`strata rays`' one-by-one replay).
+    pub fn intersect1(&self, rh: &mut RayHit1, coherent: bool) {
+        let mut ctx = RayQueryContext { inst_id: [INVALID_ID], inst_prim_id: [INVALID_ID] };
+        let mut args = query_args(coherent, &mut ctx);
+        // SAFETY: `rh` has the 4.4 RTCRayHit layout (96 bytes, 16-byte aligned, asserted in
+        // ffi.rs); args/context as in intersect8.
+        unsafe {
+            sys::rtcIntersect1(
+                self.raw,
+                rh as *mut RayHit1 as *mut sys::RTCRayHit,
+                &mut args as *mut QueryArgs as *mut sys::RTCIntersectArguments,
+            );
+        }
+    }
+
+    /// Any-hit test of one finite ray (its ray part); occluded: `tfar = -inf`.
+    pub fn occluded1(&self, r: &mut RayHit1) {
+        let mut ctx = RayQueryContext { inst_id: [INVALID_ID], inst_prim_id: [INVALID_ID] };
+        let mut args = query_args(false, &mut ctx);
+        // SAFETY: the block starts with the RTCRay layout (12 words), 16-byte aligned;
+        // args/context as in intersect8.
+        unsafe {
+            sys::rtcOccluded1(
+                self.raw,
+                r as *mut RayHit1 as *mut sys::RTCRay,
+                &mut args as *mut QueryArgs as *mut sys::RTCOccludedArguments,
+            );
+        }
     }
 }
 

@@ -83,6 +83,70 @@ fn abi_canaries_survive_plain_and_instanced_hits() {
     dev.take_errors().unwrap();
 }
 
+/// `strata rays`' 16-wide and one-by-one replays read and write Embree 4.4's `RTCRayHit16` and
+/// `RTCRayHit` through our word layouts: the same hit distances and ids as the 8-wide query on
+/// triangles, both sphere kinds and an instance (instPrimID included), the same occlusion, and
+/// nothing written past the structs.
+#[test]
+fn other_widths_find_the_hits_of_eight_wide_packets() {
+    let dev = Device::new().unwrap();
+    let scene = build(&dev, true);
+    let xs = [0.0, 3.0, 3.0, 0.0, -3.0, -3.1, 10.0, 0.0];
+    let ys = [0.0, 3.0, 0.0, 3.1, 0.0, 0.05, 0.0, -0.9];
+    let (org, dir) = packet(xs, ys);
+    let mut rh = RayHit8::default();
+    rh.ray.set(org, dir, F8::ZERO, F8::splat(f32::INFINITY), mask_all());
+    let words: Vec<[u32; RAY_WORDS]> = (0..16).map(|i| rh.ray.lane_words(i % 8)).collect();
+    let traced = scene.intersect8(&mut rh, false, mask_all());
+    let h = Hits8::from_rayhit(&rh, traced);
+    let (t8, prim, geom, inst) = (h.t.to_array(), h.prim.to_array(), h.geom.to_array(), h.inst.to_array());
+    let mut b16 = Canaried { value: RayHit16::new(&words).0, canary: [CANARY; 64] };
+    let valid = RayHit16::new(&words).1;
+    scene.intersect16(&mut b16.value, &valid, false);
+    assert!(b16.canary.iter().all(|&w| w == CANARY), "Embree wrote past RayHit16");
+    for (j, w) in words.iter().enumerate() {
+        let mut one = Canaried { value: RayHit1::new(w), canary: [CANARY; 64] };
+        scene.intersect1(&mut one.value, j % 2 == 0);
+        assert!(one.canary.iter().all(|&w| w == CANARY), "Embree wrote past RayHit1");
+        let l = j % 8;
+        // tfar is untouched on a miss (lane 6): infinity in every form.
+        let want = if mask_to_bools(h.hit)[l] { t8[l] } else { f32::INFINITY };
+        assert_eq!(b16.value.tfar(j).to_bits(), want.to_bits(), "16-wide lane {j}");
+        assert_eq!(one.value.tfar().to_bits(), want.to_bits(), "one ray {j}");
+        // Hit words: primID, geomID, instID, instPrimID after Ng and u, v.
+        let ids16: [u32; 4] = std::array::from_fn(|k| b16.value.0[16 * (RAY_WORDS + 5 + k) + j]);
+        let ids1: [u32; 4] = std::array::from_fn(|k| one.value.0[RAY_WORDS + 5 + k]);
+        let want = [prim[l], geom[l], inst[l], rh.hit.inst_prim_id[0][l]];
+        assert_eq!(ids16, want, "16-wide ids lane {j}");
+        assert_eq!(ids1, want, "one ray's ids {j}");
+    }
+    // Occlusion within tfar = 100 (every lane but 6), and not within 1.
+    for (tfar, hit) in [(100.0f32, mask_to_bools(h.hit)), (1.0, [false; 8])] {
+        let near: Vec<[u32; RAY_WORDS]> = words
+            .iter()
+            .map(|w| {
+                let mut w = *w;
+                w[8] = tfar.to_bits();
+                w
+            })
+            .collect();
+        let (mut b, valid) = RayHit16::new(&near);
+        scene.occluded16(&mut b, &valid);
+        for (j, w) in near.iter().enumerate() {
+            let mut one = RayHit1::new(w);
+            scene.occluded1(&mut one);
+            let occluded = hit[j % 8];
+            assert_eq!(b.tfar(j) == f32::NEG_INFINITY, occluded, "16-wide occluded lane {j} tfar {tfar}");
+            assert_eq!(one.tfar() == f32::NEG_INFINITY, occluded, "one ray occluded {j} tfar {tfar}");
+        }
+    }
+    // A short block: the lanes past the rays are not valid, so not traced.
+    let (mut b, valid) = RayHit16::new(&words[..3]);
+    scene.intersect16(&mut b, &valid, true);
+    assert!((3..16).all(|j| b.tfar(j) == 0.0 && b.0[16 * (RAY_WORDS + 6) + j] == INVALID_ID));
+    dev.take_errors().unwrap();
+}
+
 #[test]
 fn inactive_and_nan_lanes_are_not_traced() {
     let dev = Device::new().unwrap();

@@ -17,16 +17,19 @@ pub fn run_rays(opts: &RenderOptions) -> Result<(RayRates, String), SessionError
 
 /// A small table of [`RayRates`].
 pub fn rates_table(name: &str, r: &RayRates) -> String {
+    let kinds = |c: f64, b: f64, s: f64| format!("(camera {c:.2}, bounce {b:.2}, shadow {s:.2})");
     format!(
-        "{name}: {} camera + {} bounce + {} shadow rays, 1 thread\n  renderer          {:8.2} Mrays/s\n  Embree raw mixed  {:8.2} Mrays/s  (camera {:.2}, bounce {:.2}, shadow {:.2})\n  renderer / raw    {:8.1} %",
+        "{name}: {} camera + {} bounce + {} shadow rays, 1 thread\n  renderer          {:8.2} Mrays/s\n  Embree raw mixed  {:8.2} Mrays/s  {}\n  renderer / raw    {:8.1} %\n  Embree alone on the same lanes at its other widths (rendering traces 8 wide):\n    16 wide         {:8.2} Mrays/s  {}\n    one by one      {:8.2} Mrays/s  {}",
         r.camera_rays,
         r.bounce_rays,
         r.shadow_rays,
         r.renderer_mrays,
         r.raw_mixed_mrays,
-        r.raw_camera_mrays,
-        r.raw_bounce_mrays,
-        r.raw_shadow_mrays,
-        100.0 * r.ratio
+        kinds(r.raw_camera_mrays, r.raw_bounce_mrays, r.raw_shadow_mrays),
+        100.0 * r.ratio,
+        r.raw16_mixed_mrays,
+        kinds(r.raw16_camera_mrays, r.raw16_bounce_mrays, r.raw16_shadow_mrays),
+        r.raw1_mixed_mrays,
+        kinds(r.raw1_camera_mrays, r.raw1_bounce_mrays, r.raw1_shadow_mrays),
     )
 }

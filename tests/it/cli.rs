@@ -73,7 +73,15 @@ fn rays_reports_renderer_next_to_embree() {
     let r = strata().args(["rays", "--size", "48x48", "--spp", "1", "--json"]).output().unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let j: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
-    for key in ["renderer_mrays", "raw_camera_mrays", "raw_shadow_mrays", "raw_mixed_mrays", "ratio"] {
+    for key in [
+        "renderer_mrays",
+        "raw_camera_mrays",
+        "raw_shadow_mrays",
+        "raw_mixed_mrays",
+        "ratio",
+        "raw16_mixed_mrays",
+        "raw1_mixed_mrays",
+    ] {
         assert!(j[key].as_f64().is_some_and(|v| v > 0.0), "{key} in {j}");
     }
     assert_eq!(j["camera_rays"], 48 * 48);
