@@ -212,7 +212,7 @@ pub struct Emitters {
     /// each light's [`WarpRow`], then an all-zero row (kind [`WarpRow::NONE`]) that lanes
     /// without a light gather
     pub warp_rows: Vec<WarpRow>,
-    /// the lights' [`PlaceRow`]s as lane columns, where they fit ([`LaneTable`])
+    /// the lights' fields ([`place_row`]) as lane columns, where they fit ([`LaneTable`])
     place_lanes: Option<LaneTable<PLACE_FIELDS>>,
     /// `warp_rows` as lane columns, where they fit
     pub(super) warp_lanes: Option<LaneTable<16>>,
