@@ -100,8 +100,8 @@ fn other_widths_find_the_hits_of_eight_wide_packets() {
     let traced = scene.intersect8(&mut rh, false, mask_all());
     let h = Hits8::from_rayhit(&rh, traced);
     let (t8, prim, geom, inst) = (h.t.to_array(), h.prim.to_array(), h.geom.to_array(), h.inst.to_array());
-    let mut b16 = Canaried { value: RayHit16::new(&words).0, canary: [CANARY; 64] };
-    let valid = RayHit16::new(&words).1;
+    let (block, valid) = RayHit16::new(&words);
+    let mut b16 = Canaried { value: block, canary: [CANARY; 64] };
     scene.intersect16(&mut b16.value, &valid, false);
     assert!(b16.canary.iter().all(|&w| w == CANARY), "Embree wrote past RayHit16");
     for (j, w) in words.iter().enumerate() {

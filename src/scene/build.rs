@@ -186,34 +186,36 @@ pub enum BuildError {
     Gather(String, &'static str),
 }
 
+/// A two-way switch in the environment variable `name`: `on` (Some(true)), `off` (Some(false)),
+/// unset, empty or one of `auto` (None); any other value (or one that is not Unicode, lossily) is
+/// returned as the error.
+fn env_switch(name: &str, on: &str, off: &str, auto: &[&str]) -> Result<Option<bool>, String> {
+    match std::env::var(name) {
+        Ok(v) if v == on => Ok(Some(true)),
+        Ok(v) if v == off => Ok(Some(false)),
+        Ok(v) if v.is_empty() || auto.contains(&v.as_str()) => Ok(None),
+        Ok(v) => Err(v),
+        Err(std::env::VarError::NotPresent) => Ok(None),
+        Err(std::env::VarError::NotUnicode(v)) => Err(v.to_string_lossy().into_owned()),
+    }
+}
+
 /// The BVH quality `STRATA_BVH` forces: `high` (true), `medium` (false), unset or empty (None:
 /// by triangle count); anything else is refused (before, a misspelling was silently ignored).
 pub fn forced_bvh() -> Result<Option<bool>, BuildError> {
-    match std::env::var("STRATA_BVH") {
-        Ok(v) if v == "high" => Ok(Some(true)),
-        Ok(v) if v == "medium" => Ok(Some(false)),
-        Ok(v) if v.is_empty() => Ok(None),
-        Ok(v) => Err(BuildError::Bvh(v)),
-        Err(std::env::VarError::NotPresent) => Ok(None),
-        Err(std::env::VarError::NotUnicode(v)) => Err(BuildError::Bvh(v.to_string_lossy().into_owned())),
-    }
+    env_switch("STRATA_BVH", "high", "medium", &[]).map_err(BuildError::Bvh)
 }
 
 /// How table look-ups run (`accel::gather_u16`; the values are the same either way, only the
 /// speed differs) as `STRATA_GATHER` says: `hardware` (Some(true): AVX2's gather), `scalar`
 /// (Some(false)), `auto`, empty or unset (None: the gather on AMD CPUs); anything else is refused.
 pub fn forced_gather() -> Result<Option<bool>, BuildError> {
-    let v = match std::env::var("STRATA_GATHER") {
-        Ok(v) => v,
-        Err(std::env::VarError::NotPresent) => return Ok(None),
-        Err(std::env::VarError::NotUnicode(v)) => return Err(BuildError::Gather(v.to_string_lossy().into_owned(), "")),
-    };
-    match v.as_str() {
-        "" | "auto" => Ok(None),
-        "hardware" if accel::hardware_gather_compiled() => Ok(Some(true)),
-        "hardware" => Err(BuildError::Gather(v, " (this build has no AVX2: `scalar` or `auto`)")),
-        "scalar" => Ok(Some(false)),
-        _ => Err(BuildError::Gather(v, "")),
+    match env_switch("STRATA_GATHER", "hardware", "scalar", &["auto"]) {
+        Ok(Some(true)) if !accel::hardware_gather_compiled() => {
+            Err(BuildError::Gather("hardware".into(), " (this build has no AVX2: `scalar` or `auto`)"))
+        }
+        Ok(v) => Ok(v),
+        Err(v) => Err(BuildError::Gather(v, "")),
     }
 }
 
