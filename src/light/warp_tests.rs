@@ -251,7 +251,8 @@ fn warps_x8_match_scalar_bit_for_bit() {
     }
 }
 
-/// The rectangle warp in f64 (the same formulas), for the precision measurement.
+/// The rectangle warp in f64 (the paper's formulas, four asin and the three steps fu, cu, xu), for
+/// the precision measurement.
 #[allow(clippy::too_many_arguments)]
 fn rect_f64(o: DVec3, c: DVec3, ex: DVec3, ey: DVec3, lx: f64, ly: f64, u: f64, v: f64) -> DVec3 {
     let d = c - o;

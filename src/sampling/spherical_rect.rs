@@ -9,15 +9,20 @@
 //! the paper's `g0 + g1 + g2 + g3 - 2 pi` (in f32 that cancellation loses every digit of a small
 //! S). Each asin is an atan2 of a dot and a cross product (no clamp, no loss near +-1), and a
 //! pair's sum one atan2 of a product of complex numbers: two polynomial atan2 per shading point
-//! rather than four asin and four divisions. u picks the x of the point by inverting the area to the left of x (the paper's
-//! `au = u S + k`), v its y uniformly in the height `h = y / sqrt(x^2 + y^2 + z0^2)` along the
-//! column, which is uniform in solid angle. The density is 1 / S per unit solid angle.
+//! (`simd::math::atan2`, one division each) rather than four asin and four divisions; the
+//! coordinates are scaled by a power of two. u picks the x of the point by inverting the area to
+//! the left of x (the paper's `au = u S + k`; its three steps `fu`, `cu`, `xu` multiplied out into
+//! one square root and one division), v its y uniformly in the height `h = y / sqrt(x^2 + y^2 +
+//! z0^2)` along the column, which is uniform in solid angle. The density is 1 / S per unit solid
+//! angle. The warp's cost is latency (a chain of divisions and square roots per shading point,
+//! which the lanes wait on), so the forms here are the ones with the shortest chain.
 //!
 //! Only the x8 form does arithmetic; the scalar form is lane 0 of it on splatted input, so the two
 //! are bit-identical. Precision: for a small S the argument `au`, near pi/2 .. pi, keeps
 //! `ulp(au) / S` of u's resolution; see `light::warp` for the solid angle under which the caller
 //! falls back to area sampling.
 
+use crate::simd::math::{atan2, pow2_recip};
 use crate::simd::{Vec3x8, F8};
 use glam::Vec3;
 
@@ -36,6 +41,8 @@ pub struct SphericalRect8 {
     y1: F8,
     b0: F8,
     b1: F8,
+    /// `sqrt(1 - b0^2) = -z0 / l0`
+    w: F8,
     k: F8,
     s: F8,
 }
@@ -62,8 +69,8 @@ impl SphericalRect8 {
         // the distance to the corner between the two edges (the normals' lengths cancel). A
         // pair's sum is the argument of the product of their (cos, sin) pairs: two atan2 in all.
         // Coordinates are scaled to about 1 first (S is scale-free) to keep the fourth powers
-        // in f32's range.
-        let inv = F8::ONE / (x0.abs() + x1.abs() + y0.abs() + y1.abs() - z0);
+        // in f32's range: by a power of two, which rounds nothing and needs no division.
+        let inv = pow2_recip(x0.abs() + x1.abs() + y0.abs() + y1.abs() - z0);
         let (sx0, sx1, sy0, sy1, sz0) = (x0 * inv, x1 * inv, y0 * inv, y1 * inv, z0 * inv);
         let (sz2, az) = (sz0 * sz0, -sz0);
         let r = |x: F8, y: F8| az * x.mul_add(x, y.mul_add(y, sz2)).sqrt();
@@ -71,7 +78,7 @@ impl SphericalRect8 {
         let (p1, q1) = (sx1 * sy1, r(sx1, sy1));
         let (p2, q2) = (-(sy1 * sx0), r(sx0, sy1));
         let (p3, q3) = (sx0 * sy0, r(sx0, sy0));
-        let arg = |(p, q): (F8, F8), (p2, q2): (F8, F8)| q.mul_add(p2, p * q2).atan2(q.mul_add(q2, -(p * p2)));
+        let arg = |(p, q): (F8, F8), (p2, q2): (F8, F8)| atan2(q.mul_add(p2, p * q2), q.mul_add(q2, -(p * p2)));
         let a01 = arg((p0, q0), (p1, q1));
         let a23 = arg((p2, q2), (p3, q3));
         let s = a01 + a23;
@@ -79,7 +86,9 @@ impl SphericalRect8 {
         let k = F8::PI - a23;
         let (l0, l2) = (y0.mul_add(y0, z2).sqrt(), y1.mul_add(y1, z2).sqrt());
         let (b0, b1) = (-y0 / l0, y1 / l2);
-        Self { o, ex, ey, ez, x0, y0, z0, x1, y1, b0, b1, k, s }
+        // sqrt(1 - b0^2), the sine of the angle whose cosine is b0.
+        let w = -z0 / l0;
+        Self { o, ex, ey, ez, x0, y0, z0, x1, y1, b0, b1, w, k, s }
     }
 
     /// The solid angle S (0 or NaN-free; 0 where `o` lies in the rectangle's plane).
@@ -94,14 +103,18 @@ impl SphericalRect8 {
     /// back to area sampling there).
     #[inline]
     pub fn sample(&self, u: F8, v: F8) -> Vec3x8 {
-        let Self { x0, y0, z0, x1, y1, b0, b1, k, s, .. } = *self;
+        let Self { x0, y0, z0, x1, y1, b0, b1, w, k, s, .. } = *self;
         let au = u.mul_add(s, k);
         let (sin_au, cos_au) = au.sin_cos();
-        let fu = cos_au.mul_add(b0, -b1) / sin_au;
-        let r = F8::ONE / fu.mul_add(fu, b0 * b0).sqrt();
-        let cu = fu.simd_lt(F8::ZERO).select(-r, r).max(-F8::ONE).min(F8::ONE);
+        // The paper's fu = n / sin(au), cu = sign(fu) / sqrt(fu^2 + b0^2) and xu = -cu z0 /
+        // sqrt(1 - cu^2), multiplied out: xu = -sign(n) sin(au) z0 / sqrt(n^2 - w^2 sin(au)^2),
+        // with n^2 - w^2 sin^2 as (n - w sin)(n + w sin) (no cancellation of the squares). One
+        // square root and one division where the three steps chained three of each.
+        let n = cos_au.mul_add(b0, -b1);
         let tiny = F8::splat(f32::MIN_POSITIVE);
-        let xu = -(cu * z0) / (F8::ONE - cu * cu).max(tiny).sqrt();
+        let q = w.mul_neg_add(sin_au, n) * w.mul_add(sin_au, n);
+        let num = -(sin_au * z0).flip_signs(n);
+        let xu = num / q.max(tiny).sqrt();
         let xu = xu.max(x0).min(x1);
         let dd = xu.mul_add(xu, z0 * z0);
         let h0 = y0 / y0.mul_add(y0, dd).sqrt();

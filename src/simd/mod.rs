@@ -8,6 +8,8 @@
 use glam::Vec3;
 pub use wide::{f32x8, i32x8, u32x8};
 
+pub mod math;
+
 /// Eight f32 lanes.
 pub type F8 = f32x8;
 /// Eight u32 lanes.
