@@ -360,8 +360,7 @@ fn resource_caps_name_the_limit_and_how_to_raise_it() {
 #[test]
 fn cli_limit_flag_raises_caps_and_overrides_are_capped() {
     let bin = env!("CARGO_BIN_EXE_strata");
-    let dir = std::env::temp_dir().join(format!("strata-hostile-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("cli");
     let run = |args: &[&str]| {
         let o =
             std::process::Command::new(bin).args(args).arg("-o").arg(dir.join("img")).arg("--quiet").output().unwrap();
@@ -383,7 +382,6 @@ fn cli_limit_flag_raises_caps_and_overrides_are_capped() {
     assert!(!ok && err.contains("<built-in cornell>:3:") && err.contains("--limit max_side=N"), "{err}");
     let (ok, err) = run(&with(&["--limit", "bogus=1"]));
     assert!(!ok && err.contains("unknown limit") && err.contains("max_transform_depth"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Runs `strata ARGS` in `dir`; kills it and fails if it takes more than `secs` seconds.
@@ -408,10 +406,8 @@ fn run_within(dir: &Path, args: &[&str], secs: u64) -> (Option<i32>, String) {
     (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("strata-hostile-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> common::Scratch {
+    common::tmpdir(&format!("hostile-{name}"))
 }
 
 /// `--threads` far above the cores is refused before any thread starts, naming the limit;
@@ -428,7 +424,6 @@ fn cli_threads_above_the_cap_are_refused() {
         60,
     );
     assert_eq!(code, Some(0), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A missing output or checkpoint directory fails before rendering: at a spp that would take
@@ -450,7 +445,6 @@ fn cli_unwritable_outputs_fail_before_rendering() {
         assert!(code == Some(1) && err.contains(&m) && err.contains("cannot write"), "{extra:?}: {err}");
     }
     assert!(!dir.join("img.png").exists(), "nothing was rendered");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A sampler asked for more points than it has distinct ones is refused, naming the limit and
@@ -468,7 +462,6 @@ fn cli_sampler_past_its_period_is_refused() {
     assert!(code == Some(1) && err.contains("4096") && err.contains("--light-sampler sobol"), "{err}");
     let (code, err) = run_within(&dir, &with(&["--spp", "4096", "--pixel-sampler", "pmj02"]), 120);
     assert_eq!(code, Some(0), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// SIGTERM while a big OBJ is still loading exits promptly with code 130 and writes nothing
@@ -501,7 +494,6 @@ fn cli_sigterm_during_loading_exits_promptly() {
     assert_eq!(o.status.code(), Some(130), "{err}");
     assert!(err.contains("interrupted before rendering started"), "{err}");
     assert!(!dir.join("big.png").exists() && !dir.join("big.ckpt").exists(), "nothing written");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// An OBJ without emitters gets a default light (announced), so it renders lit; with
@@ -541,7 +533,6 @@ fn unlit_obj_gets_a_default_light() {
         let lit = mean(o);
         assert!(lit > 0.05, "{m}: mean {lit} with the default light");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 // Issue 25 (the same pixels on every node, never a lost render, never a clobbered file): one

@@ -6,10 +6,12 @@ use super::*;
 use crate::sampler::file::Scramble;
 use crate::sampler::{PointSet, SamplerKind};
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("strata-pointset-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// `name` in a fresh scratch directory, which goes (with everything in it) when the test drops
+/// the directory: keep it bound.
+fn tmp(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::Builder::new().prefix("strata-pointset-").tempdir().unwrap();
+    let p = dir.path().join(name);
+    (dir, p)
 }
 
 fn sample_sets() -> PointSets {
@@ -34,7 +36,7 @@ fn utk_text_loads_sets_separated_by_hash() {
 fn each_format_round_trips() {
     let ps = sample_sets();
     for name in ["a.txt", "a.dat", "a.bin", "a.npy"] {
-        let p = tmp(name);
+        let (_dir, p) = tmp(name);
         formats::write(&p, &ps).unwrap();
         let back = formats::read(&p).unwrap();
         assert_eq!((back.sets, back.points, back.dims, &back.data), (2, 3, 2, &ps.data), "{name}");
@@ -71,7 +73,7 @@ fn npy_float32_two_dimensional_and_fortran_order_load() {
 
 #[test]
 fn utk_bin_header_is_checked() {
-    let p = tmp("h.bin");
+    let (_dir, p) = tmp("h.bin");
     formats::write(&p, &sample_sets()).unwrap();
     let good = std::fs::read(&p).unwrap();
     assert_eq!(&good[..4], b"UTK!");
@@ -144,7 +146,7 @@ fn one_coordinate_sets_need_pad() {
 
 #[test]
 fn a_loaded_file_is_a_sampler() {
-    let p = tmp("s.txt");
+    let (_dir, p) = tmp("s.txt");
     formats::write(&p, &sample_sets()).unwrap();
     let k = resolve_sampler(&format!("file:{}?scramble=none&sets=pixel&shuffle=none", p.display())).unwrap();
     assert!(k.name().starts_with("file:") && k.name().ends_with("s.txt?scramble=none&sets=pixel&shuffle=none"));
@@ -167,7 +169,7 @@ fn pointset_plots_floor_the_spectrum_guide_white_noise_and_write_round_trip_csv(
         convergence: vec![conv],
         progressive: None,
     };
-    let dir = tmp("plots");
+    let (_scratch, dir) = tmp("plots");
     write_outputs(&dir, &r).unwrap();
     let csv = std::fs::read_to_string(dir.join("spectrum.csv")).unwrap();
     assert!(csv.contains("2,4.5e-31\n") && !csv.contains("0.0000"), "{csv}");

@@ -40,7 +40,6 @@ fn default_render_is_the_best_isa_render() {
     assert_eq!(meta(&ma, "strata.embree_approx"), approx);
     assert_eq!(meta(&ma, "strata.build"), strata::checkpoint::identity::BUILD);
     assert!(!meta(&ma, "strata.commit").is_empty() && !meta(&ma, "strata.embree_version").is_empty());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A shard rendered with `isa=avx2` on an AVX-512 CPU (or `STRATA_SPHERES=embree`) is refused
@@ -89,7 +88,6 @@ fn shards_of_another_isa_or_sphere_intersector_are_refused() {
     builtin("b1", "2..4", &[("STRATA_SPHERES", "embree")]);
     let r = strata(&dir, &["merge", "b0.ckpt", "b1.ckpt", "-o", "bm", "-q"], 60);
     assert!(r.code == Some(1) && r.err.contains(r#"spheres "embree" (b0.ckpt: "strata")"#), "{}", r.err);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A part written by another build is refused by `merge` (naming both builds and the flag) and
@@ -114,7 +112,6 @@ fn parts_of_another_build_need_allow_other_build() {
     assert_eq!(r.code, Some(0), "{}", r.err);
     let (_, m) = exr(&dir.join("m.exr"));
     assert_eq!(meta(&m, "strata.build"), format!("{} + 0123456789abcdef", strata::checkpoint::identity::BUILD));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Instruction sets below AVX2 and unknown keys are refused before rendering, with the reason
@@ -138,7 +135,6 @@ fn embree_configs_below_avx2_or_unknown_are_refused() {
         assert!(r.err.contains("STRATA_EMBREE_CONFIG") && r.err.contains(says), "{cfg}: {}", r.err);
         assert!(!dir.join("d.png").exists());
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `STRATA_GATHER` (how Halton's digit tables are looked up: AVX2's hardware gather, the default
@@ -163,5 +159,4 @@ fn the_gather_switch_keeps_the_pixels_and_refuses_unknown_values() {
     assert_eq!(r.code, Some(1), "{}", r.err);
     assert!(r.err.contains(r#"STRATA_GATHER="fast": expected `auto`, `hardware` or `scalar`"#), "{}", r.err);
     assert!(!dir.join("bad.exr").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -25,7 +25,6 @@ fn renders_over_the_memory_limit_are_refused_with_the_estimate() {
     assert!(r.code == Some(1) && r.err.contains("above the limit of 1.0 MiB"), "{}", r.err);
     let r = strata(&dir, &small, 60);
     assert_eq!(r.code, Some(0), "{}", r.err);
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// `render /dev/zero` and an OBJ that is /dev/zero fail within seconds (a NUL byte: not text),
@@ -48,7 +47,6 @@ fn endless_or_oversized_inputs_fail_fast() {
     let r = strata(&dir, &["render", "big.test", "--limit", "max_file_bytes=4000", "-o", "b", "-q"], 30);
     assert!(r.code == Some(1) && r.err.contains("larger than the limit of 4000 bytes"), "{}", r.err);
     assert!(r.err.contains("--limit max_file_bytes=N"), "{}", r.err);
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// `gen-mesh --triangles 1000000000` is refused cleanly when it does not fit (before: an abort on
@@ -63,7 +61,6 @@ fn gen_mesh_too_big_for_memory_is_refused() {
     assert_eq!(r.code, Some(1), "{}", r.err);
     assert!(r.err.contains("the mesh needs about") && r.err.contains("GiB"), "{}", r.err);
     assert!(!dir.join("big.obj").exists());
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// A scene of the built-in Cornell box's walls and light, with `light` the quadLight's radiance.
@@ -99,7 +96,6 @@ fn non_finite_samples_warn_and_negative_radiance_is_refused() {
     fs::write(dir.join("neg2.test"), box_scene("1 1 1") + "emission 0 -2 0\n").unwrap();
     let r = strata(&dir, &["render", "neg2.test", "-o", "neg", "-q"], 60);
     assert!(r.code == Some(1) && r.err.contains("neg2.test:13:"), "{}", r.err);
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// `--spp 0` and `--light-samples 0` are usage errors, as in scene files (before: silently 1); a render
@@ -122,7 +118,6 @@ fn zero_samples_are_errors_that_keep_old_outputs() {
     assert_eq!(r.code, Some(1), "{}", r.err);
     assert!(r.err.contains("no sample was rendered") && r.err.contains("--time-budget"), "{}", r.err);
     assert_eq!((fs::read(dir.join("z.png")).unwrap(), fs::read(dir.join("z.exr")).unwrap()), before);
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// An `mtllib` outside the OBJ's directory is read with a warning naming it; a triangle whose area
@@ -145,5 +140,4 @@ fn outside_mtllib_warns_and_overflowed_areas_are_named() {
     assert_eq!(r.code, Some(0), "{}", r.err);
     assert!(r.err.contains("1 triangle whose area overflows f32"), "{}", r.err);
     assert!(!r.err.contains("zero-area"), "{}", r.err);
-    fs::remove_dir_all(&dir).ok();
 }

@@ -107,7 +107,6 @@ fn no_output_flag_may_name_an_input_of_its_subcommand() {
     }
     assert!(cases >= 60, "{cases} cases");
     assert!(failures.is_empty(), "{} of {cases} cases failed:\n{}", failures.len(), failures.join("\n"));
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// Two outputs of one command naming one file, and a gen-mesh OBJ or MTL that is a link, a FIFO
@@ -141,7 +140,6 @@ fn outputs_colliding_or_special_are_refused_for_every_subcommand() {
     // A size that does not fit is refused before it is allocated (before: `capacity overflow`, 101).
     let r = strata(&dir, &["gen-mesh", "--triangles", "9223372036854775807", "big.obj"], 20);
     assert!(r.code == Some(1) && r.err.contains("needs about"), "{:?}: {}", r.code, r.err);
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// New outputs get 0666 less the umask (0644 under umask 022), replaced ones keep their mode.
@@ -164,7 +162,6 @@ fn outputs_get_the_umask_mode_or_the_replaced_files() {
     let r = shell(&dir, script, &["gen-mesh", "--triangles", "100", "m.obj"], 60);
     assert_eq!(r.code, Some(0), "{}", r.err);
     assert_eq!((mode("m.obj"), mode("m.mtl")), (0o644, 0o644));
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// Devices, FIFOs and oversized files named as inputs fail at once with what they are, under a
@@ -211,7 +208,6 @@ fn special_or_oversized_inputs_are_refused_before_reading() {
             r.err
         );
     }
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// The image directory removed during the render: the images cannot be written, the checkpoint
@@ -245,7 +241,6 @@ fn an_image_that_cannot_be_written_keeps_the_checkpoint() {
     assert!(r.err.contains("imgs/img.exr") && r.err.contains("written: c.ckpt"), "{}", r.err);
     let (h, _) = strata::checkpoint::read(&dir.join("c.ckpt")).unwrap();
     assert_eq!(h.samples, [0, 4096], "the whole render is in the checkpoint");
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// A file-size limit (`ulimit -f`, SIGXFSZ not ignored by the caller): exit 1 with `File too
@@ -262,7 +257,6 @@ fn a_file_size_limit_is_an_error_not_a_kill() {
         let name = e.unwrap().file_name().to_string_lossy().into_owned();
         assert!(!name.ends_with(".tmp") && !name.starts_with('.'), "left: {name}");
     }
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// A second render to the `-o` of a running one is refused (before: both ran and the EXR of one
@@ -279,7 +273,6 @@ fn a_second_render_to_the_same_output_is_refused() {
     assert!(r.err.contains("first=0 second=1"), "{}", r.err);
     assert!(r.err.contains("another strata process is writing this output"), "{}", r.err);
     assert!(!dir.join(".same.lock").exists(), "the lock is removed");
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// Smaller findings: `--samples` checkpoints periodically to OUT.ckpt; `-o` stems too long for the
@@ -330,7 +323,6 @@ fn smaller_findings() {
         let r = strata(&dir, &["pointset", f], 20);
         assert!(r.code == Some(1) && r.err.contains(says), "{f}: {}", r.err);
     }
-    fs::remove_dir_all(&dir).ok();
 }
 
 /// Smaller findings, continued: an OBJ whose only triangle overflows is an error, not a black
@@ -369,5 +361,4 @@ fn smaller_findings_of_scenes_and_commands() {
     assert!(!r.err.contains("4294967295"), "{}", r.err);
     let r = super::run::strata_env(&dir, &["render", "s.test", "-o", "b", "-q"], &[("STRATA_BVH", "bogus")], 60);
     assert!(r.code == Some(1) && r.err.contains("STRATA_BVH=\"bogus\""), "{}", r.err);
-    fs::remove_dir_all(&dir).ok();
 }

@@ -2,7 +2,7 @@
 //! shell (for `ulimit`, planted links), with a time limit. `STRATA_TEST_BINARY` runs another
 //! binary (e.g. an older build, to see a test fail on the code it fixes).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -58,12 +58,9 @@ pub fn shell(dir: &Path, script: &str, args: &[&str], secs: u64) -> Run {
     run_cmd(cmd, dir, secs)
 }
 
-/// A fresh scratch directory.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("strata-hostile25-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh scratch directory, removed when dropped ([`crate::common::tmpdir`]).
+pub fn scratch(name: &str) -> crate::common::Scratch {
+    crate::common::tmpdir(&format!("hostile25-{name}"))
 }
 
 /// The pixel channels of an EXR: (layer name, f32 bits).

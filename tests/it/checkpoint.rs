@@ -97,7 +97,6 @@ fn sigkill_mid_render_then_resume_is_bit_identical() {
     assert_eq!(held(&ckpt), 0..spp, "the resumed run checkpoints into its --resume file");
     let (_, _, meta) = image(&d.join("resumed"));
     assert_eq!(meta["strata.spp"], spp.to_string());
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -116,7 +115,6 @@ fn sigterm_writes_checkpoint_and_image_then_resumes_bit_identically() {
     run_ok(c);
     run_ok(render_cmd(spp, &d.join("whole"), &[]));
     assert_same_image(&d.join("whole"), &d.join("t"));
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// The GNU-parallel recipe of examples/cluster, done with std::process: several processes each
@@ -184,7 +182,6 @@ fn shards_from_parallel_processes_merge_bit_identically() {
     let e = merge_err(&[parts[3].clone(), parts[2].clone(), parts[1].clone(), d.join("unfinished.ckpt")]);
     assert!(e.contains("unfinished part") && e.contains("samples 65..100 of its range 65..120"), "{e}");
     assert!(!d.join("bad.exr").exists());
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -240,7 +237,6 @@ fn resume_refuses_other_scene_options_and_broken_files() {
     assert!(run_err(render_cmd(32, &d.join("c"), &["--samples", "5..3"])).contains("A < B"));
     assert!(run_err(render_cmd(32, &d.join("c"), &["--samples", "0..33"])).contains("<= spp (32)"));
     assert!(run_err(render_cmd(32, &d.join("c"), &["--time-budget", "0"])).contains("--time-budget"));
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -283,7 +279,6 @@ fn time_budget_renders_whole_passes_and_records_spp() {
             "{err}"
         );
     }
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// A checkpoint covers every input file: a change to an OBJ included by the `.test` file (which
@@ -409,5 +404,4 @@ fn resume_with_more_spp_extends_a_finished_render_bit_identically() {
     run_ok(cmd("render", 16, "fib", &["--sampler", "sobol", "--pixel-sampler", &spec, "--checkpoint", ck]));
     let e = run_err(cmd("render", 32, "fib", &["--sampler", "sobol", "--pixel-sampler", &spec, "--resume", ck]));
     assert!(e.contains("cannot extend") && e.contains("not progressive") && e.contains("144 points"), "{e}");
-    std::fs::remove_dir_all(&d).ok();
 }

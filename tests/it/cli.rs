@@ -47,7 +47,6 @@ fn render_default_scene_writes_exr_png_and_stats() {
     assert_eq!(meta["strata.light_sampler"], "halton");
     assert!(meta.contains_key("strata.render_seconds") && meta.contains_key("strata.version"));
     assert!(std::fs::metadata(d.join("img.png")).unwrap().len() > 100);
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -65,7 +64,6 @@ fn bad_scene_is_a_clear_error_with_file_and_line() {
     let r = strata().args(["render", "--light-sampler", "nonsense"]).output().unwrap();
     assert!(!r.status.success());
     assert!(String::from_utf8_lossy(&r.stderr).contains("nonsense"));
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -127,7 +125,6 @@ fn reference_then_compare_writes_tables_and_plot() {
         .unwrap();
     assert!(!r.status.success());
     assert!(String::from_utf8_lossy(&r.stderr).contains("--variant x"));
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]

@@ -74,14 +74,27 @@ pub fn strata() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
 }
 
-/// A fresh, empty scratch directory `strata-NAME-PID-N` under the system temp dir (N counts the
-/// calls of this process: every integration test shares one binary, so two tests may pick the same
-/// name; the pid keeps processes that run at once apart).
-pub fn tmpdir(name: &str) -> PathBuf {
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let n = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let d = std::env::temp_dir().join(format!("strata-{name}-{}-{n}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh, empty scratch directory `strata-NAME-XXXXXX` under the system temp dir (a unique
+/// suffix: tests that run at once, in one process or several, never share one), removed with
+/// everything in it when the test drops it, so the test command leaves nothing behind. Keep it
+/// bound (`let dir = tmpdir(..)`) for as long as the test uses its files.
+pub fn tmpdir(name: &str) -> Scratch {
+    let dir = tempfile::Builder::new().prefix(&format!("strata-{name}-")).tempdir();
+    Scratch(dir.unwrap_or_else(|e| panic!("a scratch directory for {name}: {e}")))
+}
+
+/// A test's scratch directory ([`tmpdir`]): a path while it lives, removed when dropped.
+pub struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = std::path::Path;
+    fn deref(&self) -> &std::path::Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<std::path::Path> for Scratch {
+    fn as_ref(&self) -> &std::path::Path {
+        self.0.path()
+    }
 }

@@ -112,7 +112,6 @@ fn a_reference_of_another_scene_or_camera_is_refused_naming_both_unless_forced()
         &d.join("c5"),
     );
     assert!(o.status.success(), "{}", stderr(&o));
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -153,7 +152,6 @@ fn owned_flags_duplicate_names_and_uncapped_ladders_are_refused_with_the_reason(
         &d.join("x"),
     );
     assert!(!o.status.success() && stderr(&o).contains("max_spp"), "{}", stderr(&o));
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
@@ -203,7 +201,6 @@ fn variants_that_render_the_same_image_are_named_and_not_ranked() {
     let lines: Vec<String> = stderr(&o).lines().filter(|l| l.starts_with("compare: run ")).map(String::from).collect();
     assert_eq!(lines.len(), 12, "{}", stderr(&o));
     assert!(lines[0].starts_with("compare: run 1/12 (a at 1 spp)") && lines[11].contains("ETA"), "{lines:?}");
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// The issue's direct9 case: `--runs 4 --spp-ladder 1,4,16`, independent against stratified light
@@ -256,7 +253,6 @@ fn defaults_are_unbiased_and_independent_samples_converge_at_slope_minus_one_hal
         serde_json::from_str(&std::fs::read_to_string(d.join("out/runs.json")).unwrap()).unwrap();
     assert_eq!(runs.as_array().unwrap().len(), 2 * 3 * 4, "one row per run");
     assert_eq!(std::fs::read_to_string(d.join("out/runs.csv")).unwrap().lines().count(), 1 + 24);
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// A noisy reference (few spp): its variance layer enters the bias test and the noise-corrected
@@ -293,7 +289,6 @@ fn the_references_variance_layer_enters_the_bias_test_and_the_corrected_mse() {
     let se = (e.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0) / k).sqrt();
     let t = strata::report::student_t_quantile(0.975, k - 1.0);
     assert!(mean.abs() > t * se, "this case must need the reference's noise: {mean} +- {}", t * se);
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// Issue 31: `--budget 0.005,0.01,0.02` is a budget ladder: one row per budget and variant, a slope
@@ -387,5 +382,4 @@ fn compare_runs_on_an_xml_scene_with_glass_and_metal_and_writes_its_table() {
     assert!(md.contains("materials.xml") && md.contains("Provenance"), "{md}");
     // The provenance prints its numbers as a person would write them (was "0.10000000000000009%").
     assert!(md.contains("the largest 0.1% of squared errors dropped"), "{md}");
-    std::fs::remove_dir_all(&d).ok();
 }

@@ -167,7 +167,9 @@ fn file_sampler() -> SamplerKind {
     static KIND: std::sync::OnceLock<SamplerKind> = std::sync::OnceLock::new();
     *KIND.get_or_init(|| {
         use strata::pointset::{command, formats, spec};
-        let path = common::tmpdir("convergence-file").join("sobol.npy");
+        // The points are read when the sampler is resolved: the file's directory may go after.
+        let dir = common::tmpdir("convergence-file");
+        let path = dir.join("sobol.npy");
         let args = command::Args { sets: 16, points: 256, ..command::Args::default() };
         formats::write(&path, &command::layout_sets(SamplerKind::SOBOL, &args).expect("sets")).expect("written");
         spec::resolve_sampler(&format!("file:{}?scramble=owen", path.display())).expect("loads")

@@ -129,7 +129,6 @@ fn every_command_in_the_readme_parses() {
         let r = strata().current_dir(&dir).arg("parse-check").args(&args).output().unwrap();
         assert!(r.status.success(), "README: `strata {}`: {}", args.join(" "), String::from_utf8_lossy(&r.stderr));
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

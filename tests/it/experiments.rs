@@ -8,7 +8,8 @@ use crate::common;
 #[test]
 fn tiny_experiments_write_tables_report_and_plots() {
     let corpus = common::corpus_required();
-    let out = std::env::temp_dir().join(format!("strata-experiments-{}", std::process::id()));
+    let dir = common::tmpdir("experiments");
+    let out = dir.to_path_buf();
     let cfg = strata::lab::experiments::Config {
         corpus,
         out: out.clone(),
@@ -65,5 +66,4 @@ fn tiny_experiments_write_tables_report_and_plots() {
         let z = r["stats"]["z"].as_f64().unwrap();
         assert!(z.abs() < 4.0, "{} {} {}: z = {z}", r["table"], r["variant"], r["setting"]);
     }
-    std::fs::remove_dir_all(&out).ok();
 }

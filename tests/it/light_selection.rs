@@ -162,7 +162,7 @@ fn strategies_agree_on_mis_test() {
         assert!(g.z_mean.abs() < 4.5, "mis.test: power and {} disagree on the image mean: {g:?}", other.name);
         assert!(g.frac_3 <= 0.1, "mis.test: power and {} disagree per block: {g:?}", other.name);
     }
-    let rough = scene_variant(&scene, "mis-rough", &[], "");
+    let (_rough_dir, rough) = scene_variant(&scene, "mis-rough", &[], "");
     let text = std::fs::read_to_string(&rough)
         .unwrap()
         .replace("roughness 0.0005", "roughness 0.15")
@@ -185,7 +185,7 @@ fn strategies_agree_on_mis_test() {
 
 /// `base` (a scene file) with the lines starting with one of the `drop` keywords removed and
 /// `extra` appended, written to a scratch file named `name`.
-fn scene_variant(base: &Path, name: &str, drop: &[&str], extra: &str) -> PathBuf {
+fn scene_variant(base: &Path, name: &str, drop: &[&str], extra: &str) -> (common::Scratch, PathBuf) {
     let text = std::fs::read_to_string(base).unwrap();
     let mut out: String = text
         .lines()
@@ -193,11 +193,10 @@ fn scene_variant(base: &Path, name: &str, drop: &[&str], extra: &str) -> PathBuf
         .map(|l| format!("{l}\n"))
         .collect();
     out += extra;
-    let d = std::env::temp_dir().join(format!("strata-lightsel-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let d = tmpdir("lightsel");
     let p = d.join(format!("{name}.test"));
     std::fs::write(&p, out).unwrap();
-    p
+    (d, p)
 }
 
 /// The many-light scene (2500 quads of mixed power and size over a glossy floor, two bounces),
@@ -208,7 +207,7 @@ fn scene_variant(base: &Path, name: &str, drop: &[&str], extra: &str) -> PathBuf
 /// fails the same test, so it has power.
 #[test]
 fn strategies_agree_on_many_lights() {
-    let scene =
+    let (_dir, scene) =
         scene_variant(&scene_dir().join("manylights.test"), "many", &["camera"], "camera 0 1.5 3  0 0 -1  0 1 0  30\n");
     let size = (32, 24);
     let mut mis = Vec::new();
@@ -254,7 +253,7 @@ fn strategies_agree_on_many_lights() {
 }
 
 /// The OBJ Cornell box (two emissive triangles) with two quad lights added, path traced to depth 3.
-fn triangles_and_quads() -> PathBuf {
+fn triangles_and_quads() -> (common::Scratch, PathBuf) {
     let text = std::fs::read_to_string(scene_dir().join("cornell_obj.test")).unwrap();
     let text: String = text
         .lines()
@@ -266,14 +265,14 @@ fn triangles_and_quads() -> PathBuf {
     let d = tmpdir("lightsel-tri");
     let scene = d.join("tri.test");
     std::fs::write(&scene, text).unwrap();
-    scene
+    (d, scene)
 }
 
 /// A scene with emissive OBJ triangles (the OBJ Cornell box's ceiling patch) and two quad lights
 /// of very different power: quads and triangles share one index space in every strategy.
 #[test]
 fn strategies_agree_with_emissive_triangles() {
-    let scene = triangles_and_quads();
+    let (_dir, scene) = triangles_and_quads();
     let mut mis = Vec::new();
     for (k, sel) in rules().into_iter().enumerate() {
         mis.push(estimate(&scene, (32, 32), 256, 60 + k as u64, sel, None));
@@ -335,7 +334,7 @@ fn compare_runs_light_selections_as_variants() {
 #[test]
 fn scene_keyword_and_flag_override() {
     let pt = "integrator pathtracer\nnexteventestimation on\nlightselection power\n";
-    let scene = scene_variant(&scene_dir().join("cornell.test"), "kw", &["integrator"], pt);
+    let (_dir, scene) = scene_variant(&scene_dir().join("cornell.test"), "kw", &["integrator"], pt);
     let o = opts(scene.clone(), 8, 8, 1);
     let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(strata::session::stats_json(&out)["light_selection"], "power");
@@ -343,7 +342,7 @@ fn scene_keyword_and_flag_override() {
     let o = RenderOptions { light_selection: Some(LightSelection::UNIFORM), ..opts(scene, 8, 8, 1) };
     let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(strata::session::stats_json(&out)["light_selection"], "uniform");
-    let bad = scene_variant(&scene_dir().join("cornell.test"), "kw-bad", &[], "lightselection nearest\n");
+    let (_bad_dir, bad) = scene_variant(&scene_dir().join("cornell.test"), "kw-bad", &[], "lightselection nearest\n");
     let lines = std::fs::read_to_string(&bad).unwrap().lines().count();
     let e = strata::session::render_to_film(&opts(bad, 8, 8, 1)).err().expect("refused").to_string();
     assert!(e.contains(&format!("kw-bad.test:{lines}")) && e.contains("all|uniform|power|spatial"), "{e}");
@@ -354,7 +353,7 @@ fn scene_keyword_and_flag_override() {
 /// and emissive triangles together; stats and summary name the strategy.
 #[test]
 fn direct_picks_one_light_per_sample() {
-    let scene = triangles_and_quads();
+    let (_dir, scene) = triangles_and_quads();
     let (size, n) = ((32, 32), 2);
     let (all, all_rays) = estimate_direct(&scene, size, 64, n, 80, LightSelection::ALL);
     let mut ests = vec![all];

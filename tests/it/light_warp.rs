@@ -66,7 +66,7 @@ fn both(name: &str, o: RenderOptions) {
 
 /// The OBJ Cornell box (two emissive triangles under the ceiling) with two quad lights added
 /// (one skewed, sampled by area under either warp), path traced to depth 3.
-fn triangles_and_quads() -> PathBuf {
+fn triangles_and_quads() -> (common::Scratch, PathBuf) {
     let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"));
     let text = std::fs::read_to_string(dir.join("cornell_obj.test")).unwrap();
     let text: String = text
@@ -79,7 +79,7 @@ fn triangles_and_quads() -> PathBuf {
     let d = tmpdir("lightwarp-tri");
     let scene = d.join("tri.test");
     std::fs::write(&scene, text).unwrap();
-    scene
+    (d, scene)
 }
 
 fn base(scene: &Path, (w, h): (u32, u32), spp: u32, seed: u64) -> RenderOptions {
@@ -108,7 +108,7 @@ fn solid_angle_agrees_with_area_sampling_on_quad_lights() {
 /// group chosen by power, and one light per sample).
 #[test]
 fn solid_angle_agrees_with_area_sampling_on_emissive_triangles() {
-    let scene = triangles_and_quads();
+    let (_dir, scene) = triangles_and_quads();
     for (k, sel) in
         [LightSelection::ALL, LightSelection::UNIFORM, LightSelection::named("power"), LightSelection::named("spatial")]
             .into_iter()

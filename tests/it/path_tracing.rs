@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use strata::session::RenderOptions;
 
 /// The built-in Cornell box (scenes/cornell.test) with the given settings replacing its own.
-fn variant(name: &str, settings: &[&str]) -> PathBuf {
+fn variant(name: &str, settings: &[&str]) -> (crate::common::Scratch, PathBuf) {
     let keys = [
         "integrator",
         "nexteventestimation",
@@ -30,11 +30,10 @@ fn variant(name: &str, settings: &[&str]) -> PathBuf {
         text.push_str(s);
         text.push('\n');
     }
-    let dir = std::env::temp_dir().join(format!("strata-path-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::tmpdir("path");
     let p = dir.join(format!("{name}.test"));
     std::fs::write(&p, text).unwrap();
-    p
+    (dir, p)
 }
 
 struct Est {
@@ -43,7 +42,8 @@ struct Est {
 }
 
 fn estimate(name: &str, settings: &[&str], spp: u32, seed: u64) -> Est {
-    let o = RenderOptions { seed, ..opts(variant(name, settings), 24, 24, spp) };
+    let (_dir, scene) = variant(name, settings);
+    let o = RenderOptions { seed, ..opts(scene, 24, 24, spp) };
     let out = strata::session::render_to_film(&o).unwrap();
     assert_eq!(out.stats.counters.nonfinite, 0, "{name}");
     Est { mean: means(&out.film), var: var_of_mean(&out.film) }
@@ -175,7 +175,7 @@ fn course_path_tracing_scenes_are_finite_and_packets_full() {
 /// Path tracing is bit-identical whatever the thread count (compaction order is per tile).
 #[test]
 fn path_tracing_is_bit_identical_across_thread_counts() {
-    let scene = variant(
+    let (_dir, scene) = variant(
         "det",
         &[
             "integrator pathtracer",
@@ -198,7 +198,7 @@ fn path_tracing_is_bit_identical_across_thread_counts() {
 /// mean is too; it darkens a scene whose unclamped samples exceed MAX, and the stats say biased.
 #[test]
 fn clamp_bounds_every_sample_and_reports_bias() {
-    let scene = variant("clamp", &["integrator pathtracer", "nexteventestimation on", "maxdepth 3"]);
+    let (_dir, scene) = variant("clamp", &["integrator pathtracer", "nexteventestimation on", "maxdepth 3"]);
     let free = strata::session::render_to_film(&opts(scene.clone(), 24, 24, 8)).unwrap();
     let clamped =
         strata::session::render_to_film(&RenderOptions { clamp: Some(0.5), ..opts(scene, 24, 24, 8) }).unwrap();

@@ -324,8 +324,7 @@ fn unwritable_profile_outputs_fail_before_rendering() {
 /// table prints them.
 #[test]
 fn cli_json_has_the_sampler_replay_with_one_entry_per_registered_kind() {
-    let dir = std::env::temp_dir().join(format!("strata-profile-replay-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = crate::common::tmpdir("profile-replay");
     let json = dir.join("p.json");
     let r = std::process::Command::new(env!("CARGO_BIN_EXE_strata"))
         .args(["profile", "--size", "32x24", "--spp", "2", "--threads", "2", "--repeats", "1"])
@@ -353,7 +352,6 @@ fn cli_json_has_the_sampler_replay_with_one_entry_per_registered_kind() {
         assert_eq!(k["calls"].as_u64(), Some(calls));
         assert!(out.contains(k["kind"].as_str().unwrap()));
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A log capped below the render's size replays a subset of the tiles, says so, and still

@@ -54,11 +54,11 @@ const SCENE: &str = r#"<scene version="3.0.0">
 "#;
 
 /// The scene with `extra` inserted, written to a fresh directory.
-fn scene_file(extra: &str) -> std::path::PathBuf {
+fn scene_file(extra: &str) -> (crate::common::Scratch, std::path::PathBuf) {
     let d = crate::common::tmpdir("ptracer");
     let p = d.join("scene.xml");
     std::fs::write(&p, SCENE.replace("$extra", extra)).unwrap();
-    p
+    (d, p)
 }
 
 fn opts(scene: &std::path::Path, integrator: &str, spp: u32, seed: u64, threads: usize) -> RenderOptions {
@@ -80,7 +80,7 @@ fn render(o: &RenderOptions) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
 
 #[test]
 fn agrees_with_the_path_tracer_per_pixel() {
-    let scene = scene_file("");
+    let (_dir, scene) = scene_file("");
     let (a, va) = render(&opts(&scene, "ptracer", 256, 1, 2));
     let (b, vb) = render(&opts(&scene, "path", 256, 2, 2));
     let (mut n, mut ok, mut sum_a, mut sum_b) = (0, 0, 0.0f64, 0.0f64);
@@ -110,7 +110,7 @@ fn agrees_with_the_path_tracer_per_pixel() {
 
 #[test]
 fn error_falls_as_samples_grow() {
-    let scene = scene_file("");
+    let (_dir, scene) = scene_file("");
     let (r, _) = render(&opts(&scene, "path", 2048, 7, 2));
     let rmse = |spp: u32| {
         let (a, _) = render(&opts(&scene, "ptracer", spp, 3, 2));
@@ -126,7 +126,7 @@ fn error_falls_as_samples_grow() {
 
 #[test]
 fn bit_identical_across_threads_and_passes() {
-    let scene = scene_file("");
+    let (_dir, scene) = scene_file("");
     let bits =
         |f: &strata::film::Film| f.sum.iter().chain(&f.sum_sq).flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
     let one = strata::session::render_to_film(&opts(&scene, "ptracer", 6, 4, 1)).unwrap();
@@ -149,11 +149,11 @@ fn what_it_cannot_render_is_refused_by_name() {
         (r#"<emitter type="directional"><vector name="direction" x="0" y="-1" z="0"/></emitter>"#, "directional"),
     ];
     for (extra, what) in cases {
-        let scene = scene_file(extra);
+        let (_dir, scene) = scene_file(extra);
         let e = strata::session::render_to_film(&opts(&scene, "ptracer", 1, 0, 1)).err().expect(what).to_string();
         assert!(e.contains("particle tracer") && e.contains(what), "{what}: {e}");
     }
-    let scene = scene_file("");
+    let (_dir, scene) = scene_file("");
     let mut o = opts(&scene, "ptracer", 1, 0, 1);
     o.defines.push(("filter".into(), "gaussian".into()));
     let e = strata::session::render_to_film(&o).err().expect("gaussian").to_string();

@@ -30,7 +30,6 @@ fn chromium(url: &str, extra: &[&str]) -> (String, String) {
         .arg(url)
         .output()
         .expect("chromium runs (scripts/setup.sh installs Debian's chromium)");
-    std::fs::remove_dir_all(&profile).ok();
     (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
@@ -105,7 +104,6 @@ fn report_html_flip_book_shows_every_variant_in_headless_chromium() {
     let (_, log) = chromium(&url, &[&format!("--screenshot={}", shot.display()), "--window-size=1280,1600"]);
     let png = std::fs::read(&shot).unwrap_or_else(|e| panic!("no screenshot {}: {e}\n{log}", shot.display()));
     assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000, "screenshot of {} bytes", png.len());
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// Issue 31: the report is supplementary material. Its HTML carries insets of the regions where
@@ -135,7 +133,6 @@ fn report_html_has_crops_by_error_a_mean_error_image_and_a_frame_per_run() {
         }
     }
     assert_eq!(html.matches("data-kind=\"run\"").count(), variants.len() * runs, "one frame per run");
-    std::fs::remove_dir_all(&d).ok();
 }
 
 /// Issue 31: the report fits a 1200-px window: in headless Chromium at 1200 px the page's scroll
@@ -156,5 +153,4 @@ fn report_html_fits_1200_px_without_horizontal_overflow() {
     let (scroll, client) = (nums[0], nums[1]);
     assert!((1100..=1200).contains(&client), "{line}");
     assert!(scroll <= client, "the page overflows 1200 px: {line}");
-    std::fs::remove_dir_all(&d).ok();
 }

@@ -178,7 +178,6 @@ fn tiny_bright_light_matches_a_large_light_of_equal_power() {
         compare(&l, &al, None, 4).assert_ok(&format!("{name}: large light vs its exact irradiance"));
         compare(&t, &l, Some(&expected), 4).assert_ok(&format!("{name}: tiny - large vs the analytic difference"));
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A light whose edge is 0.002 above the floor (1/d^2 up to 2.5e5): finite samples, and `direct` and
@@ -194,7 +193,6 @@ fn light_almost_touching_a_surface_matches_its_exact_irradiance() {
         let r = render(&RenderOptions { spp: Some(256), seed: 5, ..o });
         compare(&r, &a, None, 4).assert_ok(&format!("{name}: near light vs its exact irradiance"));
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 // ---- scene scale -----------------------------------------------------------------------------------
@@ -243,7 +241,6 @@ fn cornell_box_renders_the_same_at_scale_1e_minus_3_and_1e3() {
         let dref = render(&opts_for(scaled_scene(1.0, &dir), IntegratorKind::Direct, 1));
         compare(&d, &dref, None, 4).assert_ok(&format!("direct, scale {s:e} vs 1"));
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 // ---- degenerate geometry and cameras ---------------------------------------------------------------
@@ -293,7 +290,6 @@ fn zero_area_triangles_leave_the_image_unchanged() {
     assert_eq!(lines.len(), 1, "one warning line: {lines:?}");
     assert_eq!(lines[0], format!("strata: warning: {}: dropped 5 degenerate (zero-area) triangles", with.display()));
     assert!(warned(&plain).is_empty());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A camera inside a closed cube and inside a sphere, both standing in the lit box: the rays hit
@@ -316,7 +312,6 @@ fn camera_inside_geometry_sees_a_black_interior() {
             assert_eq!(max, 0.0, "{name} {integ:?}: the inside of a closed object is lit");
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Degenerate lights and cameras are clear errors naming the file and line.
@@ -350,7 +345,6 @@ fn degenerate_lights_and_cameras_are_errors_with_file_and_line() {
         let want = format!("{}:{line}: ", p.display());
         assert!(e.starts_with(&want) && e.contains(word), "`{to}`: error `{e}`, want `{want}...{word}...`");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 // ---- output files ----------------------------------------------------------------------------------
@@ -387,7 +381,6 @@ fn failed_renders_keep_existing_outputs_and_leave_no_temporaries() {
     let names: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.contains(".tmp-")), "temporary files left: {names:?}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// An interrupted write (the process's file-size limit, RLIMIT_FSIZE, makes the write of the EXR
@@ -422,5 +415,4 @@ fn a_write_cut_short_never_truncates_the_final_files() {
     let names: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert!(names.iter().all(|n| !n.contains(".tmp-")), "temporary files left: {names:?}");
-    std::fs::remove_dir_all(&dir).ok();
 }
