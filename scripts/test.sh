@@ -31,7 +31,16 @@ if [ ${#args[@]} -eq 0 ]; then
   cargo clippy --profile ci --workspace --all-targets -- -D warnings
 fi
 # --no-fail-fast: one failing test binary does not hide the others' results (the exit status still fails).
-cargo test --profile ci --no-fail-fast ${args[@]+"${args[@]}"}
+# The tests run with a temp dir of their own, which must be empty afterwards: a test that leaves
+# scratch files behind (in every developer's /tmp, run after run) fails the suite.
+tests_tmp="$(mktemp -d)"
+trap 'rm -rf "$tests_tmp"' EXIT
+TMPDIR="$tests_tmp" cargo test --profile ci --no-fail-fast ${args[@]+"${args[@]}"}
+if [ -n "$(ls -A "$tests_tmp")" ]; then
+  echo "test: the tests left these in their temp dir (use tests/it/common.rs's tmpdir(), removed on drop):" >&2
+  ls -A "$tests_tmp" >&2
+  exit 1
+fi
 if [ ${#args[@]} -eq 0 ]; then
   # The Python module (scripts/setup.sh --python builds it into .venv), tested against the binary
   # cargo test just built.

@@ -85,9 +85,10 @@ impl SphericalRect8 {
         // k = 2 pi - g2 - g3.
         let k = F8::PI - a23;
         let (l0, l2) = (y0.mul_add(y0, z2).sqrt(), y1.mul_add(y1, z2).sqrt());
-        let (b0, b1) = (-y0 / l0, y1 / l2);
-        // sqrt(1 - b0^2), the sine of the angle whose cosine is b0.
-        let w = -z0 / l0;
+        // b0 and w = sqrt(1 - b0^2) (the sine of the angle whose cosine is b0) share 1 / l0: the
+        // warp's time is its divisions and square roots, which share one unit.
+        let inv_l0 = F8::ONE / l0;
+        let (b0, b1, w) = (-y0 * inv_l0, y1 / l2, -z0 * inv_l0);
         Self { o, ex, ey, ez, x0, y0, z0, x1, y1, b0, b1, w, k, s }
     }
 
@@ -122,7 +123,8 @@ impl SphericalRect8 {
         let hv = v.mul_add(h1 - h0, h0);
         let hv2 = hv * hv;
         let inside = hv2.simd_lt(F8::splat(1.0 - 1e-6));
-        let yv = inside.select(hv * dd.sqrt() / (F8::ONE - hv2).max(tiny).sqrt(), y1);
+        // y = h sqrt(dd / (1 - h^2)): one square root where two divided.
+        let yv = inside.select(hv * (dd / (F8::ONE - hv2).max(tiny)).sqrt(), y1);
         let yv = yv.max(y0).min(y1);
         self.ez.mul_add(z0, self.ey.mul_add(yv, self.ex.mul_add(xu, self.o)))
     }
