@@ -118,8 +118,8 @@ impl Estimator for Direct {
 /// One sampling group of `direct`.
 #[derive(Clone, Copy)]
 enum Group<'a> {
-    /// one quad light (its index in the scene's emitters, and the light)
-    Quad(usize, &'a Emitter),
+    /// one quad light
+    Quad(&'a Emitter),
     /// all emissive triangles, chosen by power
     Triangles,
 }
@@ -139,11 +139,10 @@ impl Group<'_> {
         ls: &mut LightSample8,
     ) -> Mask8 {
         match self {
-            Group::Quad(i, e) => {
+            Group::Quad(e) => {
                 let _p = crate::profile::leaf(crate::profile::Phase::Emitter);
                 *ls = e.sample_x8(uv.0, uv.1);
-                // The light's warp row from the emitters' table (not computed again per packet).
-                scene.emitters.warp_one_x8(i, it.light_warp, ls, sh.p, active);
+                e.warp_x8(it.light_warp, ls, sh.p, active);
                 active
             }
             // The triangle chosen by power from u, u remapped within its interval (`reuse`).
@@ -159,7 +158,7 @@ impl Group<'_> {
 
 /// The groups of `scene` in sampler-dimension order: the quad lights, then the triangles if any.
 fn groups(scene: &Scene) -> impl Iterator<Item = Group<'_>> {
-    let quads = scene.emitters.list[..scene.emitters.n_quads].iter().enumerate().map(|(i, e)| Group::Quad(i, e));
+    let quads = scene.emitters.list[..scene.emitters.n_quads].iter().map(Group::Quad);
     quads.chain((scene.emitters.n_triangles() > 0).then_some(Group::Triangles))
 }
 
@@ -285,14 +284,14 @@ fn shade_all<L: LobeSet>(
             // f cos_i cos_l / d^2: a quad's sum is scaled once below; the triangles' terms are
             // complete.
             let weigh = |ls: &LightSample8, f: Vec3x8, g: F8, lit: Mask8| match group {
-                Group::Quad(..) if warped => f.scale(g * ls.area),
-                Group::Quad(..) => f.scale(g),
+                Group::Quad(_) if warped => f.scale(g * ls.area),
+                Group::Quad(_) => f.scale(g),
                 Group::Triangles => masked(f.mul_elem(ls.radiance).scale(g * ls.area * ls.inv_pmf * inv_n), lit),
             };
-            let target = if let Group::Quad(..) = group { &mut acc[..] } else { &mut *out };
+            let target = if let Group::Quad(_) = group { &mut acc[..] } else { &mut *out };
             sample_batch::<L>(scene, tracer, hits, lanes, batch, point, sample, weigh, target, mis);
         }
-        if let Group::Quad(_, light) = group {
+        if let Group::Quad(light) = group {
             let area = if warped { F8::ONE } else { F8::splat(light.area) };
             let scale = Vec3x8::splat(light.radiance).scale(inv_n * area);
             for (o, acc) in out.iter_mut().zip(acc.iter()) {
