@@ -33,8 +33,8 @@ use crate::simd::{Mask8, Vec3x8, F8, U8};
 /// (u, v), relative to the size of a unit light seen head-on. The rectangle's error grows as 1/S
 /// (its `au = u S + k` keeps `ulp(k) / S` of u's resolution): 2.2e-5 at S = 1e-2, 1.7e-4 at
 /// 1.1e-3, 2.6e-3 at 1e-4, 2.6e-2 at 1.1e-5 (with the one-division `atan2` and the multiplied-out
-/// column of `sampling::spherical_rect`; the three-step form read 2.1e-3 and 1.7e-2 there). The triangle's (half-angle form, see
-/// `sampling::spherical_tri`) stays below 2e-5 down to 1e-6 sr. At 3e-4 sr the rectangle is
+/// column of `sampling::spherical_rect`; the three-step form read 2.1e-3 and 1.7e-2 there). The
+/// triangle's (half-angle form, see `sampling::spherical_tri`) stays below 2e-5 down to 1e-6 sr. At 3e-4 sr the rectangle is
 /// within 1e-3 of its light; a unit light is then 58 units away, where area sampling's density
 /// is within 3e-4 of uniform in solid angle anyway, so nothing is lost by falling back there.
 pub const OMEGA_MIN: f32 = 3e-4;
@@ -236,6 +236,17 @@ impl Emitter {
             if row.0[15] != WarpRow::NONE {
                 rewarp(&Lights8::one(&row), ls, p, active);
             }
+        }
+    }
+}
+
+impl WarpRow {
+    /// [`Emitter::warp_x8`] of the light whose row this is (from [`Emitters::warp_rows`] rather
+    /// than computed again).
+    #[inline]
+    pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
+        if warp == LightWarp::SolidAngle && self.0[15] != WarpRow::NONE {
+            rewarp(&Lights8::one(self), ls, p, active);
         }
     }
 }

@@ -551,14 +551,14 @@ impl Bounce<'_> {
                     } else {
                         (None, None)
                     };
-                    for (i, e) in scene.emitters.list.iter().enumerate() {
+                    for (e, row) in scene.emitters.list.iter().zip(&scene.emitters.warp_rows) {
                         for j in 0..n_all {
                             let (uj, wj) = lattice_point(u, w, j, n_all);
                             // (The sample stays where it is made: a block returning it copied its
                             // 448 bytes out.) The warp reads the light's row from the table.
                             let p = crate::profile::leaf(crate::profile::Phase::Emitter);
                             let mut ls = e.sample_x8(uj, wj);
-                            scene.emitters.warp_one_x8(i, it.light_warp, &mut ls, sh.p, shade);
+                            row.warp_x8(it.light_warp, &mut ls, sh.p, shade);
                             drop(p);
                             push(&ls, scale, mis_n, shade);
                         }
