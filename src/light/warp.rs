@@ -231,11 +231,9 @@ impl Emitter {
     /// where the warp applies (module docs), on the lanes `active`.
     #[inline]
     pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
+        // The row is computed only where it is used.
         if warp == LightWarp::SolidAngle {
-            let row = self.warp_row();
-            if row.0[15] != WarpRow::NONE {
-                rewarp(&Lights8::one(&row), ls, p, active);
-            }
+            self.warp_row().warp_x8(warp, ls, p, active);
         }
     }
 }
@@ -243,7 +241,7 @@ impl Emitter {
 impl WarpRow {
     /// [`Emitter::warp_x8`] of the light whose row this is (from [`Emitters::warp_rows`] rather
     /// than computed again).
-    #[inline]
+    #[inline(always)]
     pub fn warp_x8(&self, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
         if warp == LightWarp::SolidAngle && self.0[15] != WarpRow::NONE {
             rewarp(&Lights8::one(self), ls, p, active);
@@ -265,9 +263,7 @@ impl Emitters {
     /// again).
     #[inline]
     pub fn warp_one_x8(&self, i: usize, warp: LightWarp, ls: &mut LightSample8, p: Vec3x8, active: Mask8) {
-        if warp == LightWarp::SolidAngle && self.warp_rows[i].0[15] != WarpRow::NONE {
-            rewarp(&Lights8::one(&self.warp_rows[i]), ls, p, active);
-        }
+        self.warp_rows[i].warp_x8(warp, ls, p, active);
     }
 
     /// The solid angle S of lights `ids` seen from `p` and the lanes of `active` where

@@ -14,8 +14,9 @@
 //! the left of x (the paper's `au = u S + k`; its three steps `fu`, `cu`, `xu` multiplied out into
 //! one square root and one division), v its y uniformly in the height `h = y / sqrt(x^2 + y^2 +
 //! z0^2)` along the column, which is uniform in solid angle. The density is 1 / S per unit solid
-//! angle. The warp's cost is latency (a chain of divisions and square roots per shading point,
-//! which the lanes wait on), so the forms here are the ones with the shortest chain.
+//! angle. The warp's cost is its divisions and square roots, which share one unit of the core
+//! (measured: `cargo bench --bench lights -- warps` reads the same per packet whether packets
+//! wait on each other or not), so the forms here are the ones with the fewest.
 //!
 //! Only the x8 form does arithmetic; the scalar form is lane 0 of it on splatted input, so the two
 //! are bit-identical. Precision: for a small S the argument `au`, near pi/2 .. pi, keeps

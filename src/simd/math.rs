@@ -1,5 +1,5 @@
-//! Eight-lane functions kept short in latency for the light warps, where one shading point's
-//! chain of divisions and square roots is what the lanes wait on.
+//! Eight-lane functions with fewer divisions for the light warps, whose time is their divisions
+//! and square roots (one unit of the core runs both).
 //!
 //! - [`atan2`]: one division where `wide`'s `f32x8::atan2` chains two (`t = y / x`, then
 //!   `(t - 1) / (t + 1)`); the same octant reduction and polynomial (Cephes' `atanf`, as in Agner
