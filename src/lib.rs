@@ -11,6 +11,7 @@ pub mod checkpoint;
 #[allow(dead_code)]
 #[path = "cli.rs"]
 mod cli;
+pub mod cli_values;
 pub mod files;
 pub mod film;
 pub mod frontend;
