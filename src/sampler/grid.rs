@@ -65,8 +65,24 @@ pub(super) fn cell_coord<L: Lanes>(c: L, m: Divisor, v: L) -> L {
 /// The 24-bit fixed-point points of cell `c` of an m-cell axis: `[lo, hi)` with
 /// lo = ceil(c 2^24 / m) and hi = ceil((c+1) 2^24 / m), so every y in it has c/m <= y 2^-24 < (c+1)/m.
 /// (Cells narrower than 2^-24 collapse onto their lower edge.)
-#[inline]
+///
+/// Up to 2^16 cells (every grid a sampler draws from in practice: `multijitter`'s fine cells are
+/// the set's n, `direct`'s light tables spp x light samples) `lo` is two digits of long division
+/// (base 2^16, then 2^8: `c 2^16` fits in 32 bits) and `hi` follows from it: with `2^24 = q m +
+/// r`, `c 2^24 + m - 1 = lo m + rem` gives `(c+1) 2^24 + m - 1 = (lo + q) m + rem + r`, and `rem + r
+/// < 2m`, so `hi = lo + q + [rem + r >= m]` (2^24 itself for the last cell). Two divisions where
+/// [`cell_coord`] twice took six; the same integers, so the same bits.
+#[inline(always)]
 pub(super) fn cell_span<L: Lanes>(c: L, m: Divisor) -> (L, L) {
+    if m.d <= 1 << 16 {
+        let v = m.d - 1;
+        let (q1, r1) = m.div_rem(c.shl(16).or(L::splat(v >> 8)));
+        let (q2, rem) = m.div_rem(r1.shl(8).or(L::splat(v & 0xff)));
+        let lo = q1.shl(8).or(q2);
+        let (q, r) = (FIXED_ONE / m.d, FIXED_ONE % m.d);
+        let carry = rem.add(L::splat(r)).lt_select(L::splat(m.d), L::splat(0), L::splat(1));
+        return (lo, lo.add(L::splat(q)).add(carry));
+    }
     let v = L::splat(m.d.min(FIXED_ONE) - 1);
     let next = c.add(L::splat(1));
     // cell_coord needs its cell below m: the top edge of the last cell is 2^24 itself.
