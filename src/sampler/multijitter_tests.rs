@@ -185,6 +185,25 @@ fn permute_lanes_is_a_permutation() {
     assert!(differs);
 }
 
+/// A grid side's permutation on its compile-time domain (`side`) is the run-time domain's, for
+/// every side up to 300 (the listed ones and the others), scalar and x8: the same bits.
+#[test]
+fn side_permutations_equal_the_run_time_domains() {
+    for m in 1u32..=300 {
+        let d = std::hint::black_box(PermDomain::new(m));
+        for key in [0u32, 1, 0xdead_beef, u32::MAX] {
+            for i in 0..m {
+                assert_eq!(side(i, &d, key), permute_lanes(i, &d, key), "m = {m}, key {key}, i {i}");
+            }
+            for i0 in (0..m).step_by(8) {
+                let lanes = crate::simd::U8::new(std::array::from_fn(|j| (i0 + j as u32) % m));
+                let keys = crate::simd::U8::new(std::array::from_fn(|j| key.wrapping_add(j as u32)));
+                assert_eq!(side(lanes, &d, keys).to_array(), permute_lanes(lanes, &d, keys).to_array(), "m = {m}");
+            }
+        }
+    }
+}
+
 /// The permutation domains are tight: 0..m in Z_a x Z_b with a * b == m where m has a factor
 /// pair near its square root (no cycle walking: the x8 lanes walked in lockstep, 2-5 passes of
 /// four hashes for 10 or 100 points in power-of-two domains of 16 and 128), else with fewer than

@@ -53,6 +53,11 @@ pub(super) struct PermDomain {
 }
 
 impl PermDomain {
+    /// m: the domain is 0..m.
+    pub(super) const fn m(&self) -> u32 {
+        self.m
+    }
+
     /// The domain of 0..m (m == 0 acts as 1). A `const fn`, so that the domains of the common set
     /// sizes can be constants (`multijitter`'s specialised points).
     pub(super) const fn new(m: u32) -> Self {
