@@ -113,8 +113,8 @@ fn grid_point<L: Lanes>(grid: &Grid, key: L, dim: u32, k: L) -> (L::F, L::F) {
 /// [`PermDomain`] for the sides of the usual sets: spp x light samples points of `direct`'s light
 /// tables (hw2's 25 light samples at 64 spp: 1600 points, a 40 x 40 grid), non-power-of-two spp.
 /// Their rounds' widths, table offsets and divisors then fold into the code: the same operations
-/// on the same values as on the run-time domain, so the same bits (the light tables' sides
-/// 40: `keyed_point` 370.6 -> 238.7 M instructions on hw2 sphere, 40 x 30, 64 spp). Sides of the
+/// on the same values as on the run-time domain, so the same bits (the light tables' sides of
+/// 40: `keyed_point` 370.6 -> 245.9 M instructions on hw2 sphere, 40 x 30, 64 spp). Sides of the
 /// compile-time grids fold to their arm.
 #[inline(always)]
 fn side<L: Lanes>(i: L, d: &PermDomain, key: L) -> L {
