@@ -204,6 +204,31 @@ fn side_permutations_equal_the_run_time_domains() {
     }
 }
 
+/// The sets on compile-time grids (`keyed_point`'s arms) give the run-time grid's points, bit for
+/// bit: every listed size and its neighbours, the camera's dimension and another, four keys,
+/// scalar and x8.
+#[test]
+fn compile_time_grids_equal_the_run_time_grid() {
+    let sizes = [4u32, 8, 9, 16, 25, 32, 36, 64, 100, 128, 144, 256, 288, 400, 576, 800, 1152, 1600, 2304, 3200, 6400];
+    for n in sizes.into_iter().flat_map(|n| [n - 1, n, n + 1]) {
+        let set = PointSet::new(SamplerKind::MULTIJITTER, n).shape();
+        let grid = std::hint::black_box(*set.grid());
+        let ks: Vec<u32> = if n <= 300 { (0..n).collect() } else { (0..n).step_by(7).chain([n - 1]).collect() };
+        for key in [0u32, 1, 0xdead_beef, u32::MAX] {
+            for dim in [0, 3] {
+                for &k in &ks {
+                    let (a, b) = (keyed_point(&set, key, dim, k), grid_point(&grid, key, dim, k));
+                    assert_eq!((a.0.to_bits(), a.1.to_bits()), (b.0.to_bits(), b.1.to_bits()), "n = {n}, k {k}");
+                }
+                let k8 = crate::simd::U8::new(std::array::from_fn(|j| ks[j % ks.len()]));
+                let keys = crate::simd::U8::new(std::array::from_fn(|j| key.wrapping_add(j as u32)));
+                let (a, b) = (keyed_point(&set, keys, dim, k8), grid_point(&grid, keys, dim, k8));
+                assert_eq!((a.0.to_array(), a.1.to_array()), (b.0.to_array(), b.1.to_array()), "x8: n = {n}");
+            }
+        }
+    }
+}
+
 /// The permutation domains are tight: 0..m in Z_a x Z_b with a * b == m where m has a factor
 /// pair near its square root (no cycle walking: the x8 lanes walked in lockstep, 2-5 passes of
 /// four hashes for 10 or 100 points in power-of-two domains of 16 and 128), else with fewer than
