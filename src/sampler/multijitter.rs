@@ -80,7 +80,7 @@ const DIM_CAMERA: u32 = 0;
 /// code (the same operations on the same values as the run-time grid, so the same bits: the
 /// set-up of three permutations was a fifth of the instructions of a point). So do `direct`'s
 /// light tables of the course's 9 and 25 light samples at 16 to 256 spp (144 to 6400 points: at
-/// 64 spp with 25, hw2's scenes, `keyed_point` 245.9 -> 191.9 M instructions) and the square
+/// 64 spp with 25, hw2's scenes, `keyed_point` 245.9 -> 192.9 M instructions) and the square
 /// non-power-of-two spp 9, 25, 36 and 100.
 #[inline]
 fn keyed_point<L: Lanes>(set: &SetShape, key: L, dim: u32, k: L) -> (L::F, L::F) {
