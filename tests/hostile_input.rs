@@ -7,6 +7,7 @@
 //! Issue 25's findings (CPUs and builds, outputs, resources) are in `hostile/`.
 
 use proptest::prelude::*;
+use run::scratch;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use strata::accel::alloc::CountingAlloc;
@@ -404,10 +405,6 @@ fn run_within(dir: &Path, args: &[&str], secs: u64) -> (Option<i32>, String) {
     }
     let o = child.wait_with_output().unwrap();
     (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
-}
-
-fn scratch(name: &str) -> common::Scratch {
-    common::tmpdir(&format!("hostile-{name}"))
 }
 
 /// `--threads` far above the cores is refused before any thread starts, naming the limit;

@@ -60,7 +60,7 @@ pub fn shell(dir: &Path, script: &str, args: &[&str], secs: u64) -> Run {
 
 /// A fresh scratch directory, removed when dropped ([`crate::common::tmpdir`]).
 pub fn scratch(name: &str) -> crate::common::Scratch {
-    crate::common::tmpdir(&format!("hostile25-{name}"))
+    crate::common::tmpdir(&format!("hostile-{name}"))
 }
 
 /// The pixel channels of an EXR: (layer name, f32 bits).
