@@ -98,3 +98,22 @@ impl AsRef<std::path::Path> for Scratch {
         self.0.path()
     }
 }
+
+/// The OBJ Cornell box (`scenes/cornell_obj.test`: two emissive triangles under the ceiling) path
+/// traced to depth 3 with the `.test` lines `lights` (quad lights) added, written to a scratch
+/// directory named after `name`.
+pub fn cornell_obj_with(name: &str, lights: &str) -> (Scratch, PathBuf) {
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"));
+    let text = std::fs::read_to_string(dir.join("cornell_obj.test")).unwrap();
+    let text: String = text
+        .lines()
+        .filter(|l| !l.starts_with("obj ") && !l.starts_with("maxdepth"))
+        .map(|l| format!("{l}\n"))
+        .collect::<String>()
+        + &format!("maxdepth 3\nobj {}\n", dir.join("cornell_box.obj").display())
+        + lights;
+    let d = tmpdir(name);
+    let scene = d.join("tri.test");
+    std::fs::write(&scene, text).unwrap();
+    (d, scene)
+}

@@ -254,18 +254,10 @@ fn strategies_agree_on_many_lights() {
 
 /// The OBJ Cornell box (two emissive triangles) with two quad lights added, path traced to depth 3.
 fn triangles_and_quads() -> (common::Scratch, PathBuf) {
-    let text = std::fs::read_to_string(scene_dir().join("cornell_obj.test")).unwrap();
-    let text: String = text
-        .lines()
-        .filter(|l| !l.starts_with("obj ") && !l.starts_with("maxdepth"))
-        .map(|l| format!("{l}\n"))
-        .collect::<String>()
-        + &format!("maxdepth 3\nobj {}\n", scene_dir().join("cornell_box.obj").display())
-        + "quadLight -0.9 1.2 -0.98  0 0.2 0  0.2 0 0  40 10 10\nquadLight -0.98 0.3 0.6  0 0.6 0  0 0 -0.6  0.5 0.5 1.5\n";
-    let d = tmpdir("lightsel-tri");
-    let scene = d.join("tri.test");
-    std::fs::write(&scene, text).unwrap();
-    (d, scene)
+    common::cornell_obj_with(
+        "lightsel-tri",
+        "quadLight -0.9 1.2 -0.98  0 0.2 0  0.2 0 0  40 10 10\nquadLight -0.98 0.3 0.6  0 0.6 0  0 0 -0.6  0.5 0.5 1.5\n",
+    )
 }
 
 /// A scene with emissive OBJ triangles (the OBJ Cornell box's ceiling patch) and two quad lights

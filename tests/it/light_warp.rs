@@ -67,19 +67,10 @@ fn both(name: &str, o: RenderOptions) {
 /// The OBJ Cornell box (two emissive triangles under the ceiling) with two quad lights added
 /// (one skewed, sampled by area under either warp), path traced to depth 3.
 fn triangles_and_quads() -> (common::Scratch, PathBuf) {
-    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"));
-    let text = std::fs::read_to_string(dir.join("cornell_obj.test")).unwrap();
-    let text: String = text
-        .lines()
-        .filter(|l| !l.starts_with("obj ") && !l.starts_with("maxdepth"))
-        .map(|l| format!("{l}\n"))
-        .collect::<String>()
-        + &format!("maxdepth 3\nobj {}\n", dir.join("cornell_box.obj").display())
-        + "quadLight -0.9 1.2 -0.98  0 0.2 0  0.2 0 0  40 10 10\nquadLight -0.98 0.3 0.6  0 0.6 0.1  0 0 -0.6  0.5 0.5 1.5\n";
-    let d = tmpdir("lightwarp-tri");
-    let scene = d.join("tri.test");
-    std::fs::write(&scene, text).unwrap();
-    (d, scene)
+    common::cornell_obj_with(
+        "lightwarp-tri",
+        "quadLight -0.9 1.2 -0.98  0 0.2 0  0.2 0 0  40 10 10\nquadLight -0.98 0.3 0.6  0 0.6 0.1  0 0 -0.6  0.5 0.5 1.5\n",
+    )
 }
 
 fn base(scene: &Path, (w, h): (u32, u32), spp: u32, seed: u64) -> RenderOptions {
