@@ -84,30 +84,15 @@ const DIM_CAMERA: u32 = 0;
 /// non-power-of-two spp 9, 25, 36 and 100.
 #[inline]
 fn keyed_point<L: Lanes>(set: &SetShape, key: L, dim: u32, k: L) -> (L::F, L::F) {
-    match set.grid().n.d {
-        4 => grid_point(const { &Grid::new(4) }, key, dim, k),
-        8 => grid_point(const { &Grid::new(8) }, key, dim, k),
-        16 => grid_point(const { &Grid::new(16) }, key, dim, k),
-        32 => grid_point(const { &Grid::new(32) }, key, dim, k),
-        64 => grid_point(const { &Grid::new(64) }, key, dim, k),
-        128 => grid_point(const { &Grid::new(128) }, key, dim, k),
-        256 => grid_point(const { &Grid::new(256) }, key, dim, k),
-        9 => grid_point(const { &Grid::new(9) }, key, dim, k),
-        25 => grid_point(const { &Grid::new(25) }, key, dim, k),
-        36 => grid_point(const { &Grid::new(36) }, key, dim, k),
-        100 => grid_point(const { &Grid::new(100) }, key, dim, k),
-        144 => grid_point(const { &Grid::new(144) }, key, dim, k),
-        288 => grid_point(const { &Grid::new(288) }, key, dim, k),
-        576 => grid_point(const { &Grid::new(576) }, key, dim, k),
-        1152 => grid_point(const { &Grid::new(1152) }, key, dim, k),
-        2304 => grid_point(const { &Grid::new(2304) }, key, dim, k),
-        400 => grid_point(const { &Grid::new(400) }, key, dim, k),
-        800 => grid_point(const { &Grid::new(800) }, key, dim, k),
-        1600 => grid_point(const { &Grid::new(1600) }, key, dim, k),
-        3200 => grid_point(const { &Grid::new(3200) }, key, dim, k),
-        6400 => grid_point(const { &Grid::new(6400) }, key, dim, k),
-        _ => grid_point(set.grid(), key, dim, k),
+    macro_rules! grids {
+        ($($n:literal)*) => {
+            match set.grid().n.d {
+                $($n => grid_point(const { &Grid::new($n) }, key, dim, k),)*
+                _ => grid_point(set.grid(), key, dim, k),
+            }
+        };
     }
+    grids!(4 8 16 32 64 128 256 9 25 36 100 144 288 576 1152 2304 400 800 1600 3200 6400)
 }
 
 /// [`keyed_point`] on the set's grid `grid`.
