@@ -2,6 +2,9 @@
 //!
 //! - `sampler/<kind>/{scalar,x8}`: one 2D point of every sampler (sets of 16 points, as 16 light
 //!   samples would use); criterion's thrpt is points per second, so ns per sample = 1e9 / thrpt.
+//! - `sampler/multijitter-1600/stream_x8`: `multijitter`'s points from a 1600-point set, the size
+//!   of `direct`'s light table at 64 spp with 25 light samples (hw2's scenes): a set that is not a
+//!   power of two, so its grid (40 x 40) is not the one above.
 //! - `warp/<warp>/{scalar,x8}`: uniform hemisphere, cosine, Phong lobe (s = 30), GGX half vector
 //!   (alpha = 0.3), parallelogram; thrpt is directions per second.
 //! - `equal_time/<technique>`: one single-threaded render per technique; after criterion, a table
@@ -73,6 +76,22 @@ fn samplers(c: &mut Criterion) {
             })
         });
     }
+    // The light table of hw2's scenes at 64 spp (25 light samples): 8 pixels a stream, as above.
+    let table = PointSet::new(SamplerKind::MULTIJITTER, 1600);
+    let lane = U8::from([0, 1, 2, 3, 4, 5, 6, 7]);
+    g.bench_function("multijitter-1600/stream_x8", |b| {
+        b.iter(|| {
+            let mut acc = F8::splat(0.0);
+            for i in 0..POINTS / 128 {
+                let st = table.stream_x8(black_box(lane + U8::splat(i * 8)), U8::splat(0), 3, 7);
+                for k in 0..16 {
+                    let (x, y) = st.point(k * 97);
+                    acc += x + y;
+                }
+            }
+            acc
+        })
+    });
     g.finish();
 }
 
